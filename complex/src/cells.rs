@@ -1,0 +1,579 @@
+//! Input of a complex: vertex coordinates and top cells, and the facet
+//! extraction that turns top cells into every lower-dimensional cell.
+//!
+//! A top cell is a vertex list read according to its [`Shape`]:
+//! simplices (any order; orientation comes from sorted vertex order),
+//! cuboids (vertices in tensor order: local vertex `i` sits at offset
+//! `bit a of i` along local axis `a`, as in LAR's cuboidal grids), convex
+//! polygons (cyclic order) and convex polyhedra (a list of cyclic faces).
+//! Facets of each shape are generated combinatorially; identical facets
+//! coming from neighbouring cells are merged by their vertex sets.
+
+use crate::error::{ComplexError, Result};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Vertex coordinates: `len()` points in R^`dim()`, stored row by row.
+///
+/// ```
+/// use hasse_complex::Vertices;
+/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
+/// assert_eq!((v.len(), v.dim()), (3, 2));
+/// assert_eq!(v.point(1), &[1.0, 0.0]);
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Vertices {
+    dim: usize,
+    coords: Vec<f64>,
+}
+
+impl Vertices {
+    /// Points of dimension `dim` (1, 2 or 3) from a flat row-major array.
+    /// Non-finite coordinates are rejected with the vertex and axis named.
+    pub fn new(dim: usize, coords: Vec<f64>) -> Result<Self> {
+        if !(1..=3).contains(&dim) {
+            return Err(ComplexError::UnsupportedEmbedding(dim));
+        }
+        if coords.is_empty() {
+            return Err(ComplexError::NoVertices);
+        }
+        if coords.len() % dim != 0 {
+            return Err(ComplexError::CoordinateShape {
+                len: coords.len(),
+                dim,
+            });
+        }
+        if let Some(i) = coords.iter().position(|c| !c.is_finite()) {
+            return Err(ComplexError::NonFiniteCoordinate {
+                vertex: i / dim,
+                axis: i % dim,
+                value: coords[i],
+            });
+        }
+        Ok(Self { dim, coords })
+    }
+
+    /// Points from fixed-size arrays.
+    pub fn from_points<const D: usize>(points: &[[f64; D]]) -> Result<Self> {
+        Self::new(D, points.iter().flatten().copied().collect())
+    }
+
+    /// Dimension of the space the vertices live in.
+    pub fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// Number of vertices.
+    pub fn len(&self) -> usize {
+        self.coords.len() / self.dim
+    }
+
+    /// Always false for a constructed value (at least one vertex is required).
+    pub fn is_empty(&self) -> bool {
+        self.coords.is_empty()
+    }
+
+    /// Coordinates of vertex `i`.
+    pub fn point(&self, i: usize) -> &[f64] {
+        &self.coords[i * self.dim..(i + 1) * self.dim]
+    }
+
+    /// All coordinates, row-major.
+    pub fn as_slice(&self) -> &[f64] {
+        &self.coords
+    }
+
+    /// Mutable coordinates (row-major); used by mesh perturbation.
+    pub(crate) fn as_mut_slice(&mut self) -> &mut [f64] {
+        &mut self.coords
+    }
+}
+
+/// How the vertex list of a cell is read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Shape {
+    /// p+1 vertices in any order.
+    Simplex,
+    /// 2^p vertices in tensor order (bit `a` of the local index = side along axis `a`).
+    Cuboid,
+    /// A convex polygon, vertices in cyclic order.
+    Polygon,
+    /// A convex polyhedron; its vertex list encodes faces as
+    /// `[face_count, len_0, v.., len_1, v.., ...]`, each face cyclic.
+    Polyhedron,
+}
+
+/// Cells of one dimension given by shape and vertex list, stored flat.
+///
+/// ```
+/// use hasse_complex::TopCells;
+/// let mut cells = TopCells::default();
+/// cells.push_simplex(&[0, 1, 2]);
+/// cells.push_polygon(&[1, 3, 4, 2]);
+/// assert_eq!(cells.len(), 2);
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TopCells {
+    shapes: Vec<Shape>,
+    offsets: Vec<usize>,
+    vertices: Vec<u32>,
+}
+
+impl TopCells {
+    /// Simplices, each a list of p+1 vertex indices.
+    pub fn simplices<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
+        let mut out = Self::default();
+        for c in cells {
+            out.push_simplex(c.as_ref());
+        }
+        out
+    }
+
+    /// Cuboids (segments, quads, hexes), each 2^p vertices in tensor order.
+    pub fn cuboids<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
+        let mut out = Self::default();
+        for c in cells {
+            out.push_cuboid(c.as_ref());
+        }
+        out
+    }
+
+    /// Convex polygons in cyclic vertex order.
+    pub fn polygons<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
+        let mut out = Self::default();
+        for c in cells {
+            out.push_polygon(c.as_ref());
+        }
+        out
+    }
+
+    /// Convex polyhedra, each a list of faces in cyclic vertex order.
+    pub fn polyhedra<F: AsRef<[Vec<usize>]>>(cells: impl IntoIterator<Item = F>) -> Self {
+        let mut out = Self::default();
+        for c in cells {
+            out.push_polyhedron(c.as_ref());
+        }
+        out
+    }
+
+    fn push_raw(&mut self, shape: Shape, vertices: impl IntoIterator<Item = u32>) {
+        if self.offsets.is_empty() {
+            self.offsets.push(0);
+        }
+        self.shapes.push(shape);
+        self.vertices.extend(vertices);
+        self.offsets.push(self.vertices.len());
+    }
+
+    fn push_vertices(&mut self, shape: Shape, vertices: &[usize]) {
+        // Indices beyond u32 are clamped to u32::MAX, which validation reports
+        // as out of range (no mesh here has 4 billion vertices).
+        self.push_raw(
+            shape,
+            vertices
+                .iter()
+                .map(|&v| u32::try_from(v).unwrap_or(u32::MAX)),
+        );
+    }
+
+    /// Append a simplex.
+    pub fn push_simplex(&mut self, vertices: &[usize]) {
+        self.push_vertices(Shape::Simplex, vertices);
+    }
+
+    /// Append a cuboid (tensor vertex order).
+    pub fn push_cuboid(&mut self, vertices: &[usize]) {
+        self.push_vertices(Shape::Cuboid, vertices);
+    }
+
+    /// Append a convex polygon (cyclic vertex order).
+    pub fn push_polygon(&mut self, vertices: &[usize]) {
+        self.push_vertices(Shape::Polygon, vertices);
+    }
+
+    /// Append a convex polyhedron given by its faces (each cyclic).
+    pub fn push_polyhedron(&mut self, faces: &[Vec<usize>]) {
+        let clamp = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
+        let mut encoded = vec![clamp(faces.len())];
+        for f in faces {
+            encoded.push(clamp(f.len()));
+            encoded.extend(f.iter().map(|&v| clamp(v)));
+        }
+        self.push_raw(Shape::Polyhedron, encoded);
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.shapes.len()
+    }
+
+    /// True when no cell has been added.
+    pub fn is_empty(&self) -> bool {
+        self.shapes.is_empty()
+    }
+
+    /// Shape of cell `i`.
+    pub fn shape(&self, i: usize) -> Shape {
+        self.shapes[i]
+    }
+
+    /// Raw vertex list of cell `i` (for polyhedra, the face encoding).
+    pub fn raw_vertices(&self, i: usize) -> &[u32] {
+        &self.vertices[self.offsets[i]..self.offsets[i + 1]]
+    }
+
+    /// The distinct vertices of cell `i`, sorted: row `i` of the characteristic matrix.
+    pub fn vertex_set(&self, i: usize) -> Vec<u32> {
+        let mut set = match self.shapes[i] {
+            Shape::Polyhedron => polyhedron_faces(self.raw_vertices(i))
+                .into_iter()
+                .flatten()
+                .copied()
+                .collect(),
+            _ => self.raw_vertices(i).to_vec(),
+        };
+        set.sort_unstable();
+        set.dedup();
+        set
+    }
+
+    /// Check every cell against the vertex count and its shape, and return the
+    /// common cell dimension.
+    pub(crate) fn validate(&self, vertex_count: usize) -> Result<usize> {
+        if self.is_empty() {
+            return Err(ComplexError::NoCells);
+        }
+        let mut dim = None;
+        for i in 0..self.len() {
+            let raw = self.raw_vertices(i);
+            let listed: Vec<u32> = match self.shapes[i] {
+                Shape::Polyhedron => {
+                    let faces = checked_polyhedron_faces(raw).ok_or_else(|| {
+                        ComplexError::Invalid(format!(
+                            "top cell {i}: polyhedron face list is malformed (face lengths do not add up)"
+                        ))
+                    })?;
+                    if faces.len() < 4 || faces.iter().any(|f| f.len() < 3) {
+                        return Err(ComplexError::WrongVertexCount {
+                            cell: i,
+                            shape: "polyhedron",
+                            expected: "at least 4 faces of at least 3 vertices".into(),
+                            found: faces.len(),
+                        });
+                    }
+                    for f in &faces {
+                        check_repeats(i, f)?;
+                    }
+                    faces.into_iter().flatten().copied().collect()
+                }
+                _ => {
+                    check_repeats(i, raw)?;
+                    raw.to_vec()
+                }
+            };
+            if let Some(&v) = listed.iter().find(|&&v| v as usize >= vertex_count) {
+                return Err(ComplexError::VertexOutOfRange {
+                    cell: i,
+                    vertex: v as usize,
+                    vertex_count,
+                });
+            }
+            let n = raw.len();
+            let cell_dim = match self.shapes[i] {
+                Shape::Simplex => {
+                    if n < 2 {
+                        return Err(ComplexError::WrongVertexCount {
+                            cell: i,
+                            shape: "simplex",
+                            expected: "at least 2 (an edge)".into(),
+                            found: n,
+                        });
+                    }
+                    n - 1
+                }
+                Shape::Cuboid => {
+                    if !matches!(n, 2 | 4 | 8) {
+                        return Err(ComplexError::WrongVertexCount {
+                            cell: i,
+                            shape: "cuboid",
+                            expected: "2, 4 or 8".into(),
+                            found: n,
+                        });
+                    }
+                    n.trailing_zeros() as usize
+                }
+                Shape::Polygon => {
+                    if n < 3 {
+                        return Err(ComplexError::WrongVertexCount {
+                            cell: i,
+                            shape: "polygon",
+                            expected: "at least 3".into(),
+                            found: n,
+                        });
+                    }
+                    2
+                }
+                Shape::Polyhedron => 3,
+            };
+            match dim {
+                None => dim = Some(cell_dim),
+                Some(d) if d != cell_dim => {
+                    return Err(ComplexError::MixedDimension {
+                        cell: i,
+                        expected: d,
+                        found: cell_dim,
+                    })
+                }
+                _ => {}
+            }
+        }
+        dim.ok_or(ComplexError::NoCells)
+    }
+
+    /// Facets of cell `i`, appended to `out` as cells one dimension lower.
+    fn push_facets(&self, i: usize, out: &mut TopCells) {
+        let raw = self.raw_vertices(i);
+        match self.shapes[i] {
+            Shape::Simplex => {
+                let mut sorted = raw.to_vec();
+                sorted.sort_unstable();
+                for skip in 0..sorted.len() {
+                    out.push_raw(
+                        Shape::Simplex,
+                        sorted
+                            .iter()
+                            .enumerate()
+                            .filter(|&(k, _)| k != skip)
+                            .map(|(_, &v)| v),
+                    );
+                }
+            }
+            Shape::Cuboid => {
+                let p = raw.len().trailing_zeros() as usize;
+                for axis in 0..p {
+                    for side in 0..2 {
+                        let facet: Vec<u32> = (0..raw.len())
+                            .filter(|local| (local >> axis) & 1 == side)
+                            .map(|local| raw[local])
+                            .collect();
+                        let shape = if facet.len() == 2 {
+                            Shape::Simplex
+                        } else {
+                            Shape::Cuboid
+                        };
+                        out.push_raw(shape, facet);
+                    }
+                }
+            }
+            Shape::Polygon => {
+                for k in 0..raw.len() {
+                    let (a, b) = (raw[k], raw[(k + 1) % raw.len()]);
+                    out.push_raw(Shape::Simplex, [a.min(b), a.max(b)]);
+                }
+            }
+            Shape::Polyhedron => {
+                for face in polyhedron_faces(raw) {
+                    let shape = if face.len() == 3 {
+                        Shape::Simplex
+                    } else {
+                        Shape::Polygon
+                    };
+                    out.push_raw(shape, face.iter().copied());
+                }
+            }
+        }
+    }
+}
+
+fn check_repeats(cell: usize, vertices: &[u32]) -> Result<()> {
+    let mut sorted = vertices.to_vec();
+    sorted.sort_unstable();
+    if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+        return Err(ComplexError::RepeatedVertex {
+            cell,
+            vertex: w[0] as usize,
+        });
+    }
+    Ok(())
+}
+
+/// Decode the face lists of a polyhedron, or `None` when the encoding is inconsistent.
+fn checked_polyhedron_faces(raw: &[u32]) -> Option<Vec<&[u32]>> {
+    let (&count, mut rest) = raw.split_first()?;
+    let mut faces = Vec::with_capacity(count as usize);
+    for _ in 0..count {
+        let (&len, tail) = rest.split_first()?;
+        let len = len as usize;
+        if tail.len() < len {
+            return None;
+        }
+        faces.push(&tail[..len]);
+        rest = &tail[len..];
+    }
+    rest.is_empty().then_some(faces)
+}
+
+fn polyhedron_faces(raw: &[u32]) -> Vec<&[u32]> {
+    // Only called on validated cells.
+    checked_polyhedron_faces(raw).unwrap_or_default()
+}
+
+/// Cells of one dimension after merging: the sorted vertex set of each
+/// (one row of the characteristic matrix) and the description it was first
+/// produced with (needed to extract its own facets).
+pub(crate) struct ExtractedLevel {
+    pub cells: TopCells,
+    pub vertex_sets: Vec<Vec<u32>>,
+}
+
+/// Orders vertex sets lexicographically, a proper prefix after its
+/// extensions (as if padded with `u32::MAX`); this fixes the numbering of
+/// every extracted cell independently of how cells were traversed.
+fn compare_sets(a: &[u32], b: &[u32]) -> std::cmp::Ordering {
+    for (x, y) in a.iter().zip(b) {
+        match x.cmp(y) {
+            std::cmp::Ordering::Equal => {}
+            other => return other,
+        }
+    }
+    b.len().cmp(&a.len())
+}
+
+fn pack_key(set: &[u32]) -> u128 {
+    let mut key = 0u128;
+    for k in 0..4 {
+        key = (key << 32) | u128::from(set.get(k).copied().unwrap_or(u32::MAX));
+    }
+    key
+}
+
+/// Extract, merge and number the facets of `cells` (all of dimension p ≥ 2).
+pub(crate) fn extract_facets(cells: &TopCells) -> ExtractedLevel {
+    const CHUNK: usize = 4096;
+    let chunks: Vec<TopCells> = (0..cells.len())
+        .collect::<Vec<_>>()
+        .par_chunks(CHUNK)
+        .map(|ids| {
+            let mut out = TopCells::default();
+            for &i in ids {
+                cells.push_facets(i, &mut out);
+            }
+            out
+        })
+        .collect();
+    let mut candidates = TopCells::default();
+    candidates.offsets.push(0);
+    for chunk in chunks {
+        let base = candidates.vertices.len();
+        candidates.shapes.extend(chunk.shapes);
+        candidates
+            .offsets
+            .extend(chunk.offsets.iter().skip(1).map(|o| o + base));
+        candidates.vertices.extend(chunk.vertices);
+    }
+    let sets: Vec<Vec<u32>> = (0..candidates.len())
+        .into_par_iter()
+        .map(|i| candidates.vertex_set(i))
+        .collect();
+
+    let mut order: Vec<u32> = (0..candidates.len() as u32).collect();
+    if sets.iter().all(|s| s.len() <= 4) {
+        let mut keyed: Vec<(u128, u32)> = order
+            .iter()
+            .map(|&i| (pack_key(&sets[i as usize]), i))
+            .collect();
+        keyed.par_sort_unstable();
+        order = keyed.into_iter().map(|(_, i)| i).collect();
+    } else {
+        order.par_sort_unstable_by(|&a, &b| {
+            compare_sets(&sets[a as usize], &sets[b as usize]).then(a.cmp(&b))
+        });
+    }
+
+    let mut level = TopCells::default();
+    let mut vertex_sets = Vec::new();
+    let mut previous: Option<&[u32]> = None;
+    for &i in &order {
+        let set = sets[i as usize].as_slice();
+        if previous == Some(set) {
+            continue;
+        }
+        previous = Some(set);
+        level.push_raw(
+            candidates.shapes[i as usize],
+            candidates.raw_vertices(i as usize).iter().copied(),
+        );
+        vertex_sets.push(set.to_vec());
+    }
+    ExtractedLevel {
+        cells: level,
+        vertex_sets,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cuboid_facets_follow_tensor_order() {
+        let quad = TopCells::cuboids([[0usize, 1, 2, 3]]);
+        let mut out = TopCells::default();
+        quad.push_facets(0, &mut out);
+        let facets: Vec<Vec<u32>> = (0..out.len()).map(|i| out.vertex_set(i)).collect();
+        // axis 0: side 0 = {0,2}, side 1 = {1,3}; axis 1: side 0 = {0,1}, side 1 = {2,3}.
+        assert_eq!(facets, vec![vec![0, 2], vec![1, 3], vec![0, 1], vec![2, 3]]);
+    }
+
+    #[test]
+    fn shared_facets_are_merged_and_numbered_by_vertex_set() {
+        let tris = TopCells::simplices([[2usize, 1, 0], [1, 2, 3]]);
+        let edges = extract_facets(&tris);
+        assert_eq!(
+            edges.vertex_sets,
+            vec![vec![0, 1], vec![0, 2], vec![1, 2], vec![1, 3], vec![2, 3]]
+        );
+    }
+
+    #[test]
+    fn validation_names_the_bad_cell() {
+        let cells = TopCells::simplices([vec![0usize, 1, 2], vec![0, 1, 1]]);
+        assert_eq!(
+            cells.validate(3),
+            Err(ComplexError::RepeatedVertex { cell: 1, vertex: 1 })
+        );
+        let cells = TopCells::simplices([vec![0usize, 1, 7]]);
+        assert_eq!(
+            cells.validate(3),
+            Err(ComplexError::VertexOutOfRange {
+                cell: 0,
+                vertex: 7,
+                vertex_count: 3
+            })
+        );
+        let cells = TopCells::cuboids([vec![0usize, 1, 2]]);
+        assert!(matches!(
+            cells.validate(3),
+            Err(ComplexError::WrongVertexCount { cell: 0, .. })
+        ));
+        let mut mixed = TopCells::simplices([vec![0usize, 1, 2]]);
+        mixed.push_simplex(&[0, 1]);
+        assert_eq!(
+            mixed.validate(3),
+            Err(ComplexError::MixedDimension {
+                cell: 1,
+                expected: 2,
+                found: 1
+            })
+        );
+    }
+
+    #[test]
+    fn non_finite_coordinates_are_rejected() {
+        let err = Vertices::new(2, vec![0.0, 1.0, f64::NAN, 0.0]);
+        assert!(matches!(
+            err,
+            Err(ComplexError::NonFiniteCoordinate { vertex: 1, axis: 0, value }) if value.is_nan()
+        ));
+    }
+}

@@ -1,0 +1,642 @@
+//! The oriented cell complex: LAR characteristic matrices plus the signed
+//! boundary matrices ∂_p, with the topological queries built on them.
+
+use crate::cells::{extract_facets, TopCells, Vertices};
+use crate::error::{ComplexError, Result};
+use crate::frame::{self, Frame};
+use crate::homology::{self, Field};
+use crate::lar::{characteristic_matrix, Lar};
+use crate::tags::{CellTag, Tags};
+use rayon::prelude::*;
+use sprs::{CsMat, TriMat};
+use std::collections::VecDeque;
+use std::sync::OnceLock;
+
+/// An oriented cell complex of dimension n embedded in R^d (n ≤ d ≤ 3).
+///
+/// Built from top cells only; every lower cell is extracted, merged and
+/// numbered by its sorted vertex list. Each level answers directly:
+/// `cell_count(p)`, `boundary(p)`, `coboundary(p)`, and (in the geometry
+/// module) `measure(p)`, `centroid(p)`.
+///
+/// ```
+/// use hasse_complex::{Complex, TopCells, Vertices};
+/// // Two triangles forming the unit square.
+/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]).unwrap();
+/// let k = Complex::build(v, TopCells::simplices([[0, 1, 2], [1, 3, 2]])).unwrap();
+/// assert_eq!(k.cell_counts(), vec![4, 5, 2]);
+/// assert_eq!(k.euler_characteristic(), 1);
+/// // ∂1 ∂2 = 0, exactly.
+/// let dd = k.boundary(1) * k.boundary(2);
+/// assert!(dd.data().iter().all(|&x| x == 0));
+/// ```
+#[derive(Clone, Debug)]
+pub struct Complex {
+    lar: Lar,
+    boundaries: Vec<CsMat<i8>>,
+    top_orientation: Vec<i8>,
+    tags: Tags,
+    stars: Vec<OnceLock<CsMat<u8>>>,
+    pub(crate) geometry: crate::geometry::GeometryCache,
+    pub(crate) dual: crate::dual::DualCache,
+}
+
+impl PartialEq for Complex {
+    /// Two complexes are equal when their vertices, cells, orientations and
+    /// tags are; cached geometry does not take part.
+    fn eq(&self, other: &Self) -> bool {
+        self.lar == other.lar
+            && self.boundaries == other.boundaries
+            && self.top_orientation == other.top_orientation
+            && self.tags == other.tags
+    }
+}
+
+impl Complex {
+    /// Build a complex from its top cells: extract and number every lower
+    /// cell, compute ∂_p from the filtered LAR products and orient them.
+    pub fn build(vertices: Vertices, cells: TopCells) -> Result<Self> {
+        let n = cells.validate(vertices.len())?;
+        if n > vertices.dim() {
+            return Err(ComplexError::DimensionTooHigh {
+                cell_dim: n,
+                embedding_dim: vertices.dim(),
+            });
+        }
+        let k0 = vertices.len();
+        let top_sets: Vec<Vec<u32>> = (0..cells.len())
+            .into_par_iter()
+            .map(|i| cells.vertex_set(i))
+            .collect();
+        let mut matrices = vec![characteristic_matrix(&top_sets, k0)];
+        drop(top_sets);
+        let mut current = cells;
+        for _ in (2..=n).rev() {
+            let level = extract_facets(&current);
+            matrices.push(characteristic_matrix(&level.vertex_sets, k0));
+            current = level.cells;
+        }
+        matrices.reverse();
+        Self::from_lar(Lar::new(vertices, matrices)?)
+    }
+
+    /// Orient a LAR whose characteristic matrices are all given (every cell
+    /// convex). Use [`Complex::build`] when only top cells are known.
+    pub fn from_lar(lar: Lar) -> Result<Self> {
+        let n = lar.dim();
+        if n > lar.vertices().dim() {
+            return Err(ComplexError::DimensionTooHigh {
+                cell_dim: n,
+                embedding_dim: lar.vertices().dim(),
+            });
+        }
+        let mut lower = cell_frames(&lar, 0)?;
+        let mut boundaries = Vec::with_capacity(n);
+        let mut top_frames = Vec::new();
+        for p in 1..=n {
+            let upper = cell_frames(&lar, p)?;
+            boundaries.push(signed_boundary(&lar, p, &lower, &upper)?);
+            if p == n {
+                top_frames = upper;
+            } else {
+                lower = upper;
+            }
+        }
+        let top_orientation = orient_top_cells(&lar, &boundaries[n - 1], &top_frames)?;
+        let top = &mut boundaries[n - 1];
+        let cols: Vec<usize> = top.indices().to_vec();
+        for (value, col) in top.data_mut().iter_mut().zip(cols) {
+            *value *= top_orientation[col];
+        }
+        check_coherence(&boundaries[n - 1])?;
+        Ok(Self {
+            stars: (0..=n).map(|_| OnceLock::new()).collect(),
+            lar,
+            boundaries,
+            top_orientation,
+            tags: Tags::default(),
+            geometry: Default::default(),
+            dual: Default::default(),
+        })
+    }
+
+    /// The LAR representation (vertices and characteristic matrices).
+    pub fn lar(&self) -> &Lar {
+        &self.lar
+    }
+
+    /// Topological dimension n (dimension of the top cells).
+    pub fn dim(&self) -> usize {
+        self.lar.dim()
+    }
+
+    /// Dimension d of the space the vertices live in.
+    pub fn embedding_dim(&self) -> usize {
+        self.lar.vertices().dim()
+    }
+
+    /// The vertices.
+    pub fn vertices(&self) -> &Vertices {
+        self.lar.vertices()
+    }
+
+    /// Number of p-cells |K_p| (0 for p > n).
+    pub fn cell_count(&self, p: usize) -> usize {
+        self.lar.cell_count(p)
+    }
+
+    /// (|K_0|, …, |K_n|).
+    pub fn cell_counts(&self) -> Vec<usize> {
+        (0..=self.dim()).map(|p| self.cell_count(p)).collect()
+    }
+
+    /// Sorted vertex indices of p-cell `i` (row i of M_p).
+    pub fn cell_vertices(&self, p: usize, i: usize) -> &[usize] {
+        self.lar.cell_vertices(p, i)
+    }
+
+    /// The signed boundary matrix ∂_p (|K_{p-1}| × |K_p|, CSR), 1 ≤ p ≤ n.
+    ///
+    /// # Panics
+    /// When p is 0 or exceeds the dimension; use [`Complex::try_boundary`] for
+    /// indices that come from user input.
+    pub fn boundary(&self, p: usize) -> &CsMat<i8> {
+        &self.boundaries[p - 1]
+    }
+
+    /// ∂_p, or an error naming the valid range.
+    pub fn try_boundary(&self, p: usize) -> Result<&CsMat<i8>> {
+        if p == 0 || p > self.dim() {
+            return Err(ComplexError::DimensionOutOfRange { p, dim: self.dim() });
+        }
+        Ok(&self.boundaries[p - 1])
+    }
+
+    /// ∂_p in CSC storage, for column (cell → facets) access.
+    pub fn boundary_csc(&self, p: usize) -> CsMat<i8> {
+        self.boundary(p).to_csc()
+    }
+
+    /// The coboundary δ^p = ∂_{p+1}ᵀ (|K_{p+1}| × |K_p|, CSR), 0 ≤ p < n.
+    pub fn coboundary(&self, p: usize) -> CsMat<i8> {
+        self.boundary(p + 1).transpose_view().to_csr()
+    }
+
+    /// Orientation of each top cell relative to the frame of its sorted
+    /// vertex list (+1 same, −1 reversed). In R^n every top cell ends up
+    /// positively oriented; on embedded manifolds the orientation is
+    /// propagated coherently, with closed surfaces oriented outward.
+    pub fn top_orientation(&self) -> &[i8] {
+        &self.top_orientation
+    }
+
+    /// Euler characteristic Σ (−1)^p |K_p|.
+    pub fn euler_characteristic(&self) -> i64 {
+        homology::euler_characteristic(&self.cell_counts())
+    }
+
+    /// Betti numbers β_0 … β_n over the rationals.
+    pub fn betti_numbers(&self) -> Vec<usize> {
+        self.betti_numbers_over(Field::Rationals)
+    }
+
+    /// Betti numbers over the chosen field.
+    pub fn betti_numbers_over(&self, field: Field) -> Vec<usize> {
+        homology::betti_numbers(&self.cell_counts(), &self.boundaries, field)
+    }
+
+    /// The Hasse matrix H(K): one block-bidiagonal sparse matrix holding
+    /// every incidence. Rows are the odd-dimensional cells (K_1, K_3, …),
+    /// columns the even-dimensional ones (K_0, K_2, …); the block of row
+    /// dimension 2i+1 holds δ^{2i} against K_{2i} and ∂_{2i+2} against
+    /// K_{2i+2}. Its shape r × c gives χ(K) = c − r.
+    pub fn hasse_matrix(&self) -> CsMat<i8> {
+        let n = self.dim();
+        let offset = |parity: usize| -> Vec<usize> {
+            let mut off = vec![0; n + 2];
+            let mut acc = 0;
+            for p in (parity..=n).step_by(2) {
+                off[p] = acc;
+                acc += self.cell_count(p);
+            }
+            off[n + 1] = acc;
+            off
+        };
+        let (row_off, col_off) = (offset(1), offset(0));
+        let rows: usize = (1..=n).step_by(2).map(|p| self.cell_count(p)).sum();
+        let cols: usize = (0..=n).step_by(2).map(|p| self.cell_count(p)).sum();
+        let mut tri = TriMat::new((rows, cols));
+        for p in 1..=n {
+            // ∂_p relates (p-1)-cells to p-cells; whichever is odd is the row.
+            for (value, (i, j)) in self.boundary(p).iter() {
+                if p % 2 == 1 {
+                    tri.add_triplet(row_off[p] + j, col_off[p - 1] + i, *value);
+                } else {
+                    tri.add_triplet(row_off[p - 1] + i, col_off[p] + j, *value);
+                }
+            }
+        }
+        tri.to_csr()
+    }
+
+    /// Vertex → p-cells incidence (M_pᵀ as CSR; for p = n the vertex star).
+    pub fn vertex_star(&self, p: usize) -> &CsMat<u8> {
+        self.stars[p].get_or_init(|| {
+            if p == 0 {
+                CsMat::eye(self.cell_count(0))
+            } else {
+                self.lar.cells_by_vertex(p)
+            }
+        })
+    }
+
+    /// Adjacency of p-cells through shared (p−1)-faces: entry (i, j), i ≠ j,
+    /// is the number of faces they share (|∂_p|ᵀ|∂_p| without its diagonal).
+    pub fn cell_adjacency(&self, p: usize) -> CsMat<u32> {
+        let abs = self.boundary(p).map(|x| u32::from(x.unsigned_abs()));
+        let product = &abs.transpose_view().to_csr() * &abs;
+        let mut tri = TriMat::new(product.shape());
+        for (v, (i, j)) in product.iter() {
+            if i != j {
+                tri.add_triplet(i, j, *v);
+            }
+        }
+        tri.to_csr()
+    }
+
+    /// The p-cell with exactly these vertices, if there is one.
+    pub fn find_cell(&self, p: usize, vertices: &[usize]) -> Option<usize> {
+        if p > self.dim() {
+            return None;
+        }
+        let mut sorted = vertices.to_vec();
+        sorted.sort_unstable();
+        let first = *sorted.first()?;
+        if first >= self.cell_count(0) {
+            return None;
+        }
+        let star = self.vertex_star(p);
+        star.outer_view(first)?
+            .indices()
+            .iter()
+            .copied()
+            .find(|&j| self.cell_vertices(p, j) == sorted.as_slice())
+    }
+
+    /// The boundary subcomplex ∂K: the (n−1)-cells with exactly one top
+    /// cell on them, and all their faces.
+    pub fn boundary_subcomplex(&self) -> Subcomplex {
+        let n = self.dim();
+        let mut member: Vec<Vec<bool>> = (0..n).map(|p| vec![false; self.cell_count(p)]).collect();
+        let top = self.boundary(n);
+        for (i, row) in top.outer_iterator().enumerate() {
+            member[n - 1][i] = row.nnz() == 1;
+        }
+        for p in (1..n).rev() {
+            for (j, col) in self
+                .boundary(p)
+                .transpose_view()
+                .outer_iterator()
+                .enumerate()
+            {
+                if member[p][j] {
+                    for (i, _) in col.iter() {
+                        member[p - 1][i] = true;
+                    }
+                }
+            }
+        }
+        Subcomplex {
+            cells: member
+                .into_iter()
+                .map(|m| {
+                    m.iter()
+                        .enumerate()
+                        .filter(|(_, &b)| b)
+                        .map(|(i, _)| i)
+                        .collect()
+                })
+                .collect(),
+        }
+    }
+
+    /// Named cell sets (boundary regions, materials).
+    pub fn tags(&self) -> &Tags {
+        &self.tags
+    }
+
+    /// The tag called `name`, if present.
+    pub fn tag(&self, name: &str) -> Option<&CellTag> {
+        self.tags.get(name)
+    }
+
+    /// Name a set of p-cells; ids are checked against the cell count.
+    pub fn set_tag(&mut self, name: &str, dim: usize, cells: Vec<usize>) -> Result<()> {
+        if dim > self.dim() {
+            return Err(ComplexError::DimensionOutOfRange {
+                p: dim,
+                dim: self.dim(),
+            });
+        }
+        if let Some(&bad) = cells.iter().find(|&&c| c >= self.cell_count(dim)) {
+            return Err(ComplexError::Invalid(format!(
+                "tag '{name}': {dim}-cell {bad} does not exist (there are {})",
+                self.cell_count(dim)
+            )));
+        }
+        self.tags.insert(name, CellTag::new(dim, cells));
+        Ok(())
+    }
+
+    /// Tag the boundary (n−1)-cells whose vertex average satisfies `inside`.
+    /// Returns how many cells were tagged.
+    pub fn tag_boundary_where(&mut self, name: &str, inside: impl Fn(&[f64]) -> bool) -> usize {
+        let n = self.dim();
+        let d = self.embedding_dim();
+        let boundary = self.boundary_subcomplex();
+        let cells: Vec<usize> = boundary
+            .cells(n - 1)
+            .iter()
+            .copied()
+            .filter(|&f| {
+                let verts = self.cell_vertices(n - 1, f);
+                let mut centre = vec![0.0; d];
+                for &v in verts {
+                    for (c, x) in centre.iter_mut().zip(self.vertices().point(v)) {
+                        *c += x / verts.len() as f64;
+                    }
+                }
+                inside(&centre)
+            })
+            .collect();
+        let count = cells.len();
+        self.tags.insert(name, CellTag::new(n - 1, cells));
+        count
+    }
+
+    /// Replace all tags (used by readers).
+    pub(crate) fn replace_tags(&mut self, tags: Tags) {
+        self.tags = tags;
+    }
+}
+
+/// A set of cells of every dimension closed under taking faces.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Subcomplex {
+    cells: Vec<Vec<usize>>,
+}
+
+impl Subcomplex {
+    /// Sorted ids of the member p-cells (empty beyond the top dimension).
+    pub fn cells(&self, p: usize) -> &[usize] {
+        self.cells.get(p).map_or(&[], Vec::as_slice)
+    }
+
+    /// Number of member p-cells for every p.
+    pub fn cell_counts(&self) -> Vec<usize> {
+        self.cells.iter().map(Vec::len).collect()
+    }
+
+    /// True when p-cell `i` belongs to the subcomplex.
+    pub fn contains(&self, p: usize, i: usize) -> bool {
+        self.cells(p).binary_search(&i).is_ok()
+    }
+}
+
+fn cell_frames(lar: &Lar, p: usize) -> Result<Vec<Frame>> {
+    let vertices = lar.vertices();
+    (0..lar.cell_count(p))
+        .into_par_iter()
+        .map(|i| {
+            let cell = lar.cell_vertices(p, i);
+            frame::frame(vertices, cell, p).ok_or_else(|| ComplexError::DegenerateCell {
+                dim: p,
+                cell: i,
+                vertices: cell.to_vec(),
+            })
+        })
+        .collect()
+}
+
+/// ∂_p with signs: exact (−1)^k between simplices, geometric induced
+/// orientation otherwise. Top cells are not yet oriented.
+fn signed_boundary(lar: &Lar, p: usize, lower: &[Frame], upper: &[Frame]) -> Result<CsMat<i8>> {
+    let (indptr, indices) = lar.boundary_pattern(p);
+    let vertices = lar.vertices();
+    let data: Vec<i8> = (0..lar.cell_count(p - 1))
+        .into_par_iter()
+        .flat_map_iter(|i| {
+            let facet = lar.cell_vertices(p - 1, i);
+            indices[indptr[i]..indptr[i + 1]].iter().map(move |&j| {
+                let cell = lar.cell_vertices(p, j);
+                if cell.len() == p + 1 && facet.len() == p {
+                    let k = facet
+                        .iter()
+                        .zip(cell)
+                        .position(|(a, b)| a != b)
+                        .unwrap_or(p);
+                    return Ok(if k % 2 == 0 { 1 } else { -1 });
+                }
+                let diameter = frame::diameter(vertices, cell);
+                frame::induced_sign(&upper[j], &lower[i], diameter).ok_or_else(|| {
+                    ComplexError::Invalid(format!(
+                        "{}-cell {i} (vertices {facet:?}) does not bound {p}-cell {j} (vertices {cell:?}) from outside: the cell is not convex or is degenerate",
+                        p - 1
+                    ))
+                })
+            })
+        })
+        .collect::<Result<_>>()?;
+    let shape = (lar.cell_count(p - 1), lar.cell_count(p));
+    CsMat::try_new(shape, indptr, indices, data)
+        .map_err(|e| ComplexError::Invalid(format!("internal: boundary matrix ∂_{p}: {}", e.3)))
+}
+
+/// Orientation flags of the top cells: the ambient orientation when n = d,
+/// otherwise propagated across shared faces, each closed surface oriented
+/// by its outward normal.
+fn orient_top_cells(lar: &Lar, top: &CsMat<i8>, frames: &[Frame]) -> Result<Vec<i8>> {
+    let n = lar.dim();
+    let d = lar.vertices().dim();
+    let cells = lar.cell_count(n);
+    if n == d {
+        return Ok(frames
+            .iter()
+            .map(|f| if frame::det(n, &f.basis) > 0.0 { 1 } else { -1 })
+            .collect());
+    }
+    let by_cell = top.to_csc();
+    let mut flags = vec![0i8; cells];
+    for start in 0..cells {
+        if flags[start] != 0 {
+            continue;
+        }
+        flags[start] = 1;
+        let mut component = vec![start];
+        let mut closed = true;
+        let mut queue = VecDeque::from([start]);
+        while let Some(c) = queue.pop_front() {
+            let Some(col) = by_cell.outer_view(c) else {
+                continue;
+            };
+            for (face, &s) in col.iter() {
+                let Some(row) = top.outer_view(face) else {
+                    continue;
+                };
+                if row.nnz() == 1 {
+                    closed = false;
+                }
+                if row.nnz() != 2 {
+                    continue;
+                }
+                for (other, &t) in row.iter() {
+                    if other == c {
+                        continue;
+                    }
+                    let wanted = -flags[c] * s * t;
+                    if flags[other] == 0 {
+                        flags[other] = wanted;
+                        component.push(other);
+                        queue.push_back(other);
+                    } else if flags[other] != wanted {
+                        return Err(ComplexError::NonOrientable {
+                            cell: other,
+                            face,
+                            face_dim: n - 1,
+                        });
+                    }
+                }
+            }
+        }
+        if closed
+            && n == 2
+            && d == 3
+            && enclosed_volume(lar, top, &by_cell, &flags, &component) < 0.0
+        {
+            for &c in &component {
+                flags[c] = -flags[c];
+            }
+        }
+    }
+    Ok(flags)
+}
+
+/// Signed volume enclosed by a closed oriented surface component:
+/// (1/6) Σ_cells Σ_{oriented boundary edges a→b} det[x_c, x_a, x_b].
+fn enclosed_volume(
+    lar: &Lar,
+    top: &CsMat<i8>,
+    by_cell: &CsMat<i8>,
+    flags: &[i8],
+    component: &[usize],
+) -> f64 {
+    let _ = top;
+    let vertices = lar.vertices();
+    let mut volume = 0.0;
+    for &c in component {
+        let centre =
+            frame::frame(vertices, lar.cell_vertices(2, c), 0).map_or([0.0; 3], |f| f.centre);
+        let Some(col) = by_cell.outer_view(c) else {
+            continue;
+        };
+        for (edge, &s) in col.iter() {
+            let ends = lar.cell_vertices(1, edge);
+            let (a, b) = (
+                frame::point(vertices, ends[0]),
+                frame::point(vertices, ends[1]),
+            );
+            let m = [centre, a, b];
+            volume += f64::from(flags[c] * s) * frame::det(3, &m) / 6.0;
+        }
+    }
+    volume
+}
+
+/// Every (n−1)-cell shared by two top cells must appear with opposite signs.
+fn check_coherence(top: &CsMat<i8>) -> Result<()> {
+    for (face, row) in top.outer_iterator().enumerate() {
+        if row.nnz() == 2 && row.data()[0] == row.data()[1] {
+            let cells: Vec<usize> = row.indices().to_vec();
+            return Err(ComplexError::Invalid(format!(
+                "top cells {} and {} lie on the same side of their shared face {face}: the cells overlap or one is inverted",
+                cells[0], cells[1]
+            )));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn dense(m: &CsMat<i8>) -> Vec<Vec<i8>> {
+        let d = m.to_dense();
+        d.rows().into_iter().map(|r| r.to_vec()).collect()
+    }
+
+    #[test]
+    fn single_triangle_matches_hand_computed_boundaries() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+        // Edges numbered by vertex sets: e0 = {0,1}, e1 = {0,2}, e2 = {1,2}.
+        assert_eq!(
+            dense(k.boundary(1)),
+            vec![vec![-1, -1, 0], vec![1, 0, -1], vec![0, 1, 1]]
+        );
+        // Counter-clockwise triangle: ∂ = e0 − e1 + e2.
+        assert_eq!(dense(k.boundary(2)), vec![vec![1], vec![-1], vec![1]]);
+    }
+
+    #[test]
+    fn clockwise_input_is_reoriented_positively() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [0.0, 1.0], [1.0, 0.0]]).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+        assert_eq!(k.top_orientation(), &[-1]);
+        // Edges {0,1} (up the y axis), {0,2}, {1,2}; counter-clockwise
+        // boundary runs 0→2→1→0: −e0 + e1 − e2.
+        assert_eq!(dense(k.boundary(2)), vec![vec![-1], vec![1], vec![-1]]);
+    }
+
+    #[test]
+    fn unit_square_quad_is_counter_clockwise() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]).unwrap();
+        let k = Complex::build(v, TopCells::cuboids([[0, 1, 2, 3]])).unwrap();
+        // e0={0,1} bottom (→), e1={0,2} left (↑), e2={1,3} right (↑), e3={2,3} top (→).
+        assert_eq!(
+            dense(k.boundary(2)),
+            vec![vec![1], vec![-1], vec![1], vec![-1]]
+        );
+    }
+
+    #[test]
+    fn degenerate_and_overlapping_cells_are_reported() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [0.0, 1.0]]).unwrap();
+        let err = Complex::build(v.clone(), TopCells::simplices([[0, 1, 2]])).unwrap_err();
+        assert_eq!(
+            err,
+            ComplexError::DegenerateCell {
+                dim: 2,
+                cell: 0,
+                vertices: vec![0, 1, 2]
+            }
+        );
+        // Both triangles lie above edge {0,1}.
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.5, 2.0]]).unwrap();
+        let err = Complex::build(v, TopCells::simplices([[0, 1, 2], [0, 1, 3]])).unwrap_err();
+        assert!(err.to_string().contains("overlap"), "{err}");
+    }
+
+    #[test]
+    fn hasse_matrix_of_a_triangle() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+        let h = k.hasse_matrix();
+        // d = 2: H = [δ0 | δ1ᵀ], 3 × (3 + 1), χ = 4 − 3 = 1.
+        assert_eq!(h.shape(), (3, 4));
+        assert_eq!(
+            dense(&h),
+            vec![vec![-1, 1, 0, 1], vec![-1, 0, 1, -1], vec![0, -1, 1, 1]]
+        );
+    }
+}

@@ -1,0 +1,75 @@
+//! Typed errors for everything that can go wrong when a complex is built
+//! from user input. Every variant names the offending cell or vertex so a
+//! front end can point the user at it.
+
+/// Why a complex could not be built or a query could not be answered.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ComplexError {
+    #[error("the vertex coordinates are empty: a complex needs at least one vertex")]
+    NoVertices,
+    #[error("no top cells were given: a complex needs at least one cell")]
+    NoCells,
+    #[error("embedding dimension {0} is not supported (1, 2 or 3)")]
+    UnsupportedEmbedding(usize),
+    #[error("{len} coordinate values cannot be split into points of dimension {dim}")]
+    CoordinateShape { len: usize, dim: usize },
+    #[error(
+        "vertex {vertex} has a non-finite coordinate {value} on axis {axis}; fix the mesh input"
+    )]
+    NonFiniteCoordinate {
+        vertex: usize,
+        axis: usize,
+        value: f64,
+    },
+    #[error("top cell {cell} refers to vertex {vertex}, but only {vertex_count} vertices exist (indices start at 0)")]
+    VertexOutOfRange {
+        cell: usize,
+        vertex: usize,
+        vertex_count: usize,
+    },
+    #[error("top cell {cell} lists vertex {vertex} more than once")]
+    RepeatedVertex { cell: usize, vertex: usize },
+    #[error("top cell {cell} is a {shape} with {found} vertices; a {shape} needs {expected}")]
+    WrongVertexCount {
+        cell: usize,
+        shape: &'static str,
+        expected: String,
+        found: usize,
+    },
+    #[error("top cell {cell} is a {found}-cell but the complex is {expected}-dimensional; all top cells must have the same dimension")]
+    MixedDimension {
+        cell: usize,
+        expected: usize,
+        found: usize,
+    },
+    #[error("top cells are {cell_dim}-dimensional, which does not fit in R^{embedding_dim}")]
+    DimensionTooHigh {
+        cell_dim: usize,
+        embedding_dim: usize,
+    },
+    #[error("{dim}-cell {cell} (vertices {vertices:?}) has zero {dim}-measure: its vertices span fewer than {dim} dimensions")]
+    DegenerateCell {
+        dim: usize,
+        cell: usize,
+        vertices: Vec<usize>,
+    },
+    #[error("the complex is not orientable: top cell {cell} cannot be oriented consistently with its neighbours across {face_dim}-cell {face}")]
+    NonOrientable {
+        cell: usize,
+        face: usize,
+        face_dim: usize,
+    },
+    #[error("cell dimension {p} is out of range: this complex has cells of dimension 0..={dim}")]
+    DimensionOutOfRange { p: usize, dim: usize },
+    #[error("characteristic matrix M_{p} has {found} columns but there are {expected} vertices")]
+    CharacteristicShape {
+        p: usize,
+        expected: usize,
+        found: usize,
+    },
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// Shorthand used throughout the crate.
+pub type Result<T, E = ComplexError> = std::result::Result<T, E>;

@@ -1,0 +1,179 @@
+//! Oriented affine frames of cells, and the sign with which a facet
+//! appears in the boundary of a cell.
+//!
+//! The orientation of a p-cell is that of the frame built greedily from its
+//! sorted vertex list: v_k − v_0 for the first p vertices that add a new
+//! direction. For a simplex this is exactly the orientation of its sorted
+//! vertex order. A facet f of a convex cell c carries the induced
+//! orientation when (outward direction, frame of f) is positively oriented
+//! in the frame of c; the outward direction is taken from the vertex average
+//! of c (interior for convex cells) to that of f.
+
+use crate::cells::Vertices;
+
+/// Points are padded to three coordinates so all dimensions share one code path.
+pub(crate) type Point = [f64; 3];
+
+/// Relative size below which a direction is considered already spanned.
+const SPAN_TOLERANCE: f64 = 1e-10;
+
+pub(crate) fn point(vertices: &Vertices, i: usize) -> Point {
+    let mut x = [0.0; 3];
+    x[..vertices.dim()].copy_from_slice(vertices.point(i));
+    x
+}
+
+pub(crate) fn sub(a: &Point, b: &Point) -> Point {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn dot(a: &Point, b: &Point) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(crate) fn norm(a: &Point) -> f64 {
+    dot(a, a).sqrt()
+}
+
+/// An orthonormal basis of the span of a p-cell, oriented like the cell,
+/// and the average of its vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Frame {
+    pub dim: usize,
+    pub basis: [Point; 3],
+    pub centre: Point,
+}
+
+impl Frame {
+    /// Coordinates of `v` in the basis (first `dim` entries used).
+    pub fn local(&self, v: &Point) -> Point {
+        let mut out = [0.0; 3];
+        for (k, b) in self.basis.iter().take(self.dim).enumerate() {
+            out[k] = dot(b, v);
+        }
+        out
+    }
+}
+
+/// The frame of a cell with the given sorted vertices, or `None` when the
+/// vertices span fewer than `p` directions (a zero-measure cell).
+pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Frame> {
+    let mut centre = [0.0; 3];
+    for &v in cell {
+        let x = point(vertices, v);
+        for k in 0..3 {
+            centre[k] += x[k];
+        }
+    }
+    for c in &mut centre {
+        *c /= cell.len() as f64;
+    }
+    let mut basis = [[0.0; 3]; 3];
+    let mut found = 0;
+    if p > 0 {
+        let origin = point(vertices, cell[0]);
+        let scale = cell
+            .iter()
+            .map(|&v| norm(&sub(&point(vertices, v), &origin)))
+            .fold(0.0, f64::max);
+        for &v in &cell[1..] {
+            let mut w = sub(&point(vertices, v), &origin);
+            // Two Gram–Schmidt passes keep the basis orthonormal to rounding.
+            for _ in 0..2 {
+                for b in basis.iter().take(found) {
+                    let c = dot(&w, b);
+                    for k in 0..3 {
+                        w[k] -= c * b[k];
+                    }
+                }
+            }
+            let len = norm(&w);
+            if len > SPAN_TOLERANCE * scale {
+                basis[found] = [w[0] / len, w[1] / len, w[2] / len];
+                found += 1;
+                if found == p {
+                    break;
+                }
+            }
+        }
+    }
+    (found == p).then_some(Frame {
+        dim: p,
+        basis,
+        centre,
+    })
+}
+
+/// Determinant of the leading `n`×`n` block (n ≤ 3).
+pub(crate) fn det(n: usize, m: &[Point; 3]) -> f64 {
+    match n {
+        0 => 1.0,
+        1 => m[0][0],
+        2 => m[0][0] * m[1][1] - m[0][1] * m[1][0],
+        _ => {
+            m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+        }
+    }
+}
+
+/// +1 when `facet` carries the orientation induced by `cell`, −1 when the
+/// opposite, `None` when the facet does not separate the cell's interior
+/// from outside (degenerate or non-convex geometry).
+pub(crate) fn induced_sign(cell: &Frame, facet: &Frame, diameter: f64) -> Option<i8> {
+    let outward = sub(&facet.centre, &cell.centre);
+    let mut m = [[0.0; 3]; 3];
+    m[0] = cell.local(&outward);
+    for r in 0..facet.dim {
+        m[r + 1] = cell.local(&facet.basis[r]);
+    }
+    let d = det(cell.dim, &m);
+    if d.abs() <= SPAN_TOLERANCE * diameter.max(f64::MIN_POSITIVE) {
+        return None;
+    }
+    Some(if d > 0.0 { 1 } else { -1 })
+}
+
+/// Largest distance from the first vertex: the length scale of a cell.
+pub(crate) fn diameter(vertices: &Vertices, cell: &[usize]) -> f64 {
+    let origin = point(vertices, cell[0]);
+    cell.iter()
+        .map(|&v| norm(&sub(&point(vertices, v), &origin)))
+        .fold(0.0, f64::max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn unit_triangle() -> Vertices {
+        Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap()
+    }
+
+    #[test]
+    fn triangle_boundary_signs_are_alternating() {
+        // ∂[v0,v1,v2] = [v1,v2] − [v0,v2] + [v0,v1].
+        let v = unit_triangle();
+        let tri = frame(&v, &[0, 1, 2], 2).unwrap();
+        let sign = |e: [usize; 2]| induced_sign(&tri, &frame(&v, &e, 1).unwrap(), 1.0).unwrap();
+        assert_eq!(sign([1, 2]), 1);
+        assert_eq!(sign([0, 2]), -1);
+        assert_eq!(sign([0, 1]), 1);
+    }
+
+    #[test]
+    fn edge_boundary_is_head_minus_tail() {
+        let v = unit_triangle();
+        let edge = frame(&v, &[0, 1], 1).unwrap();
+        let at = |i| induced_sign(&edge, &frame(&v, &[i], 0).unwrap(), 1.0).unwrap();
+        assert_eq!((at(0), at(1)), (-1, 1));
+    }
+
+    #[test]
+    fn collinear_points_have_no_2_frame() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 1.0], [2.0, 2.0]]).unwrap();
+        assert!(frame(&v, &[0, 1, 2], 2).is_none());
+        assert!(frame(&v, &[0, 1, 2], 1).is_some());
+    }
+}

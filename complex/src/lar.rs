@@ -1,0 +1,279 @@
+//! Linear Algebraic Representation: a complex as its characteristic
+//! matrices M_p (p-cells × vertices, binary CSR), and the unoriented
+//! boundary ∂_p read off the product M_{p-1} M_pᵀ.
+//!
+//! Entry (i, j) of M_{p-1} M_pᵀ counts the vertices that (p-1)-cell i and
+//! p-cell j share; i lies on the boundary of j exactly when that count equals
+//! the number of vertices of i (the LAR filtering rule).
+
+use crate::cells::Vertices;
+use crate::error::{ComplexError, Result};
+use rayon::prelude::*;
+use sprs::{CsMat, TriMat};
+
+/// Vertex coordinates plus the characteristic matrices M_1 … M_n.
+/// M_0 is the identity and is not stored.
+///
+/// The worked example of the LAR paper (two non-convex faces):
+/// ```
+/// use hasse_complex::{Lar, Vertices};
+/// let v = Vertices::new(2, vec![0.0; 16]).unwrap();
+/// let ev = vec![vec![0, 1], vec![0, 2], vec![0, 6], vec![1, 3], vec![2, 3],
+///               vec![3, 5], vec![4, 5], vec![4, 6], vec![5, 7], vec![6, 7]];
+/// let fv = vec![vec![0, 1, 3, 5, 6, 7], vec![0, 2, 3, 4, 5, 6]];
+/// let lar = Lar::from_vertex_sets(v, vec![ev, fv]).unwrap();
+/// let d2 = lar.unoriented_boundary(2).unwrap();
+/// assert_eq!(d2.outer_view(2).unwrap().nnz(), 2); // edge (0,6) bounds both faces
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lar {
+    vertices: Vertices,
+    characteristic: Vec<CsMat<u8>>,
+    /// 0..k0, so that rows of the identity M_0 can be borrowed like other rows.
+    vertex_ids: Vec<usize>,
+}
+
+/// Build a binary CSR matrix from sorted vertex sets.
+pub(crate) fn characteristic_matrix(sets: &[Vec<u32>], vertex_count: usize) -> CsMat<u8> {
+    let mut indptr = Vec::with_capacity(sets.len() + 1);
+    indptr.push(0);
+    let nnz: usize = sets.iter().map(Vec::len).sum();
+    let mut indices = Vec::with_capacity(nnz);
+    for s in sets {
+        indices.extend(s.iter().map(|&v| v as usize));
+        indptr.push(indices.len());
+    }
+    CsMat::new((sets.len(), vertex_count), indptr, indices, vec![1u8; nnz])
+}
+
+impl Lar {
+    /// A LAR from its characteristic matrices `[M_1, …, M_n]` (CSR, binary).
+    pub fn new(vertices: Vertices, characteristic: Vec<CsMat<u8>>) -> Result<Self> {
+        if characteristic.is_empty() {
+            return Err(ComplexError::NoCells);
+        }
+        for (k, m) in characteristic.iter().enumerate() {
+            if m.cols() != vertices.len() {
+                return Err(ComplexError::CharacteristicShape {
+                    p: k + 1,
+                    expected: vertices.len(),
+                    found: m.cols(),
+                });
+            }
+        }
+        let characteristic = characteristic
+            .into_iter()
+            .map(|m| if m.is_csr() { m } else { m.to_csr() })
+            .collect();
+        Ok(Self {
+            vertex_ids: (0..vertices.len()).collect(),
+            vertices,
+            characteristic,
+        })
+    }
+
+    /// A LAR from vertex lists per dimension: `cells[p-1]` lists the p-cells.
+    pub fn from_vertex_sets(vertices: Vertices, cells: Vec<Vec<Vec<usize>>>) -> Result<Self> {
+        let k0 = vertices.len();
+        let mut matrices = Vec::with_capacity(cells.len());
+        for (k, level) in cells.iter().enumerate() {
+            let mut sets = Vec::with_capacity(level.len());
+            for (j, cell) in level.iter().enumerate() {
+                let mut set = Vec::with_capacity(cell.len());
+                for &v in cell {
+                    if v >= k0 {
+                        return Err(ComplexError::VertexOutOfRange {
+                            cell: j,
+                            vertex: v,
+                            vertex_count: k0,
+                        });
+                    }
+                    set.push(v as u32);
+                }
+                set.sort_unstable();
+                set.dedup();
+                if set.len() != cell.len() {
+                    return Err(ComplexError::Invalid(format!(
+                        "{}-cell {j} lists a vertex more than once",
+                        k + 1
+                    )));
+                }
+                sets.push(set);
+            }
+            matrices.push(characteristic_matrix(&sets, k0));
+        }
+        Self::new(vertices, matrices)
+    }
+
+    /// Dimension n of the highest cells.
+    pub fn dim(&self) -> usize {
+        self.characteristic.len()
+    }
+
+    /// The vertices.
+    pub fn vertices(&self) -> &Vertices {
+        &self.vertices
+    }
+
+    /// Number of p-cells.
+    pub fn cell_count(&self, p: usize) -> usize {
+        match p {
+            0 => self.vertices.len(),
+            _ => self.characteristic.get(p - 1).map_or(0, |m| m.rows()),
+        }
+    }
+
+    /// M_p for p ≥ 1 (p-cells × vertices).
+    pub fn characteristic(&self, p: usize) -> Result<&CsMat<u8>> {
+        if p == 0 || p > self.dim() {
+            return Err(ComplexError::DimensionOutOfRange { p, dim: self.dim() });
+        }
+        Ok(&self.characteristic[p - 1])
+    }
+
+    /// Sorted vertices of p-cell `i`.
+    pub fn cell_vertices(&self, p: usize, i: usize) -> &[usize] {
+        if p == 0 {
+            // Row i of the identity M_0.
+            return &self.vertex_ids[i..i + 1];
+        }
+        let m = &self.characteristic[p - 1];
+        let range = m.indptr().outer_inds_sz(i);
+        &m.indices()[range]
+    }
+
+    /// M_{p-1} M_pᵀ: shared-vertex counts between (p-1)-cells and p-cells.
+    pub fn incidence_counts(&self, p: usize) -> Result<CsMat<u32>> {
+        let upper = self.characteristic(p)?.map(|&x| u32::from(x));
+        let lower = if p == 1 {
+            CsMat::eye(self.vertices.len())
+        } else {
+            self.characteristic(p - 1)?.map(|&x| u32::from(x))
+        };
+        Ok(&lower * &upper.transpose_view().to_csr())
+    }
+
+    /// The unoriented ∂_p: entries of M_{p-1} M_pᵀ equal to the vertex count
+    /// of the (p-1)-cell become 1, all others 0.
+    pub fn unoriented_boundary(&self, p: usize) -> Result<CsMat<u8>> {
+        let counts = self.incidence_counts(p)?;
+        let mut tri = TriMat::new(counts.shape());
+        for (row, vec) in counts.outer_iterator().enumerate() {
+            let size = self.cell_vertices(p - 1, row).len() as u32;
+            for (col, &c) in vec.iter() {
+                if c == size {
+                    tri.add_triplet(row, col, 1u8);
+                }
+            }
+        }
+        Ok(tri.to_csr())
+    }
+
+    /// Vertex → p-cells map (M_pᵀ in CSR), used by the filtered product.
+    pub(crate) fn cells_by_vertex(&self, p: usize) -> CsMat<u8> {
+        self.characteristic[p - 1].transpose_view().to_csr()
+    }
+
+    /// Sparsity pattern of the unoriented ∂_p as CSR (indptr, column
+    /// indices), computed row by row as the filtered product M_{p-1} M_pᵀ.
+    /// Every p-cell containing (p-1)-cell i contains its first vertex, so
+    /// only the p-cells around that vertex can reach the full count.
+    pub(crate) fn boundary_pattern(&self, p: usize) -> (Vec<usize>, Vec<usize>) {
+        let by_vertex = self.cells_by_vertex(p);
+        let upper = &self.characteristic[p - 1];
+        let rows = self.cell_count(p - 1);
+        let row_entries: Vec<Vec<usize>> = (0..rows)
+            .into_par_iter()
+            .map(|i| {
+                let lower = self.cell_vertices(p - 1, i);
+                let Some(&first) = lower.first() else {
+                    return Vec::new();
+                };
+                let star = &by_vertex.indices()[by_vertex.indptr().outer_inds_sz(first)];
+                star.iter()
+                    .copied()
+                    .filter(|&j| {
+                        let cell = &upper.indices()[upper.indptr().outer_inds_sz(j)];
+                        lower[1..].iter().all(|v| cell.binary_search(v).is_ok())
+                    })
+                    .collect()
+            })
+            .collect();
+        let mut indptr = Vec::with_capacity(rows + 1);
+        indptr.push(0);
+        let mut indices = Vec::with_capacity(row_entries.iter().map(Vec::len).sum());
+        for r in row_entries {
+            indices.extend(r);
+            indptr.push(indices.len());
+        }
+        (indptr, indices)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The worked example of the LAR paper (Figure 2d): two non-convex faces.
+    fn paper_example() -> Lar {
+        let v = Vertices::new(2, vec![0.0; 16]).unwrap();
+        let ev = vec![
+            vec![0, 1],
+            vec![0, 2],
+            vec![0, 6],
+            vec![1, 3],
+            vec![2, 3],
+            vec![3, 5],
+            vec![4, 5],
+            vec![4, 6],
+            vec![5, 7],
+            vec![6, 7],
+        ];
+        let fv = vec![vec![0, 1, 3, 5, 6, 7], vec![0, 2, 3, 4, 5, 6]];
+        Lar::from_vertex_sets(v, vec![ev, fv]).unwrap()
+    }
+
+    #[test]
+    fn lar_paper_incidence_counts() {
+        let counts = paper_example().incidence_counts(2).unwrap().to_dense();
+        // [EF]ᵀ as printed in the paper.
+        let expected_t = [
+            [2u32, 1, 2, 2, 1, 2, 1, 1, 2, 2],
+            [1, 2, 2, 1, 2, 2, 2, 2, 1, 1],
+        ];
+        for (face, row) in expected_t.iter().enumerate() {
+            for (edge, &c) in row.iter().enumerate() {
+                assert_eq!(counts[[edge, face]], c, "edge {edge}, face {face}");
+            }
+        }
+    }
+
+    #[test]
+    fn lar_paper_unoriented_boundary_and_total_boundary_chain() {
+        let lar = paper_example();
+        let d2 = lar.unoriented_boundary(2).unwrap().to_dense();
+        let expected_t = [
+            [1u8, 0, 1, 1, 0, 1, 0, 0, 1, 1],
+            [0, 1, 1, 0, 1, 1, 1, 1, 0, 0],
+        ];
+        for (face, row) in expected_t.iter().enumerate() {
+            for (edge, &b) in row.iter().enumerate() {
+                assert_eq!(d2[[edge, face]], b, "edge {edge}, face {face}");
+            }
+        }
+        // [∂2][Λ2] mod 2 = {e0, e1, e3, e4, e6, e7, e8, e9}.
+        let total: Vec<u8> = (0..10).map(|e| (d2[[e, 0]] + d2[[e, 1]]) % 2).collect();
+        assert_eq!(total, vec![1, 1, 0, 1, 1, 0, 1, 1, 1, 1]);
+    }
+
+    #[test]
+    fn fused_pattern_equals_filtered_product() {
+        let lar = paper_example();
+        for p in 1..=2 {
+            let (indptr, indices) = lar.boundary_pattern(p);
+            let filtered = lar.unoriented_boundary(p).unwrap();
+            assert_eq!(indptr, filtered.indptr().raw_storage());
+            assert_eq!(indices, filtered.indices());
+        }
+    }
+}
