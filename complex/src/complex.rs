@@ -120,6 +120,24 @@ impl Complex {
         })
     }
 
+    /// The same cells on moved vertices (e.g. a perturbed grid): orientation
+    /// and geometry are recomputed, tags are kept.
+    pub fn with_vertices(&self, vertices: Vertices) -> Result<Self> {
+        if vertices.len() != self.cell_count(0) {
+            return Err(ComplexError::Invalid(format!(
+                "{} vertices given for a complex with {}",
+                vertices.len(),
+                self.cell_count(0)
+            )));
+        }
+        let matrices = (1..=self.dim())
+            .map(|p| self.lar.characteristic(p).cloned())
+            .collect::<Result<Vec<_>>>()?;
+        let mut moved = Self::from_lar(Lar::new(vertices, matrices)?)?;
+        moved.tags = self.tags.clone();
+        Ok(moved)
+    }
+
     /// The LAR representation (vertices and characteristic matrices).
     pub fn lar(&self) -> &Lar {
         &self.lar
