@@ -335,8 +335,19 @@ impl TopCells {
         let raw = self.raw_vertices(i);
         match self.shapes[i] {
             Shape::Simplex => {
-                let mut sorted = raw.to_vec();
+                // At most 4 vertices below the top of a 3-complex; the stack
+                // copy avoids an allocation per cell.
+                let mut buffer = [0u32; 8];
+                let mut heap;
+                let sorted: &mut [u32] = if raw.len() <= buffer.len() {
+                    buffer[..raw.len()].copy_from_slice(raw);
+                    &mut buffer[..raw.len()]
+                } else {
+                    heap = raw.to_vec();
+                    &mut heap
+                };
                 sorted.sort_unstable();
+                let sorted = &*sorted;
                 for skip in 0..sorted.len() {
                     out.push_raw(
                         Shape::Simplex,
@@ -350,18 +361,19 @@ impl TopCells {
             }
             Shape::Cuboid => {
                 let p = raw.len().trailing_zeros() as usize;
+                let shape = if p == 2 {
+                    Shape::Simplex
+                } else {
+                    Shape::Cuboid
+                };
                 for axis in 0..p {
                     for side in 0..2 {
-                        let facet: Vec<u32> = (0..raw.len())
-                            .filter(|local| (local >> axis) & 1 == side)
-                            .map(|local| raw[local])
-                            .collect();
-                        let shape = if facet.len() == 2 {
-                            Shape::Simplex
-                        } else {
-                            Shape::Cuboid
-                        };
-                        out.push_raw(shape, facet);
+                        out.push_raw(
+                            shape,
+                            (0..raw.len())
+                                .filter(|local| (local >> axis) & 1 == side)
+                                .map(|local| raw[local]),
+                        );
                     }
                 }
             }
@@ -423,7 +435,51 @@ fn polyhedron_faces(raw: &[u32]) -> Vec<&[u32]> {
 /// produced with (needed to extract its own facets).
 pub(crate) struct ExtractedLevel {
     pub cells: TopCells,
-    pub vertex_sets: Vec<Vec<u32>>,
+    pub sets: FlatSets,
+}
+
+/// Sorted vertex sets stored flat: set i is `vertices[offsets[i]..offsets[i + 1]]`.
+#[derive(Default)]
+pub(crate) struct FlatSets {
+    pub offsets: Vec<usize>,
+    pub vertices: Vec<u32>,
+}
+
+impl FlatSets {
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    pub fn get(&self, i: usize) -> &[u32] {
+        &self.vertices[self.offsets[i]..self.offsets[i + 1]]
+    }
+}
+
+/// The sorted vertex sets of every cell, without a heap allocation per
+/// cell (polyhedra, whose lists encode faces, are the exception).
+pub(crate) fn vertex_sets(cells: &TopCells) -> FlatSets {
+    if cells.shapes.iter().any(|s| *s == Shape::Polyhedron) {
+        let mut sets = FlatSets {
+            offsets: vec![0],
+            vertices: Vec::new(),
+        };
+        for i in 0..cells.len() {
+            sets.vertices.extend(cells.vertex_set(i));
+            sets.offsets.push(sets.vertices.len());
+        }
+        return sets;
+    }
+    let mut vertices = cells.vertices.clone();
+    let offsets = if cells.offsets.is_empty() {
+        vec![0]
+    } else {
+        cells.offsets.clone()
+    };
+    // Cells are small; sorting each in place is cheaper than spawning tasks.
+    for w in offsets.windows(2) {
+        vertices[w[0]..w[1]].sort_unstable();
+    }
+    FlatSets { offsets, vertices }
 }
 
 /// Orders vertex sets lexicographically, a proper prefix after its
@@ -439,12 +495,50 @@ fn compare_sets(a: &[u32], b: &[u32]) -> std::cmp::Ordering {
     b.len().cmp(&a.len())
 }
 
-fn pack_key(set: &[u32]) -> u128 {
-    let mut key = 0u128;
-    for k in 0..4 {
-        key = (key << 32) | u128::from(set.get(k).copied().unwrap_or(u32::MAX));
+fn vertex_bound(sets: &FlatSets) -> usize {
+    sets.vertices
+        .iter()
+        .map(|&v| v as usize + 1)
+        .max()
+        .unwrap_or(0)
+}
+
+/// Candidate indices ordered by vertex set (the order of [`compare_sets`],
+/// ties by index). Sets are bucketed by their smallest vertex with a
+/// counting sort, then each small bucket is sorted on its own: linear in
+/// the number of candidates, and the same order as one global sort.
+fn sorted_by_vertex_set(sets: &FlatSets, vertex_count: usize) -> Vec<u32> {
+    let mut start = vec![0usize; vertex_count + 1];
+    for i in 0..sets.len() {
+        start[sets.get(i)[0] as usize + 1] += 1;
     }
-    key
+    for v in 0..vertex_count {
+        start[v + 1] += start[v];
+    }
+    let mut order = vec![0u32; sets.len()];
+    let mut next = start.clone();
+    for i in 0..sets.len() {
+        let v = sets.get(i)[0] as usize;
+        order[next[v]] = i as u32;
+        next[v] += 1;
+    }
+    // Buckets are disjoint slices; sort them in parallel in fixed-size groups.
+    let mut buckets: Vec<&mut [u32]> = Vec::with_capacity(vertex_count);
+    let mut rest = order.as_mut_slice();
+    for v in 0..vertex_count {
+        let (bucket, tail) = rest.split_at_mut(start[v + 1] - start[v]);
+        buckets.push(bucket);
+        rest = tail;
+    }
+    buckets
+        .par_iter_mut()
+        .with_min_len(1024)
+        .for_each(|bucket| {
+            bucket.sort_unstable_by(|&a, &b| {
+                compare_sets(sets.get(a as usize), sets.get(b as usize)).then(a.cmp(&b))
+            })
+        });
+    order
 }
 
 /// Extract, merge and number the facets of `cells` (all of dimension p ≥ 2).
@@ -471,30 +565,17 @@ pub(crate) fn extract_facets(cells: &TopCells) -> ExtractedLevel {
             .extend(chunk.offsets.iter().skip(1).map(|o| o + base));
         candidates.vertices.extend(chunk.vertices);
     }
-    let sets: Vec<Vec<u32>> = (0..candidates.len())
-        .into_par_iter()
-        .map(|i| candidates.vertex_set(i))
-        .collect();
+    let sets = vertex_sets(&candidates);
 
-    let mut order: Vec<u32> = (0..candidates.len() as u32).collect();
-    if sets.iter().all(|s| s.len() <= 4) {
-        let mut keyed: Vec<(u128, u32)> = order
-            .iter()
-            .map(|&i| (pack_key(&sets[i as usize]), i))
-            .collect();
-        keyed.par_sort_unstable();
-        order = keyed.into_iter().map(|(_, i)| i).collect();
-    } else {
-        order.par_sort_unstable_by(|&a, &b| {
-            compare_sets(&sets[a as usize], &sets[b as usize]).then(a.cmp(&b))
-        });
-    }
-
+    let order = sorted_by_vertex_set(&sets, vertex_bound(&sets));
     let mut level = TopCells::default();
-    let mut vertex_sets = Vec::new();
+    let mut unique = FlatSets {
+        offsets: vec![0],
+        vertices: Vec::new(),
+    };
     let mut previous: Option<&[u32]> = None;
     for &i in &order {
-        let set = sets[i as usize].as_slice();
+        let set = sets.get(i as usize);
         if previous == Some(set) {
             continue;
         }
@@ -503,11 +584,12 @@ pub(crate) fn extract_facets(cells: &TopCells) -> ExtractedLevel {
             candidates.shapes[i as usize],
             candidates.raw_vertices(i as usize).iter().copied(),
         );
-        vertex_sets.push(set.to_vec());
+        unique.vertices.extend_from_slice(set);
+        unique.offsets.push(unique.vertices.len());
     }
     ExtractedLevel {
         cells: level,
-        vertex_sets,
+        sets: unique,
     }
 }
 
@@ -529,10 +611,8 @@ mod tests {
     fn shared_facets_are_merged_and_numbered_by_vertex_set() {
         let tris = TopCells::simplices([[2usize, 1, 0], [1, 2, 3]]);
         let edges = extract_facets(&tris);
-        assert_eq!(
-            edges.vertex_sets,
-            vec![vec![0, 1], vec![0, 2], vec![1, 2], vec![1, 3], vec![2, 3]]
-        );
+        let sets: Vec<&[u32]> = (0..edges.sets.len()).map(|i| edges.sets.get(i)).collect();
+        assert_eq!(sets, vec![&[0, 1][..], &[0, 2], &[1, 2], &[1, 3], &[2, 3]]);
     }
 
     #[test]

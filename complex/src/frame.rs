@@ -19,7 +19,9 @@ const SPAN_TOLERANCE: f64 = 1e-10;
 
 pub(crate) fn point(vertices: &Vertices, i: usize) -> Point {
     let mut x = [0.0; 3];
-    x[..vertices.dim()].copy_from_slice(vertices.point(i));
+    for (slot, &c) in x.iter_mut().zip(vertices.point(i)) {
+        *slot = c;
+    }
     x
 }
 
@@ -42,6 +44,8 @@ pub(crate) struct Frame {
     pub dim: usize,
     pub basis: [Point; 3],
     pub centre: Point,
+    /// Largest distance from the first vertex (the cell's length scale).
+    pub diameter: f64,
 }
 
 impl Frame {
@@ -58,26 +62,36 @@ impl Frame {
 /// The frame of a cell with the given sorted vertices, or `None` when the
 /// vertices span fewer than `p` directions (a zero-measure cell).
 pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Frame> {
+    // Cells have few vertices; gather their points once (on the stack when
+    // they fit) instead of re-reading them in every pass.
+    let mut stack = [[0.0; 3]; 8];
+    let heap: Vec<Point>;
+    let points: &[Point] = if cell.len() <= stack.len() {
+        for (slot, &v) in stack.iter_mut().zip(cell) {
+            *slot = point(vertices, v);
+        }
+        &stack[..cell.len()]
+    } else {
+        heap = cell.iter().map(|&v| point(vertices, v)).collect();
+        &heap
+    };
+    let origin = points[0];
     let mut centre = [0.0; 3];
-    for &v in cell {
-        let x = point(vertices, v);
+    let mut diameter: f64 = 0.0;
+    for x in points {
         for k in 0..3 {
             centre[k] += x[k];
         }
+        diameter = diameter.max(norm(&sub(x, &origin)));
     }
     for c in &mut centre {
-        *c /= cell.len() as f64;
+        *c /= points.len() as f64;
     }
     let mut basis = [[0.0; 3]; 3];
     let mut found = 0;
     if p > 0 {
-        let origin = point(vertices, cell[0]);
-        let scale = cell
-            .iter()
-            .map(|&v| norm(&sub(&point(vertices, v), &origin)))
-            .fold(0.0, f64::max);
-        for &v in &cell[1..] {
-            let mut w = sub(&point(vertices, v), &origin);
+        for x in &points[1..] {
+            let mut w = sub(x, &origin);
             // Two Gram–Schmidt passes keep the basis orthonormal to rounding.
             for _ in 0..2 {
                 for b in basis.iter().take(found) {
@@ -88,7 +102,7 @@ pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Fra
                 }
             }
             let len = norm(&w);
-            if len > SPAN_TOLERANCE * scale {
+            if len > SPAN_TOLERANCE * diameter {
                 basis[found] = [w[0] / len, w[1] / len, w[2] / len];
                 found += 1;
                 if found == p {
@@ -101,6 +115,7 @@ pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Fra
         dim: p,
         basis,
         centre,
+        diameter,
     })
 }
 
@@ -133,14 +148,6 @@ pub(crate) fn induced_sign(cell: &Frame, facet: &Frame, diameter: f64) -> Option
         return None;
     }
     Some(if d > 0.0 { 1 } else { -1 })
-}
-
-/// Largest distance from the first vertex: the length scale of a cell.
-pub(crate) fn diameter(vertices: &Vertices, cell: &[usize]) -> f64 {
-    let origin = point(vertices, cell[0]);
-    cell.iter()
-        .map(|&v| norm(&sub(&point(vertices, v), &origin)))
-        .fold(0.0, f64::max)
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 //! p-cell j share; i lies on the boundary of j exactly when that count equals
 //! the number of vertices of i (the LAR filtering rule).
 
-use crate::cells::Vertices;
+use crate::cells::{FlatSets, Vertices};
 use crate::error::{ComplexError, Result};
 use rayon::prelude::*;
 use sprs::{CsMat, TriMat};
@@ -34,16 +34,16 @@ pub struct Lar {
 }
 
 /// Build a binary CSR matrix from sorted vertex sets.
-pub(crate) fn characteristic_matrix(sets: &[Vec<u32>], vertex_count: usize) -> CsMat<u8> {
-    let mut indptr = Vec::with_capacity(sets.len() + 1);
-    indptr.push(0);
-    let nnz: usize = sets.iter().map(Vec::len).sum();
-    let mut indices = Vec::with_capacity(nnz);
-    for s in sets {
-        indices.extend(s.iter().map(|&v| v as usize));
-        indptr.push(indices.len());
-    }
-    CsMat::new((sets.len(), vertex_count), indptr, indices, vec![1u8; nnz])
+pub(crate) fn characteristic_matrix(sets: &FlatSets, vertex_count: usize) -> CsMat<u8> {
+    let indices: Vec<usize> = sets.vertices.iter().map(|&v| v as usize).collect();
+    let nnz = indices.len();
+    // Rows are sorted and in range by construction.
+    CsMat::new(
+        (sets.len(), vertex_count),
+        sets.offsets.clone(),
+        indices,
+        vec![1u8; nnz],
+    )
 }
 
 impl Lar {
@@ -77,7 +77,10 @@ impl Lar {
         let k0 = vertices.len();
         let mut matrices = Vec::with_capacity(cells.len());
         for (k, level) in cells.iter().enumerate() {
-            let mut sets = Vec::with_capacity(level.len());
+            let mut sets = FlatSets {
+                offsets: vec![0],
+                vertices: Vec::new(),
+            };
             for (j, cell) in level.iter().enumerate() {
                 let mut set = Vec::with_capacity(cell.len());
                 for &v in cell {
@@ -98,7 +101,8 @@ impl Lar {
                         k + 1
                     )));
                 }
-                sets.push(set);
+                sets.vertices.extend(set);
+                sets.offsets.push(sets.vertices.len());
             }
             matrices.push(characteristic_matrix(&sets, k0));
         }
@@ -182,29 +186,37 @@ impl Lar {
         let by_vertex = self.cells_by_vertex(p);
         let upper = &self.characteristic[p - 1];
         let rows = self.cell_count(p - 1);
-        let row_entries: Vec<Vec<usize>> = (0..rows)
+        const CHUNK: usize = 8192;
+        let row_of = |i: usize, out: &mut Vec<usize>| {
+            let lower = self.cell_vertices(p - 1, i);
+            let Some(&first) = lower.first() else { return };
+            let star = &by_vertex.indices()[by_vertex.indptr().outer_inds_sz(first)];
+            out.extend(star.iter().copied().filter(|&j| {
+                let cell = &upper.indices()[upper.indptr().outer_inds_sz(j)];
+                lower[1..].iter().all(|v| cell.binary_search(v).is_ok())
+            }));
+        };
+        let chunks: Vec<(Vec<usize>, Vec<usize>)> = (0..rows.div_ceil(CHUNK))
             .into_par_iter()
-            .map(|i| {
-                let lower = self.cell_vertices(p - 1, i);
-                let Some(&first) = lower.first() else {
-                    return Vec::new();
-                };
-                let star = &by_vertex.indices()[by_vertex.indptr().outer_inds_sz(first)];
-                star.iter()
-                    .copied()
-                    .filter(|&j| {
-                        let cell = &upper.indices()[upper.indptr().outer_inds_sz(j)];
-                        lower[1..].iter().all(|v| cell.binary_search(v).is_ok())
-                    })
-                    .collect()
+            .map(|chunk| {
+                let mut lengths = Vec::with_capacity(CHUNK);
+                let mut entries = Vec::with_capacity(CHUNK * 2);
+                for i in chunk * CHUNK..((chunk + 1) * CHUNK).min(rows) {
+                    let before = entries.len();
+                    row_of(i, &mut entries);
+                    lengths.push(entries.len() - before);
+                }
+                (lengths, entries)
             })
             .collect();
         let mut indptr = Vec::with_capacity(rows + 1);
         indptr.push(0);
-        let mut indices = Vec::with_capacity(row_entries.iter().map(Vec::len).sum());
-        for r in row_entries {
-            indices.extend(r);
-            indptr.push(indices.len());
+        let mut indices = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
+        for (lengths, entries) in chunks {
+            for len in lengths {
+                indptr.push(indptr[indptr.len() - 1] + len);
+            }
+            indices.extend(entries);
         }
         (indptr, indices)
     }
