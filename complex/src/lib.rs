@@ -18,13 +18,17 @@ pub mod complex;
 pub mod dual;
 pub mod error;
 mod frame;
+pub mod generate;
 pub mod geometry;
+pub mod gmsh;
 pub mod homology;
+pub mod json;
 pub mod lar;
 pub mod tags;
 
 pub use cells::{Shape, TopCells, Vertices};
 pub use complex::{Complex, Subcomplex};
+pub use dual::DualKind;
 pub use error::{ComplexError, Result};
 pub use homology::Field;
 pub use lar::Lar;
