@@ -1,5 +1,598 @@
 //! Geometry of every cell: measures, centroids, normals, circumcentres.
+//!
+//! Every quantity is computed on first use, in parallel over cells, and
+//! cached in the complex. Each cell is computed on its own, with its sums in
+//! a fixed order, so the results are bit-for-bit the same whatever the
+//! number of threads.
+//!
+//! # Measures and centroids: the cone decomposition
+//!
+//! A p-cell c is split into cones from its apex a (the average of its
+//! vertices) over its facets, |c| = (1/p) Σ_{f ∈ ∂c} |f| h_f with h_f the
+//! distance from a to the affine hull of f, and its centroid is the
+//! volume-weighted average of the cone centroids
+//! a + p/(p+1) (centroid_f − a). Applied bottom-up this is the
+//! decomposition of c into the simplices (apex of c, apex of f, edge) —
+//! triangles (a, v₀, v₁) for a polygon, tetrahedra (a_c, a_f, v₀, v₁) for a
+//! polyhedron — which is what is computed:
+//!
+//! - convex polytopes with planar faces (every simplex, polygon, polyhedron,
+//!   and every affine image of a square or cube): exact, in any embedding;
+//! - non-planar quadrilaterals and polygons embedded in R³ (e.g. the quads
+//!   of a torus surface): the area is that of the triangle fan from the
+//!   vertex average, Σ_e ½ |e| dist(a, line e);
+//! - 3-cells with non-planar faces (e.g. a jittered hexahedral grid): the
+//!   volume of the solid bounded by the faces triangulated as fans from
+//!   their vertex averages, Σ_f ⅓ (a_f − a_c)·A_f with A_f the vector area
+//!   of the fan. Neighbouring cells triangulate their shared face the same
+//!   way, so these volumes add up exactly to the volume of their union.
+
+use crate::complex::Complex;
+use crate::error::{ComplexError, Result};
+use crate::frame::{self, Point};
+use rayon::prelude::*;
+use sprs::CsMat;
+use std::borrow::Cow;
+use std::ops::Range;
+use std::sync::OnceLock;
+
+/// Highest cell dimension a complex can have (the embedding is at most R³).
+const LEVELS: usize = 4;
 
 /// Lazily computed geometric quantities of a complex.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct GeometryCache {}
+pub(crate) struct GeometryCache {
+    /// ∂_p in CSC storage (index p ≥ 1): the facets of each p-cell.
+    facets: [OnceLock<CsMat<i8>>; LEVELS],
+    /// Measures and centroids of the p-cells.
+    cells: [OnceLock<CellGeometry>; LEVELS],
+    /// Unit normals of the (n−1)-cells.
+    normals: OnceLock<Vec<f64>>,
+    /// Circumcentres of simplicial p-cells.
+    circumcentres: [OnceLock<Vec<f64>>; LEVELS],
+    /// Largest top-cell diameter.
+    mesh_size: OnceLock<f64>,
+}
+
+#[derive(Clone, Debug, Default)]
+struct CellGeometry {
+    measure: Vec<f64>,
+    /// Stride d.
+    centroid: Vec<f64>,
+}
+
+impl Complex {
+    /// Measure (length, area, volume) of every p-cell; 1 for vertices and an
+    /// empty slice for p > n.
+    ///
+    /// Exact for convex polytopes; non-planar cells are measured through the
+    /// cone decomposition described in the [module documentation](self).
+    ///
+    /// ```
+    /// use hasse_complex::{Complex, TopCells, Vertices};
+    /// let v = Vertices::from_points(&[[0.0, 0.0], [2.0, 0.0], [0.0, 1.0], [2.0, 1.0]]).unwrap();
+    /// let k = Complex::build(v, TopCells::cuboids([[0, 1, 2, 3]])).unwrap();
+    /// assert_eq!(k.measure(2), &[2.0]);
+    /// let mut lengths = k.measure(1).to_vec();
+    /// lengths.sort_by(f64::total_cmp);
+    /// assert_eq!(lengths, vec![1.0, 1.0, 2.0, 2.0]);
+    /// ```
+    pub fn measure(&self, p: usize) -> &[f64] {
+        self.cell_geometry(p).map_or(&[], |g| &g.measure)
+    }
+
+    /// Centre of mass of every p-cell, row by row with stride
+    /// d = [`Complex::embedding_dim`]; an empty slice for p > n.
+    ///
+    /// ```
+    /// use hasse_complex::{Complex, TopCells, Vertices};
+    /// // A trapezoid with parallel sides 2 (y = 0) and 1 (y = 1).
+    /// let v = Vertices::from_points(&[[0.0, 0.0], [2.0, 0.0], [1.5, 1.0], [0.5, 1.0]]).unwrap();
+    /// let k = Complex::build(v, TopCells::polygons([[0, 1, 2, 3]])).unwrap();
+    /// let c = k.centroid_of(2, 0);
+    /// assert!((c[0] - 1.0).abs() < 1e-15 && (c[1] - 4.0 / 9.0).abs() < 1e-15);
+    /// ```
+    pub fn centroid(&self, p: usize) -> &[f64] {
+        self.cell_geometry(p).map_or(&[], |g| &g.centroid)
+    }
+
+    /// Centroid of p-cell `i` (an empty slice when it does not exist).
+    pub fn centroid_of(&self, p: usize, i: usize) -> &[f64] {
+        let d = self.embedding_dim();
+        self.centroid(p).get(i * d..(i + 1) * d).unwrap_or(&[])
+    }
+
+    /// Unit normal of every (n−1)-cell, stride d, consistent with ∂_n: it
+    /// points out of every top cell c with ∂_n(f, c) = +1 and into those
+    /// with −1.
+    ///
+    /// For each top cell c on f, ν_{f,c} is the unit normal of f inside the
+    /// span of c pointing away from c's centroid; the normal of f is
+    /// normalize(Σ_c ∂_n(f, c) ν_{f,c}). In a flat complex (n = d) this is
+    /// the normal of f; on an embedded surface it is tangent to the surface
+    /// (the average of the two in-plane normals), and for a curve (n = 1)
+    /// it is ± the tangent. For a non-planar face of a 3-cell, ν is the
+    /// direction of the face's vector area.
+    ///
+    /// ```
+    /// use hasse_complex::{Complex, TopCells, Vertices};
+    /// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
+    /// let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+    /// // Edge {0,1} lies on y = 0 and enters ∂ with +1: its normal is (0, −1).
+    /// let e = k.find_cell(1, &[0, 1]).unwrap();
+    /// assert_eq!(k.boundary(2).get(e, 0), Some(&1));
+    /// assert_eq!(&k.normal()[2 * e..2 * e + 2], &[0.0, -1.0]);
+    /// ```
+    pub fn normal(&self) -> &[f64] {
+        self.geometry.normals.get_or_init(|| self.compute_normals())
+    }
+
+    /// Circumcentre of every p-cell (stride d), computed in the simplex's
+    /// own affine span, so it works for simplices embedded in a higher
+    /// dimensional space. Only simplices have one: the error names the
+    /// first p-cell that is not a simplex. Empty for p > n.
+    ///
+    /// ```
+    /// use hasse_complex::{Complex, TopCells, Vertices};
+    /// let v = Vertices::from_points(&[[0.0, 0.0], [4.0, 0.0], [0.0, 2.0]]).unwrap();
+    /// let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+    /// // Right angle at the origin: the circumcentre is the hypotenuse midpoint.
+    /// assert_eq!(k.circumcentre(2).unwrap(), &[2.0, 1.0]);
+    /// ```
+    pub fn circumcentre(&self, p: usize) -> Result<&[f64]> {
+        if p > self.dim() {
+            return Ok(&[]);
+        }
+        let slot = &self.geometry.circumcentres[p];
+        if let Some(c) = slot.get() {
+            return Ok(c);
+        }
+        if let Some(i) = (0..self.cell_count(p)).find(|&i| self.cell_vertices(p, i).len() != p + 1)
+        {
+            let vertices = self.cell_vertices(p, i);
+            return Err(ComplexError::Invalid(format!(
+                "{p}-cell {i} (vertices {vertices:?}) has {} vertices, not {}: circumcentres exist only for simplices",
+                vertices.len(),
+                p + 1
+            )));
+        }
+        let centres = self.compute_circumcentres(p)?;
+        Ok(slot.get_or_init(|| centres))
+    }
+
+    /// The largest diameter (largest distance between two of its vertices)
+    /// of a top cell.
+    ///
+    /// ```
+    /// use hasse_complex::{Complex, TopCells, Vertices};
+    /// let v = Vertices::from_points(&[[0.0, 0.0], [3.0, 0.0], [0.0, 4.0], [3.0, 4.0]]).unwrap();
+    /// let k = Complex::build(v, TopCells::cuboids([[0, 1, 2, 3]])).unwrap();
+    /// assert_eq!(k.mesh_size(), 5.0);
+    /// ```
+    pub fn mesh_size(&self) -> f64 {
+        *self.geometry.mesh_size.get_or_init(|| {
+            let n = self.dim();
+            let vertices = self.vertices();
+            let largest_squared = (0..self.cell_count(n))
+                .into_par_iter()
+                .map(|c| {
+                    let cell = self.cell_vertices(n, c);
+                    let mut largest: f64 = 0.0;
+                    for (k, &a) in cell.iter().enumerate() {
+                        let x = frame::point(vertices, a);
+                        for &b in &cell[k + 1..] {
+                            let r = frame::sub(&frame::point(vertices, b), &x);
+                            largest = largest.max(frame::dot(&r, &r));
+                        }
+                    }
+                    largest
+                })
+                .reduce(|| 0.0, f64::max);
+            largest_squared.sqrt()
+        })
+    }
+
+    /// ∂_p in CSC storage, cached: column j lists the facets of p-cell j.
+    pub(crate) fn facets_csc(&self, p: usize) -> &CsMat<i8> {
+        self.geometry.facets[p].get_or_init(|| self.boundary_csc(p))
+    }
+
+    fn cell_geometry(&self, p: usize) -> Option<&CellGeometry> {
+        (p <= self.dim()).then(|| self.geometry.cells[p].get_or_init(|| self.compute_cells(p)))
+    }
+
+    fn compute_cells(&self, p: usize) -> CellGeometry {
+        let d = self.embedding_dim();
+        let count = self.cell_count(p);
+        let mut measure = vec![0.0; count];
+        let mut centroid = vec![0.0; count * d];
+        let mesh = Mesh::new(self);
+        let write = |(i, (m, c)): (usize, (&mut f64, &mut [f64]))| {
+            let (mi, ci) = match p {
+                0 => (1.0, mesh.point(i)),
+                1 => mesh.segment(i),
+                2 => mesh.polygon(i),
+                _ => mesh.polyhedron(i),
+            };
+            *m = mi;
+            c.copy_from_slice(&ci[..d]);
+        };
+        measure
+            .par_iter_mut()
+            .zip(centroid.par_chunks_mut(d))
+            .enumerate()
+            .for_each(write);
+        CellGeometry { measure, centroid }
+    }
+
+    /// Vertex `i` padded to three coordinates.
+    pub(crate) fn point3(&self, i: usize) -> Point {
+        frame::point(self.vertices(), i)
+    }
+
+    fn compute_normals(&self) -> Vec<f64> {
+        let n = self.dim();
+        let d = self.embedding_dim();
+        if n == 0 {
+            return Vec::new();
+        }
+        let mesh = Mesh::new(self);
+        let top = self.boundary(n);
+        let top_centres = self.centroid(n);
+        let face_centres = self.centroid(n - 1);
+        let mut normals = vec![0.0; self.cell_count(n - 1) * d];
+        normals.par_chunks_mut(d).enumerate().for_each(|(f, out)| {
+            let xf = padded(&face_centres[f * d..(f + 1) * d]);
+            // Directions spanned by the face itself.
+            let face_direction = match n {
+                1 => [0.0; 3],
+                2 => {
+                    let (a, b) = mesh.ends(f);
+                    unit(&frame::sub(&b, &a))
+                }
+                _ => unit(&mesh.vector_area(f)),
+            };
+            let (cells, signs) = row(top, f);
+            let mut sum = [0.0; 3];
+            for (&c, &s) in cells.iter().zip(signs) {
+                let away = frame::sub(&xf, &padded(&top_centres[c * d..(c + 1) * d]));
+                let nu = match n {
+                    1 => away,
+                    2 => {
+                        let along = frame::dot(&away, &face_direction);
+                        frame::sub(&away, &scale(&face_direction, along))
+                    }
+                    _ => {
+                        if frame::dot(&away, &face_direction) >= 0.0 {
+                            face_direction
+                        } else {
+                            scale(&face_direction, -1.0)
+                        }
+                    }
+                };
+                sum = add(&sum, &scale(&unit(&nu), f64::from(s)));
+            }
+            out.copy_from_slice(&unit(&sum)[..d]);
+        });
+        normals
+    }
+
+    fn compute_circumcentres(&self, p: usize) -> Result<Vec<f64>> {
+        let d = self.embedding_dim();
+        let centres: Vec<Option<Point>> = (0..self.cell_count(p))
+            .into_par_iter()
+            .map(|i| circumcentre_of(self, self.cell_vertices(p, i)))
+            .collect();
+        let mut out = Vec::with_capacity(centres.len() * d);
+        for (i, c) in centres.into_iter().enumerate() {
+            let c = c.ok_or_else(|| ComplexError::DegenerateCell {
+                dim: p,
+                cell: i,
+                vertices: self.cell_vertices(p, i).to_vec(),
+            })?;
+            out.extend_from_slice(&c[..d]);
+        }
+        Ok(out)
+    }
+}
+
+/// Allocation-free access to coordinates, edge ends and facet columns
+/// for the per-cell kernels.
+struct Mesh<'a> {
+    coords: &'a [f64],
+    d: usize,
+    /// The vertex pairs of the edges, flat (row i of M₁ is entries 2i, 2i+1).
+    edges: Cow<'a, [usize]>,
+    complex: &'a Complex,
+}
+
+/// Polygons with at most this many edges keep their edge end points on the
+/// stack between the two passes of [`Mesh::polygon`].
+const SMALL_POLYGON: usize = 8;
+
+impl<'a> Mesh<'a> {
+    fn new(complex: &'a Complex) -> Self {
+        Self {
+            coords: complex.vertices().as_slice(),
+            d: complex.embedding_dim(),
+            edges: complex
+                .lar()
+                .characteristic(1)
+                .map_or(Cow::Borrowed(&[][..]), edge_pairs),
+            complex,
+        }
+    }
+
+    #[inline(always)]
+    fn point(&self, i: usize) -> Point {
+        let x = &self.coords[i * self.d..(i + 1) * self.d];
+        match *x {
+            [a] => [a, 0.0, 0.0],
+            [a, b] => [a, b, 0.0],
+            [a, b, c, ..] => [a, b, c],
+            [] => [0.0; 3],
+        }
+    }
+
+    /// The two end points of edge `e` (tail = lower vertex id, head = higher).
+    #[inline(always)]
+    fn ends(&self, e: usize) -> (Point, Point) {
+        (
+            self.point(self.edges[2 * e]),
+            self.point(self.edges[2 * e + 1]),
+        )
+    }
+
+    fn segment(&self, e: usize) -> (f64, Point) {
+        let (a, b) = self.ends(e);
+        (frame::norm(&frame::sub(&b, &a)), scale(&add(&a, &b), 0.5))
+    }
+
+    /// Fan of triangles (apex, v₀, v₁) over the edges of a 2-cell, apex the
+    /// vertex average (every vertex of the cycle ends two edges).
+    fn polygon(&self, f: usize) -> (f64, Point) {
+        let (edges, _) = column(self.complex.facets_csc(2), f);
+        let Some(&first) = edges.first() else {
+            return (0.0, [0.0; 3]);
+        };
+        let origin = self.ends(first).0;
+        let small = edges.len() <= SMALL_POLYGON;
+        let mut ends = [([0.0; 3], [0.0; 3]); SMALL_POLYGON];
+        let mut sum = [0.0; 3];
+        for (k, &e) in edges.iter().enumerate() {
+            let (a, b) = self.ends(e);
+            if small {
+                ends[k] = (a, b);
+            }
+            sum = add(
+                &sum,
+                &add(&frame::sub(&a, &origin), &frame::sub(&b, &origin)),
+            );
+        }
+        let apex = add(&origin, &scale(&sum, 0.5 / edges.len() as f64));
+        let mut area = 0.0;
+        let mut moment = [0.0; 3];
+        for (k, &e) in edges.iter().enumerate() {
+            let (a, b) = if small { ends[k] } else { self.ends(e) };
+            let a = frame::sub(&a, &apex);
+            let b = frame::sub(&b, &apex);
+            let t = 0.5 * frame::norm(&cross(&a, &b));
+            area += t;
+            // Triangle centroid relative to the apex: (a + b) / 3.
+            moment = add(&moment, &scale(&add(&a, &b), t / 3.0));
+        }
+        (area, centred(&apex, &moment, area))
+    }
+
+    /// Signed tetrahedra (o, a_f, v₀, v₁) over the oriented fan of every
+    /// face f, a_f its vertex average. The faces close up, so the result
+    /// does not depend on the apex o (taken at a vertex of the cell): it is
+    /// the cone decomposition from the vertex average, computed with fewer
+    /// loads. Per face, with primes relative to o and C = r (v₀′ × v₁′):
+    /// 6 vol = s a_f′·ΣC and 24 moment = s [a_f′ (a_f′·ΣC) + Σ (v₀′ + v₁′)(C·a_f′)].
+    fn polyhedron(&self, c: usize) -> (f64, Point) {
+        let (faces, face_signs) = column(self.complex.facets_csc(3), c);
+        let edge_csc = self.complex.facets_csc(2);
+        let Some(&first_face) = faces.first() else {
+            return (0.0, [0.0; 3]);
+        };
+        let origin = match column(edge_csc, first_face).0.first() {
+            Some(&e) => self.ends(e).0,
+            None => return (0.0, [0.0; 3]),
+        };
+        let mut volume6 = 0.0;
+        let mut moment24 = [0.0; 3];
+        for (&f, &s) in faces.iter().zip(face_signs) {
+            let (edges, edge_signs) = column(edge_csc, f);
+            let mut sum = [0.0; 3];
+            let mut normal = [0.0; 3];
+            let mut tensor = [[0.0; 3]; 3];
+            for (&e, &r) in edges.iter().zip(edge_signs) {
+                let (a, b) = self.ends(e);
+                let a = frame::sub(&a, &origin);
+                let b = frame::sub(&b, &origin);
+                let ab = add(&a, &b);
+                let c = scale(&cross(&a, &b), f64::from(r));
+                sum = add(&sum, &ab);
+                normal = add(&normal, &c);
+                for (row, x) in tensor.iter_mut().zip(ab) {
+                    *row = add(row, &scale(&c, x));
+                }
+            }
+            let apex = scale(&sum, 0.5 / edges.len().max(1) as f64);
+            let s = f64::from(s);
+            let height = s * frame::dot(&apex, &normal);
+            volume6 += height;
+            let spread = tensor.map(|row| frame::dot(&row, &apex));
+            moment24 = add(&moment24, &add(&scale(&apex, height), &scale(&spread, s)));
+        }
+        // The sign follows the orientation convention; the centroid does not.
+        let centroid = if volume6 == 0.0 {
+            origin
+        } else {
+            add(&origin, &scale(&moment24, 0.25 / volume6))
+        };
+        ((volume6 / 6.0).abs(), centroid)
+    }
+
+    /// Vector area of 2-cell `f` in its own orientation: ½ Σ r (v₀ − o) × (v₁ − o)
+    /// over its edges with their ∂₂ signs, for any o.
+    fn vector_area(&self, f: usize) -> Point {
+        let (edges, signs) = column(self.complex.facets_csc(2), f);
+        let Some(&first) = edges.first() else {
+            return [0.0; 3];
+        };
+        let origin = self.ends(first).0;
+        let mut area = [0.0; 3];
+        for (&e, &r) in edges.iter().zip(signs) {
+            let (a, b) = self.ends(e);
+            let a = frame::sub(&a, &origin);
+            let b = frame::sub(&b, &origin);
+            area = add(&area, &scale(&cross(&a, &b), 0.5 * f64::from(r)));
+        }
+        area
+    }
+}
+
+/// The vertex pairs of the edges as one flat slice: M₁'s own column
+/// indices when every row holds two entries (always, for a valid complex).
+fn edge_pairs(m: &CsMat<u8>) -> Cow<'_, [usize]> {
+    let indptr = m.indptr();
+    let uniform = indptr.raw_storage().first() == Some(&0)
+        && (0..=m.rows()).all(|i| indptr.index(i) == 2 * i);
+    if uniform {
+        Cow::Borrowed(&m.indices()[..2 * m.rows()])
+    } else {
+        Cow::Owned(
+            (0..m.rows())
+                .flat_map(|i| {
+                    let row = &m.indices()[indptr.outer_inds_sz(i)];
+                    let first = row.first().copied().unwrap_or(0);
+                    [first, row.get(1).copied().unwrap_or(first)]
+                })
+                .collect(),
+        )
+    }
+}
+
+/// Circumcentre of the simplex with these vertices: x₀ + B y with
+/// (2BᵀB) y = (|x_i − x₀|²)_i, B = [x₁ − x₀, …, x_p − x₀]; `None` when
+/// the simplex is degenerate.
+fn circumcentre_of(complex: &Complex, cell: &[usize]) -> Option<Point> {
+    let origin = complex.point3(*cell.first()?);
+    let mut edges = [[0.0; 3]; 3];
+    let p = cell.len() - 1;
+    for (k, &v) in cell[1..].iter().enumerate() {
+        edges[k] = frame::sub(&complex.point3(v), &origin);
+    }
+    // Unused rows/columns are padded with the identity and a zero right-hand side.
+    let mut gram = nalgebra::Matrix3::<f64>::identity();
+    let mut rhs = nalgebra::Vector3::<f64>::zeros();
+    for i in 0..p {
+        for j in 0..p {
+            gram[(i, j)] = 2.0 * frame::dot(&edges[i], &edges[j]);
+        }
+        rhs[i] = frame::dot(&edges[i], &edges[i]);
+    }
+    let y = gram.lu().solve(&rhs)?;
+    let mut centre = origin;
+    for (k, edge) in edges.iter().take(p).enumerate() {
+        centre = add(&centre, &scale(edge, y[k]));
+    }
+    centre.iter().all(|x| x.is_finite()).then_some(centre)
+}
+
+/// Entries (row or column indices, values) of outer slice `j` of a
+/// compressed matrix: a column of a CSC matrix.
+pub(crate) fn column(m: &CsMat<i8>, j: usize) -> (&[usize], &[i8]) {
+    let range: Range<usize> = m.indptr().outer_inds_sz(j);
+    (&m.indices()[range.clone()], &m.data()[range])
+}
+
+/// A row of a CSR matrix (same storage access as [`column`]).
+pub(crate) fn row(m: &CsMat<i8>, i: usize) -> (&[usize], &[i8]) {
+    column(m, i)
+}
+
+/// A stored point (1 to 3 coordinates) padded to three.
+pub(crate) fn padded(x: &[f64]) -> Point {
+    let mut out = [0.0; 3];
+    out[..x.len()].copy_from_slice(x);
+    out
+}
+
+pub(crate) fn add(a: &Point, b: &Point) -> Point {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+pub(crate) fn scale(a: &Point, s: f64) -> Point {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+
+pub(crate) fn cross(a: &Point, b: &Point) -> Point {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// `a / |a|`, or zero for the zero vector.
+pub(crate) fn unit(a: &Point) -> Point {
+    let len = frame::norm(a);
+    if len > 0.0 {
+        scale(a, 1.0 / len)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// apex + moment / mass, or the apex for a zero mass.
+fn centred(apex: &Point, moment: &Point, mass: f64) -> Point {
+    if mass == 0.0 {
+        *apex
+    } else {
+        add(apex, &scale(moment, 1.0 / mass))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Complex, TopCells, Vertices};
+
+    #[test]
+    fn unit_tetrahedron_volume_and_centroid() {
+        let v = Vertices::from_points(&[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ])
+        .unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2, 3]])).unwrap();
+        assert!((k.measure(3)[0] - 1.0 / 6.0).abs() < 1e-16);
+        for x in k.centroid(3) {
+            assert!((x - 0.25).abs() < 1e-16);
+        }
+        // Faces: three right triangles of area 1/2 and one equilateral of side √2.
+        let mut areas = k.measure(2).to_vec();
+        areas.sort_by(f64::total_cmp);
+        for a in &areas[..3] {
+            assert!((a - 0.5).abs() < 1e-15);
+        }
+        assert!((areas[3] - 3f64.sqrt() / 2.0).abs() < 1e-15);
+        assert_eq!(k.measure(0), &[1.0; 4]);
+        assert!(k.measure(4).is_empty());
+        assert!(k.centroid_of(3, 1).is_empty());
+    }
+
+    #[test]
+    fn circumcentre_rejects_non_simplices() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]).unwrap();
+        let k = Complex::build(v, TopCells::cuboids([[0, 1, 2, 3]])).unwrap();
+        let err = k.circumcentre(2).unwrap_err().to_string();
+        assert!(err.contains("2-cell 0"), "{err}");
+        // Edges are simplices.
+        assert_eq!(k.circumcentre(1).unwrap().len(), 8);
+    }
+}
