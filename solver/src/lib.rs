@@ -1,0 +1,10 @@
+//! # hasse-solver
+//!
+//! The canonical form δΩ∂ = Aᵀ Ω A on cell complexes: the operator type,
+//! the metrics Ω of FD, FE, FV and DEC, boundary conditions, faer solves,
+//! case files and the `hasse` command line.
+
+pub mod canonical;
+pub mod info;
+pub mod linear;
+pub mod mesh_spec;
