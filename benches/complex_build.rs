@@ -40,14 +40,18 @@ fn bare_product(complex: &Complex) -> usize {
 }
 
 fn bench(c: &mut Criterion) {
-    let sizes: Vec<(&str, Vec<Vec<f64>>)> = vec![
+    // Under `cargo test --all-targets` (no --bench flag) criterion runs each
+    // benchmark once as a smoke test: use small grids there.
+    let benching = std::env::args().any(|a| a == "--bench");
+    let (n2, n3) = if benching { (1000, 100) } else { (20, 5) };
+    let sizes: Vec<(String, Vec<Vec<f64>>)> = vec![
         (
-            "2d-1000x1000",
-            vec![generate::uniform_axis(1000, 0.0, 1.0).expect("valid axis"); 2],
+            format!("2d-{n2}x{n2}"),
+            vec![generate::uniform_axis(n2, 0.0, 1.0).expect("valid axis"); 2],
         ),
         (
-            "3d-100x100x100",
-            vec![generate::uniform_axis(100, 0.0, 1.0).expect("valid axis"); 3],
+            format!("3d-{n3}x{n3}x{n3}"),
+            vec![generate::uniform_axis(n3, 0.0, 1.0).expect("valid axis"); 3],
         ),
     ];
     let mut group = c.benchmark_group("complex_build");
@@ -57,13 +61,13 @@ fn bench(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1));
     for (name, axes) in &sizes {
         group.bench_with_input(
-            BenchmarkId::new("complex+geometry", name),
+            BenchmarkId::new("complex+geometry", name.as_str()),
             axes,
             |b, axes| b.iter(|| build_with_geometry(axes)),
         );
         let complex = build_with_geometry(axes);
         group.bench_with_input(
-            BenchmarkId::new("baseline:sprs M_(n-1) M_n^T", name),
+            BenchmarkId::new("baseline:sprs M_(n-1) M_n^T", name.as_str()),
             &complex,
             |b, complex| b.iter(|| bare_product(complex)),
         );

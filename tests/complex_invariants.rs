@@ -7,12 +7,6 @@ use hasse_complex::{generate, gmsh, Complex, TopCells, Vertices};
 use sprs::CsMat;
 use std::path::PathBuf;
 
-fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../complex/tests/data")
-        .join(name)
-}
-
 fn cases(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../cases")

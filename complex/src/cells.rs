@@ -458,7 +458,7 @@ impl FlatSets {
 /// The sorted vertex sets of every cell, without a heap allocation per
 /// cell (polyhedra, whose lists encode faces, are the exception).
 pub(crate) fn vertex_sets(cells: &TopCells) -> FlatSets {
-    if cells.shapes.iter().any(|s| *s == Shape::Polyhedron) {
+    if cells.shapes.contains(&Shape::Polyhedron) {
         let mut sets = FlatSets {
             offsets: vec![0],
             vertices: Vec::new(),

@@ -505,7 +505,7 @@ mod tests {
             let row: f64 = (0..3).map(|j| expected[(i, j)] * u[j]).sum();
             assert!((mu[i] - row).abs() < 1e-14);
         }
-        assert!(omega.is_symmetric(0.0) == false);
+        assert!(!omega.is_symmetric(0.0));
     }
 
     #[test]

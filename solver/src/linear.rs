@@ -84,7 +84,7 @@ pub struct Factor {
 enum Numeric {
     Llt(Llt<usize, f64>),
     Ldlt(Arc<SymbolicCholesky<usize>>, Vec<f64>),
-    Lu(Lu<usize, f64>),
+    Lu(Box<Lu<usize, f64>>),
 }
 
 /// Figures of one solve, for the user's report.
@@ -177,10 +177,10 @@ impl DirectSolver {
                 }
                 Numeric::Ldlt(symbolic.clone(), values)
             }
-            Analysis::Lu(symbolic) => Numeric::Lu(
+            Analysis::Lu(symbolic) => Numeric::Lu(Box::new(
                 Lu::try_new_with_symbolic(symbolic.clone(), matrix)
                     .map_err(|_| SolveError::Singular { method: "LU" })?,
-            ),
+            )),
         };
         Ok(Factor {
             kind: self.kind,
@@ -233,12 +233,12 @@ impl Factor {
 /// ‖b − M x‖₂ / ‖b‖₂.
 pub fn relative_residual(matrix: SparseColMatRef<'_, usize, f64>, x: &[f64], rhs: &[f64]) -> f64 {
     let mut r = rhs.to_vec();
-    for j in 0..matrix.ncols() {
+    for (j, &xj) in x.iter().enumerate().take(matrix.ncols()) {
         let range = matrix.col_range(j);
         let rows = &matrix.row_idx()[range.clone()];
         let vals = &matrix.val()[range];
         for (&i, &v) in rows.iter().zip(vals) {
-            r[i] -= v * x[j];
+            r[i] -= v * xj;
         }
     }
     let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
