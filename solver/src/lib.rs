@@ -8,3 +8,4 @@ pub mod canonical;
 pub mod info;
 pub mod linear;
 pub mod mesh_spec;
+pub mod metric;

@@ -1,0 +1,1044 @@
+//! Nodal Galerkin stiffness −∇·(K∇u) written as Ω over the edges.
+//!
+//! Unknowns live on vertices and A = δ⁰ = ∂₁ᵀ. Every top cell c contributes
+//! a local stiffness K_c (vertices × vertices) with K_c 1 = 0. Because the
+//! edge graph of a cell is connected, the local incidence A_c (cell edges ×
+//! cell vertices, signs from the global ∂₁) has kernel = constants, so
+//!
+//! ```text
+//!     Ω_c = (A_c⁺)ᵀ K_c A_c⁺   gives   A_cᵀ Ω_c A_c = K_c   exactly,
+//! ```
+//!
+//! and Σ_c A_cᵀ Ω_c A_c is the usual assembled stiffness. Which element a
+//! cell gets depends on its shape:
+//!
+//! | cell | element | Ω_c |
+//! |---|---|---|
+//! | simplex (segment, triangle, tetrahedron) | P1 | diagonal |
+//! | quadrilateral (2D), hexahedron (3D) | Q1, isoparametric, Gauss 2ⁿ | dense |
+//! | any other convex polygon or polyhedron | lowest-order virtual element | dense |
+//!
+//! P1 is diagonal for every tensor K, not only a scalar one: in a simplex
+//! every pair of vertices is an edge, and a symmetric K_c with zero row sums
+//! is exactly the weighted graph Laplacian with ω_ab = −(K_c)_ab. For K = λI
+//! these are the cotangent weights, λ/2·cot θ_e on a triangle (θ_e the angle
+//! opposite e) and λ|e′|cot φ_e′ / 6 on a tetrahedron (e′ the edge opposite
+//! e, φ_e′ the dihedral angle at e′).
+//!
+//! Simplices may be embedded in a higher-dimensional space (a triangulated
+//! surface in R³): gradients are taken in the simplex's own tangent space.
+//! Q1 and the virtual element need cells that fill their space (n = d).
+
+use super::{check_tensors, MetricError, Tensor};
+use crate::canonical::BlockMetric;
+use hasse_complex::Complex;
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+use sprs::CsMat;
+
+/// A point padded to three coordinates.
+pub(crate) type Point = [f64; 3];
+
+/// Singular values of an integer cell incidence below this are its kernel;
+/// the smallest nonzero one is √(algebraic connectivity of the cell's edge
+/// graph), ≥ 0.1 for any cell with fewer than a few hundred vertices.
+const PSEUDO_INVERSE_TOLERANCE: f64 = 1e-8;
+
+/// Galerkin stiffness metric of −∇·(K∇u) with one tensor per top cell
+/// (P1 on simplices, Q1 on quadrilaterals and hexahedra, the lowest-order
+/// virtual element on every other convex polygon or polyhedron).
+///
+/// P1 cells add to a diagonal Ω (one 1×1 block per edge, in edge order);
+/// Q1 and VEM cells push one dense block over their edges, in cell order.
+/// See the [module documentation](self) for the construction.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::canonical::Canonical;
+/// use hasse_solver::metric::{fe, isotropic};
+/// // Q1 on a uniform grid: the 9-point stencil, 8/3 on the diagonal.
+/// let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let omega = fe::stiffness_metric(&k, &vec![isotropic(1.0); 4]).unwrap();
+/// let m = Canonical::new(k.coboundary(0), omega).unwrap().assemble().to_dense();
+/// assert!((m[(4, 4)] - 8.0 / 3.0).abs() < 1e-14);
+/// assert!((m[(4, 0)] + 1.0 / 3.0).abs() < 1e-14);
+/// ```
+pub fn stiffness_metric(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, MetricError> {
+    stiffness(complex, tensors, Route::ByShape)
+}
+
+/// Stiffness metric from the lowest-order virtual element method on every
+/// cell of dimension ≥ 2, quadrilaterals and hexahedra included (segments
+/// stay P1, which is what the virtual element is in 1D).
+///
+/// Following Beirão da Veiga et al., "The hitchhiker's guide to the virtual
+/// element method" (k = 1), with Π̃ (n × N) the gradient average
+/// Π̃ u = (1/|c|) ∫_∂c u n and Π u = ū + (x − x̄)·Π̃ u the projection onto
+/// linear functions (ū, x̄ the vertex averages):
+///
+/// ```text
+///     K_c = |c| Π̃ᵀ K Π̃  +  α (I − Π)ᵀ (I − Π),    α = tr(K)/n · h_c^(n−2)
+/// ```
+///
+/// with h_c the cell diameter; α scales the stabilisation like the
+/// consistency term (entries of order tr(K)/n · h^(n−2)). The boundary
+/// integrals ∫_∂c φ_i n are exact on polygon edges (φ_i is linear there);
+/// on a polyhedron each face is split into the fan of triangles about its
+/// vertex average, with the 3-point vertex rule on each triangle, which is
+/// exact for linear functions. |c| is the volume bounded by the same fans,
+/// so the divergence theorem holds exactly for the discrete surface and
+/// K_c u = ∫_c K∇u·∇φ_i for every linear u (the patch test), also on
+/// hexahedra with non-planar faces. On a simplex the element is P1.
+///
+/// ```
+/// use hasse_complex::{Complex, TopCells, Vertices};
+/// use hasse_solver::metric::{fe, isotropic};
+/// // A unit square with one corner cut off: a pentagon.
+/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [1.0, 0.5], [0.5, 1.0], [0.0, 1.0]]).unwrap();
+/// let k = Complex::build(v, TopCells::polygons([[0, 1, 2, 3, 4]])).unwrap();
+/// let omega = fe::vem_stiffness_metric(&k, &[isotropic(1.0)]).unwrap();
+/// assert_eq!(omega.block_count(), 1);
+/// assert!(omega.is_symmetric(1e-14));
+/// ```
+pub fn vem_stiffness_metric(
+    complex: &Complex,
+    tensors: &[Tensor],
+) -> Result<BlockMetric, MetricError> {
+    stiffness(complex, tensors, Route::Vem)
+}
+
+/// Galerkin load vector ∫ f φ_v for every vertex v, with the quadrature of
+/// the element [`stiffness_metric`] uses on each cell:
+///
+/// - P1: segments 2-point Gauss (degree 3), triangles the 3-point
+///   edge-midpoint rule (degree 2), tetrahedra the 4-point rule with
+///   barycentric coordinates (a, b, b, b), a = (5 + 3√5)/20,
+///   b = (5 − √5)/20 (degree 2): exact for linear f;
+/// - Q1: tensor Gauss 2×2 (2×2×2) on the isoparametric map: exact for
+///   linear f on parallelograms, parallelepipeds and any quadrilateral, and
+///   Σ_v load_v = ∫_c f exactly for linear f on any hexahedron;
+/// - virtual elements: |c| f(x_c) / N_c at each of the N_c vertices, x_c the
+///   centroid (one-point rule: Σ_v load_v = ∫_c f for linear f, the load is
+///   O(h²) accurate in L²).
+///
+/// An f that returns a non-finite value is reported with the cell.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::fe;
+/// let k = rectangle(3, 2, [0.0, 3.0], [0.0, 1.0]).unwrap();
+/// let b = fe::load(&k, &|x: &[f64]| 1.0 + x[0]).unwrap();
+/// // ∫ (1 + x) over [0, 3] × [0, 1] = 3 + 4.5.
+/// assert!((b.iter().sum::<f64>() - 7.5).abs() < 1e-13);
+/// ```
+pub fn load(
+    complex: &Complex,
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+) -> Result<Vec<f64>, MetricError> {
+    let top = Topology::new(complex, "FE load")?;
+    let n = top.n;
+    let parts = (0..complex.cell_count(n))
+        .into_par_iter()
+        .map(|c| cell_load(&top, c, f))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut out = vec![0.0; complex.cell_count(0)];
+    for part in parts {
+        for (v, x) in part {
+            out[v] += x;
+        }
+    }
+    Ok(out)
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Route {
+    ByShape,
+    Vem,
+}
+
+/// The element a cell gets.
+enum Element {
+    P1,
+    /// Local vertex positions in tensor order.
+    Q1(Vec<usize>),
+    Vem,
+}
+
+fn stiffness(
+    complex: &Complex,
+    tensors: &[Tensor],
+    route: Route,
+) -> Result<BlockMetric, MetricError> {
+    let top = Topology::new(complex, "FE stiffness")?;
+    let n = top.n;
+    check_tensors(tensors, complex.cell_count(n), top.d)?;
+    let locals = (0..complex.cell_count(n))
+        .into_par_iter()
+        .map(|c| {
+            let k = &tensors[c];
+            match top.element(c, route)? {
+                Element::P1 => p1_weights(&top, c, k),
+                Element::Q1(order) => {
+                    let kc = q1_stiffness(&top, c, &order, k)?;
+                    edge_block(&top, c, &kc, "Q1")
+                }
+                Element::Vem => {
+                    let kc = vem_stiffness(&top, c, k)?;
+                    edge_block(&top, c, &kc, "VEM")
+                }
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(gather(complex.cell_count(1), &locals))
+}
+
+/// One cell's share of Ω.
+pub(crate) enum Local {
+    /// (edge, weight) pairs added to the diagonal.
+    Diagonal(Vec<(usize, f64)>),
+    /// A dense symmetric block over `edges` (row-major).
+    Dense { edges: Vec<usize>, values: Vec<f64> },
+}
+
+/// Diagonal weights summed per edge first (one 1×1 block per edge that any
+/// cell touched, in edge order), then the dense blocks in cell order: the
+/// result does not depend on the thread count.
+pub(crate) fn gather(edges: usize, locals: &[Local]) -> BlockMetric {
+    let mut diagonal = vec![0.0; edges];
+    let mut touched = vec![false; edges];
+    for local in locals {
+        if let Local::Diagonal(weights) = local {
+            for &(e, w) in weights {
+                diagonal[e] += w;
+                touched[e] = true;
+            }
+        }
+    }
+    let mut metric = BlockMetric::new(edges);
+    for (e, (&w, &t)) in diagonal.iter().zip(&touched).enumerate() {
+        if t {
+            metric.push_symmetric(&[e], &[w]);
+        }
+    }
+    for local in locals {
+        if let Local::Dense { edges, values } = local {
+            metric.push_symmetric(edges, values);
+        }
+    }
+    metric
+}
+
+/// Incidence access shared by the nodal metrics.
+pub(crate) struct Topology<'a> {
+    pub(crate) complex: &'a Complex,
+    /// Topological dimension.
+    pub(crate) n: usize,
+    /// Embedding dimension.
+    pub(crate) d: usize,
+    /// δ⁰ (rows: edges), to read each edge's tail (−1) and head (+1).
+    delta0: CsMat<i8>,
+    /// ∂_p in CSC storage for p = 2..=n, at index p − 2.
+    facets: Vec<CsMat<i8>>,
+}
+
+impl<'a> Topology<'a> {
+    pub(crate) fn new(complex: &'a Complex, method: &'static str) -> Result<Self, MetricError> {
+        let n = complex.dim();
+        if n == 0 {
+            return Err(MetricError::UnsupportedMesh {
+                method,
+                needs: "a complex with edges",
+                detail: "this complex has vertices only".into(),
+            });
+        }
+        Ok(Self {
+            complex,
+            n,
+            d: complex.embedding_dim(),
+            delta0: complex.coboundary(0),
+            facets: (2..=n).map(|p| complex.boundary_csc(p)).collect(),
+        })
+    }
+
+    /// Facets of p-cell `j` (2 ≤ p ≤ n) with their signs.
+    pub(crate) fn facets_of(&self, p: usize, j: usize) -> (&[usize], &[i8]) {
+        let m = &self.facets[p - 2];
+        let range = m.indptr().outer_inds_sz(j);
+        (&m.indices()[range.clone()], &m.data()[range])
+    }
+
+    /// (tail, head) of edge `e`: the vertices where ∂₁ is −1 and +1.
+    pub(crate) fn ends(&self, e: usize) -> (usize, usize) {
+        let range = self.delta0.indptr().outer_inds_sz(e);
+        let vertices = &self.delta0.indices()[range.clone()];
+        let signs = &self.delta0.data()[range];
+        let ends = self.complex.cell_vertices(1, e);
+        let (mut tail, mut head) = (ends[0], ends[ends.len() - 1]);
+        for (&v, &s) in vertices.iter().zip(signs) {
+            if s < 0 {
+                tail = v;
+            } else {
+                head = v;
+            }
+        }
+        (tail, head)
+    }
+
+    /// Positions of edge `e`'s tail and head in the sorted list `vertices`.
+    pub(crate) fn local_ends(
+        &self,
+        e: usize,
+        vertices: &[usize],
+        cell: usize,
+    ) -> Result<(usize, usize), MetricError> {
+        let (t, h) = self.ends(e);
+        match (vertices.binary_search(&t), vertices.binary_search(&h)) {
+            (Ok(a), Ok(b)) => Ok((a, b)),
+            _ => Err(MetricError::UnsupportedMesh {
+                method: "nodal metric",
+                needs: "cells whose edges join their own vertices",
+                detail: format!("edge {e} of top cell {cell} has a vertex outside the cell"),
+            }),
+        }
+    }
+
+    /// Sorted edges of top cell `c`.
+    pub(crate) fn edges_of(&self, c: usize) -> Vec<usize> {
+        match self.n {
+            1 => vec![c],
+            2 => self.facets_of(2, c).0.to_vec(),
+            _ => {
+                let mut edges: Vec<usize> = self
+                    .facets_of(3, c)
+                    .0
+                    .iter()
+                    .flat_map(|&f| self.facets_of(2, f).0.iter().copied())
+                    .collect();
+                edges.sort_unstable();
+                edges.dedup();
+                edges
+            }
+        }
+    }
+
+    pub(crate) fn is_simplex(&self, c: usize) -> bool {
+        self.complex.cell_vertices(self.n, c).len() == self.n + 1
+    }
+
+    pub(crate) fn point(&self, v: usize) -> Point {
+        let mut x = [0.0; 3];
+        let p = self.complex.vertices().point(v);
+        x[..p.len()].copy_from_slice(p);
+        x
+    }
+
+    fn points(&self, c: usize) -> Vec<Point> {
+        self.complex
+            .cell_vertices(self.n, c)
+            .iter()
+            .map(|&v| self.point(v))
+            .collect()
+    }
+
+    fn element(&self, c: usize, route: Route) -> Result<Element, MetricError> {
+        if self.is_simplex(c) && (route == Route::ByShape || self.n == 1) {
+            return Ok(Element::P1);
+        }
+        if self.n != self.d {
+            return Err(MetricError::UnsupportedMesh {
+                method: "FE (Q1, VEM)",
+                needs: "non-simplicial cells that fill their space (n = d)",
+                detail: format!(
+                    "top cell {c} is not a simplex and the complex is {}-dimensional in R^{}",
+                    self.n, self.d
+                ),
+            });
+        }
+        if route == Route::Vem {
+            return Ok(Element::Vem);
+        }
+        Ok(match self.tensor_order(c) {
+            Some(order) => Element::Q1(order),
+            None => Element::Vem,
+        })
+    }
+
+    /// Local vertex positions of a quadrilateral or hexahedron in tensor
+    /// order (bit a of the index = side along local axis a), recovered from
+    /// its edge graph; `None` when the graph is not a square or a cube.
+    fn tensor_order(&self, c: usize) -> Option<Vec<usize>> {
+        let vertices = self.complex.cell_vertices(self.n, c);
+        let m = vertices.len();
+        if m != 1 << self.n || self.n < 2 {
+            return None;
+        }
+        let edges = self.edges_of(c);
+        if edges.len() != self.n * m / 2 {
+            return None;
+        }
+        let mut adjacent = vec![Vec::with_capacity(self.n); m];
+        for &e in &edges {
+            let (a, b) = self.local_ends(e, vertices, c).ok()?;
+            adjacent[a].push(b);
+            adjacent[b].push(a);
+        }
+        if adjacent.iter().any(|a| a.len() != self.n) {
+            return None;
+        }
+        let mut order = vec![usize::MAX; m];
+        order[0] = 0;
+        for (axis, &b) in adjacent[0].iter().enumerate() {
+            order[1 << axis] = b;
+        }
+        // Increasing index visits every corner after the corners one step
+        // closer to corner 0. A corner with two set bits a, b is the common
+        // neighbour of corners l^a and l^b other than l^a^b.
+        for l in 0..m {
+            if l.count_ones() < 2 {
+                continue;
+            }
+            let a = l.trailing_zeros();
+            let b = (l & !(1 << a)).trailing_zeros();
+            let (p, q, back) = (
+                order[l ^ (1 << a)],
+                order[l ^ (1 << b)],
+                order[l ^ (1 << a) ^ (1 << b)],
+            );
+            order[l] = *adjacent[p]
+                .iter()
+                .find(|&&x| x != back && adjacent[q].contains(&x))?;
+        }
+        let mut seen = vec![false; m];
+        for &o in &order {
+            if std::mem::replace(&mut seen[o], true) {
+                return None;
+            }
+        }
+        let mut slot = vec![0usize; m];
+        for (l, &o) in order.iter().enumerate() {
+            slot[o] = l;
+        }
+        for &e in &edges {
+            let (a, b) = self.local_ends(e, vertices, c).ok()?;
+            if (slot[a] ^ slot[b]).count_ones() != 1 {
+                return None;
+            }
+        }
+        Some(order)
+    }
+}
+
+/// Measure of a simplex and the gradients of its barycentric coordinates,
+/// tangent to the simplex (so embedded simplices work); `None` when the
+/// simplex is degenerate.
+pub(crate) fn simplex_gradients(x: &[Point], d: usize) -> Option<(f64, Vec<Point>)> {
+    let n = x.len().checked_sub(1)?;
+    if n == 0 {
+        return None;
+    }
+    let factorial: f64 = (1..=n).map(|k| k as f64).product();
+    let edges = DMatrix::from_fn(d, n, |i, j| x[j + 1][i] - x[0][i]);
+    // Rows: ∇λ_1 … ∇λ_n, the pseudo-inverse of the edge matrix. A
+    // full-dimensional simplex inverts it directly; an embedded one goes
+    // through E = QR (E⁺ = R⁻¹Qᵀ), whose conditioning is that of E and not
+    // of the Gram matrix EᵀE.
+    let (measure, rows) = if n == d {
+        let det = edges.determinant();
+        (det.abs() / factorial, edges.try_inverse()?)
+    } else {
+        let qr = edges.qr();
+        let r = qr.r();
+        let det = r.determinant();
+        (det.abs() / factorial, r.try_inverse()? * qr.q().transpose())
+    };
+    if measure.is_nan() || measure <= 0.0 {
+        return None;
+    }
+    let mut gradients = vec![[0.0; 3]; n + 1];
+    for k in 0..n {
+        for i in 0..d {
+            gradients[k + 1][i] = rows[(k, i)];
+            gradients[0][i] -= rows[(k, i)];
+        }
+    }
+    Some((measure, gradients))
+}
+
+/// gᵀ K h over the leading d coordinates.
+pub(crate) fn k_dot(g: &Point, k: &Tensor, h: &Point, d: usize) -> f64 {
+    (0..d)
+        .map(|i| g[i] * (0..d).map(|j| k[i][j] * h[j]).sum::<f64>())
+        .sum()
+}
+
+fn p1_weights(top: &Topology, c: usize, k: &Tensor) -> Result<Local, MetricError> {
+    let vertices = top.complex.cell_vertices(top.n, c);
+    let (measure, gradients) =
+        simplex_gradients(&top.points(c), top.d).ok_or(MetricError::UnsupportedCell {
+            method: "P1",
+            needs: "a simplex of positive measure",
+            cell: c,
+        })?;
+    top.edges_of(c)
+        .into_iter()
+        .map(|e| {
+            let (a, b) = top.local_ends(e, vertices, c)?;
+            Ok((e, -measure * k_dot(&gradients[a], k, &gradients[b], top.d)))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Local::Diagonal)
+}
+
+/// Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the edges of cell `c`; `kc` is indexed by
+/// the cell's sorted vertex list.
+fn edge_block(
+    top: &Topology,
+    c: usize,
+    kc: &DMatrix<f64>,
+    method: &'static str,
+) -> Result<Local, MetricError> {
+    let vertices = top.complex.cell_vertices(top.n, c);
+    let edges = top.edges_of(c);
+    let mut a = DMatrix::zeros(edges.len(), vertices.len());
+    for (r, &e) in edges.iter().enumerate() {
+        let (t, h) = top.local_ends(e, vertices, c)?;
+        a[(r, t)] = -1.0;
+        a[(r, h)] = 1.0;
+    }
+    let pinv =
+        a.pseudo_inverse(PSEUDO_INVERSE_TOLERANCE)
+            .map_err(|_| MetricError::UnsupportedCell {
+                method,
+                needs: "a cell whose edge incidence has a pseudo-inverse",
+                cell: c,
+            })?;
+    let omega = pinv.transpose() * kc * &pinv;
+    let m = edges.len();
+    // Symmetric up to rounding; made exactly so.
+    let values: Vec<f64> = (0..m * m)
+        .map(|idx| {
+            let (i, j) = (idx / m, idx % m);
+            0.5 * (omega[(i, j)] + omega[(j, i)])
+        })
+        .collect();
+    if values.iter().any(|v| !v.is_finite()) {
+        return Err(MetricError::UnsupportedCell {
+            method,
+            needs: "a non-degenerate cell (finite local stiffness)",
+            cell: c,
+        });
+    }
+    Ok(Local::Dense { edges, values })
+}
+
+/// Sign (±1) of corner `l` along local axis `a`.
+fn corner_sign(l: usize, a: usize) -> f64 {
+    if (l >> a) & 1 == 1 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// Q1 shape functions and their reference gradients at ξ ∈ [−1, 1]^n.
+fn q1_shape(xi: &[f64], n: usize) -> (Vec<f64>, Vec<[f64; 3]>) {
+    let m = 1 << n;
+    let scale = 1.0 / m as f64;
+    let factor = |l: usize, b: usize| 1.0 + corner_sign(l, b) * xi[b];
+    let values = (0..m)
+        .map(|l| scale * (0..n).map(|b| factor(l, b)).product::<f64>())
+        .collect();
+    let gradients = (0..m)
+        .map(|l| {
+            let mut g = [0.0; 3];
+            for (a, ga) in g.iter_mut().enumerate().take(n) {
+                *ga = scale
+                    * corner_sign(l, a)
+                    * (0..n)
+                        .filter(|&b| b != a)
+                        .map(|b| factor(l, b))
+                        .product::<f64>();
+            }
+            g
+        })
+        .collect();
+    (values, gradients)
+}
+
+/// One Gauss point of a Q1 cell mapped to the physical cell.
+struct GaussPoint {
+    /// Reference weight (1) times |det J|.
+    weight: f64,
+    /// Shape functions, tensor order.
+    values: Vec<f64>,
+    /// Physical shape gradients, tensor order.
+    gradients: Vec<Point>,
+    point: Point,
+}
+
+/// Gauss points (2 per axis, weight 1 each on [−1, 1]^n) of a Q1 cell with
+/// corners `x` in tensor order.
+fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, MetricError> {
+    let g = 1.0 / 3f64.sqrt();
+    let bad = MetricError::UnsupportedCell {
+        method: "Q1",
+        needs: "a quadrilateral or hexahedron whose isoparametric map keeps one orientation (convex, not inverted)",
+        cell,
+    };
+    let mut out = Vec::with_capacity(1 << n);
+    let mut orientation = 0.0;
+    for q in 0..1usize << n {
+        let xi: Vec<f64> = (0..n).map(|a| g * corner_sign(q, a)).collect();
+        let (values, reference) = q1_shape(&xi, n);
+        let jacobian = DMatrix::<f64>::from_fn(n, n, |i, a| {
+            x.iter().zip(&reference).map(|(xl, gl)| xl[i] * gl[a]).sum()
+        });
+        let det = jacobian.determinant();
+        if det.is_nan() || det == 0.0 || det * orientation < 0.0 {
+            return Err(bad);
+        }
+        orientation = det.signum();
+        let inverse = jacobian.try_inverse().ok_or_else(|| bad.clone())?;
+        let gradients = reference
+            .iter()
+            .map(|r| {
+                let mut p = [0.0; 3];
+                for (i, pi) in p.iter_mut().enumerate().take(n) {
+                    *pi = (0..n).map(|a| inverse[(a, i)] * r[a]).sum();
+                }
+                p
+            })
+            .collect();
+        let mut point = [0.0; 3];
+        for (xl, &v) in x.iter().zip(&values) {
+            for i in 0..n {
+                point[i] += v * xl[i];
+            }
+        }
+        out.push(GaussPoint {
+            weight: det.abs(),
+            values,
+            gradients,
+            point,
+        });
+    }
+    Ok(out)
+}
+
+/// Corners of cell `c` in tensor order.
+fn tensor_points(top: &Topology, c: usize, order: &[usize]) -> Vec<Point> {
+    let vertices = top.complex.cell_vertices(top.n, c);
+    order.iter().map(|&o| top.point(vertices[o])).collect()
+}
+
+fn q1_stiffness(
+    top: &Topology,
+    c: usize,
+    order: &[usize],
+    k: &Tensor,
+) -> Result<DMatrix<f64>, MetricError> {
+    let n = top.n;
+    let m = order.len();
+    let mut kc = DMatrix::zeros(m, m);
+    for q in q1_points(&tensor_points(top, c, order), n, c)? {
+        for (l, gl) in q.gradients.iter().enumerate() {
+            for (j, gj) in q.gradients.iter().enumerate() {
+                kc[(order[l], order[j])] += q.weight * k_dot(gl, k, gj, n);
+            }
+        }
+    }
+    Ok(kc)
+}
+
+fn sub(a: &Point, b: &Point) -> Point {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: &Point, b: &Point) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: &Point, b: &Point) -> Point {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn average(points: impl ExactSizeIterator<Item = Point>) -> Point {
+    let count = points.len() as f64;
+    let mut sum = [0.0; 3];
+    for p in points {
+        for i in 0..3 {
+            sum[i] += p[i];
+        }
+    }
+    sum.map(|s| s / count)
+}
+
+/// ∫_∂c φ_i n for every vertex of a polygon (exact: φ_i is linear on each
+/// edge) and the polygon's area, both from the outward edge normals.
+fn polygon_moments(
+    top: &Topology,
+    c: usize,
+    x: &[Point],
+    centre: &Point,
+) -> Result<(Vec<Point>, f64), MetricError> {
+    let vertices = top.complex.cell_vertices(2, c);
+    let mut moments = vec![[0.0; 3]; x.len()];
+    let mut area = 0.0;
+    for e in top.edges_of(c) {
+        let (a, b) = top.local_ends(e, vertices, c)?;
+        let t = sub(&x[b], &x[a]);
+        let mid = [0.5 * (x[a][0] + x[b][0]), 0.5 * (x[a][1] + x[b][1]), 0.0];
+        let mut normal = [t[1], -t[0], 0.0];
+        if dot(&normal, &sub(&mid, centre)) < 0.0 {
+            normal = normal.map(|v| -v);
+        }
+        for i in [a, b] {
+            for (mi, ni) in moments[i].iter_mut().zip(&normal) {
+                *mi += 0.5 * ni;
+            }
+        }
+        area += 0.5 * dot(&sub(&mid, centre), &normal);
+    }
+    Ok((moments, area))
+}
+
+/// ∫_∂c φ_i n for every vertex of a polyhedron and its volume, over the
+/// faces split into fans of triangles about their vertex averages, with the
+/// vertex rule on each triangle (exact for functions linear on it).
+fn polyhedron_moments(
+    top: &Topology,
+    c: usize,
+    x: &[Point],
+    centre: &Point,
+) -> Result<(Vec<Point>, f64), MetricError> {
+    let vertices = top.complex.cell_vertices(3, c);
+    let mut moments = vec![[0.0; 3]; x.len()];
+    let mut volume = 0.0;
+    for &f in top.facets_of(3, c).0 {
+        let face: Vec<usize> = top
+            .complex
+            .cell_vertices(2, f)
+            .iter()
+            .map(|v| {
+                vertices
+                    .binary_search(v)
+                    .map_err(|_| MetricError::UnsupportedMesh {
+                        method: "VEM",
+                        needs: "cells whose faces use their own vertices",
+                        detail: format!("face {f} of top cell {c} has a vertex outside the cell"),
+                    })
+            })
+            .collect::<Result<_, _>>()?;
+        let apex = average(face.iter().map(|&i| x[i]));
+        // Fan triangles (apex, tail, head), all turning the face's way.
+        let (edges, signs) = top.facets_of(2, f);
+        let mut fan = Vec::with_capacity(edges.len());
+        let mut total = [0.0; 3];
+        for (&e, &s) in edges.iter().zip(signs) {
+            let (a, b) = top.local_ends(e, vertices, c)?;
+            let (t, h) = if s > 0 { (a, b) } else { (b, a) };
+            let area = cross(&sub(&x[t], &apex), &sub(&x[h], &apex)).map(|v| 0.5 * v);
+            for i in 0..3 {
+                total[i] += area[i];
+            }
+            fan.push((t, h, area));
+        }
+        let outward = match dot(&total, &sub(&apex, centre)) {
+            s if s > 0.0 => 1.0,
+            s if s < 0.0 => -1.0,
+            _ => {
+                return Err(MetricError::UnsupportedCell {
+                    method: "VEM",
+                    needs: "a convex polyhedron (a face is edge-on to the cell centre)",
+                    cell: c,
+                })
+            }
+        };
+        let share = 1.0 / (3 * face.len()) as f64;
+        for (t, h, area) in fan {
+            let area = area.map(|v| outward * v);
+            for i in 0..3 {
+                moments[t][i] += area[i] / 3.0;
+                moments[h][i] += area[i] / 3.0;
+                for &j in &face {
+                    moments[j][i] += area[i] * share;
+                }
+            }
+            let centroid = average([apex, x[t], x[h]].into_iter());
+            volume += dot(&sub(&centroid, centre), &area) / 3.0;
+        }
+    }
+    Ok((moments, volume))
+}
+
+fn vem_stiffness(top: &Topology, c: usize, k: &Tensor) -> Result<DMatrix<f64>, MetricError> {
+    let n = top.n;
+    let x = top.points(c);
+    let m = x.len();
+    let centre = average(x.iter().copied());
+    let (moments, measure) = if n == 2 {
+        polygon_moments(top, c, &x, &centre)?
+    } else {
+        polyhedron_moments(top, c, &x, &centre)?
+    };
+    if measure.is_nan() || measure <= 0.0 {
+        return Err(MetricError::UnsupportedCell {
+            method: "VEM",
+            needs: "a convex cell of positive measure",
+            cell: c,
+        });
+    }
+    // Π̃ (n × m): gradient of the projection, column i = ∫_∂c φ_i n / |c|.
+    let pit = DMatrix::from_fn(n, m, |a, i| moments[i][a] / measure);
+    let kn = DMatrix::from_fn(n, n, |a, b| k[a][b]);
+    let consistency = pit.transpose() * &kn * &pit * measure;
+    let offsets = DMatrix::from_fn(m, n, |i, a| x[i][a] - centre[a]);
+    let projection = DMatrix::from_element(m, m, 1.0 / m as f64) + &offsets * &pit;
+    let residual = DMatrix::identity(m, m) - projection;
+    let diameter = x
+        .iter()
+        .flat_map(|a| x.iter().map(move |b| dot(&sub(a, b), &sub(a, b))))
+        .fold(0.0f64, f64::max)
+        .sqrt();
+    let alpha = kn.trace() / n as f64 * diameter.powi(n as i32 - 2);
+    Ok(consistency + residual.transpose() * residual * alpha)
+}
+
+/// Barycentric quadrature on the n-simplex: (coordinates, weight / |c|).
+fn simplex_rule(n: usize) -> Vec<(Vec<f64>, f64)> {
+    match n {
+        1 => {
+            let s = 3f64.sqrt() / 6.0;
+            vec![(vec![0.5 + s, 0.5 - s], 0.5), (vec![0.5 - s, 0.5 + s], 0.5)]
+        }
+        2 => vec![
+            (vec![0.5, 0.5, 0.0], 1.0 / 3.0),
+            (vec![0.0, 0.5, 0.5], 1.0 / 3.0),
+            (vec![0.5, 0.0, 0.5], 1.0 / 3.0),
+        ],
+        _ => {
+            let root5 = 5f64.sqrt();
+            let (a, b) = ((5.0 + 3.0 * root5) / 20.0, (5.0 - root5) / 20.0);
+            (0..4)
+                .map(|k| ((0..4).map(|i| if i == k { a } else { b }).collect(), 0.25))
+                .collect()
+        }
+    }
+}
+
+fn evaluate(
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+    x: &Point,
+    d: usize,
+    cell: usize,
+) -> Result<f64, MetricError> {
+    let value = f(&x[..d]);
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(MetricError::NonFinite { cell })
+    }
+}
+
+fn cell_load(
+    top: &Topology,
+    c: usize,
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+) -> Result<Vec<(usize, f64)>, MetricError> {
+    let (n, d) = (top.n, top.d);
+    let vertices = top.complex.cell_vertices(n, c);
+    let mut out: Vec<(usize, f64)> = vertices.iter().map(|&v| (v, 0.0)).collect();
+    match top.element(c, Route::ByShape)? {
+        Element::P1 => {
+            let x = top.points(c);
+            let (measure, _) = simplex_gradients(&x, d).ok_or(MetricError::UnsupportedCell {
+                method: "P1",
+                needs: "a simplex of positive measure",
+                cell: c,
+            })?;
+            for (beta, w) in simplex_rule(n) {
+                let mut p = [0.0; 3];
+                for (xi, bi) in x.iter().zip(&beta) {
+                    for a in 0..3 {
+                        p[a] += bi * xi[a];
+                    }
+                }
+                let value = w * measure * evaluate(f, &p, d, c)?;
+                for (o, bi) in out.iter_mut().zip(&beta) {
+                    o.1 += value * bi;
+                }
+            }
+        }
+        Element::Q1(order) => {
+            for q in q1_points(&tensor_points(top, c, &order), n, c)? {
+                let value = q.weight * evaluate(f, &q.point, d, c)?;
+                for (l, v) in q.values.iter().enumerate() {
+                    out[order[l]].1 += value * v;
+                }
+            }
+        }
+        Element::Vem => {
+            let measure = top.complex.measure(n)[c];
+            let mut p = [0.0; 3];
+            p[..d].copy_from_slice(top.complex.centroid_of(n, c));
+            let share = measure * evaluate(f, &p, d, c)? / vertices.len() as f64;
+            for o in &mut out {
+                o.1 = share;
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metric::isotropic;
+    use hasse_complex::{TopCells, Vertices};
+
+    fn weights(complex: &Complex) -> Vec<f64> {
+        let cells = complex.cell_count(complex.dim());
+        let omega = stiffness_metric(complex, &vec![isotropic(1.0); cells]).unwrap();
+        let dense = omega.to_dense();
+        (0..omega.size()).map(|e| dense[e][e]).collect()
+    }
+
+    fn angle(apex: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+        let (u, v) = (
+            [a[0] - apex[0], a[1] - apex[1]],
+            [b[0] - apex[0], b[1] - apex[1]],
+        );
+        (u[0] * v[1] - u[1] * v[0])
+            .abs()
+            .atan2(u[0] * v[0] + u[1] * v[1])
+    }
+
+    #[test]
+    fn right_triangle_has_no_weight_on_the_hypotenuse() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [3.0, 0.0], [0.0, 2.0]]).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+        let w = weights(&k);
+        let hypotenuse = k.find_cell(1, &[1, 2]).unwrap();
+        assert!(w[hypotenuse].abs() < 1e-15);
+        // Leg {0,1} is opposite the angle at 2: cot = 2/3, weight 1/3.
+        assert!((w[k.find_cell(1, &[0, 1]).unwrap()] - 1.0 / 3.0).abs() < 1e-15);
+        assert!((w[k.find_cell(1, &[0, 2]).unwrap()] - 0.75).abs() < 1e-15);
+    }
+
+    #[test]
+    fn triangle_weights_are_half_cotangents() {
+        let p = [[0.1, -0.2], [2.3, 0.4], [0.7, 1.9]];
+        let v = Vertices::from_points(&p).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+        let w = weights(&k);
+        for (a, b, o) in [(0, 1, 2), (1, 2, 0), (0, 2, 1)] {
+            let e = k.find_cell(1, &[a, b]).unwrap();
+            let expected = 0.5 / angle(p[o], p[a], p[b]).tan();
+            assert!(
+                (w[e] - expected).abs() < 1e-14,
+                "{a}{b}: {} vs {expected}",
+                w[e]
+            );
+        }
+    }
+
+    #[test]
+    fn tetrahedron_weights_are_opposite_edge_cotangents() {
+        let p = [
+            [0.0, 0.0, 0.0],
+            [1.2, 0.1, -0.1],
+            [0.3, 0.9, 0.2],
+            [0.2, 0.3, 1.1],
+        ];
+        let v = Vertices::from_points(&p).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2, 3]])).unwrap();
+        let w = weights(&k);
+        let sub3 = |a: usize, b: usize| [p[a][0] - p[b][0], p[a][1] - p[b][1], p[a][2] - p[b][2]];
+        let cross3 = |u: [f64; 3], v: [f64; 3]| {
+            [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ]
+        };
+        let dot3 = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        for (a, b) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+            // Opposite edge {c, d}; the dihedral angle there is between the
+            // faces {c, d, a} and {c, d, b}.
+            let others: Vec<usize> = (0..4).filter(|&i| i != a && i != b).collect();
+            let (c, d) = (others[0], others[1]);
+            let axis = sub3(d, c);
+            let unit = dot3(axis, axis).sqrt();
+            let reject = |x: usize| {
+                let r = sub3(x, c);
+                let t = dot3(r, axis) / (unit * unit);
+                [r[0] - t * axis[0], r[1] - t * axis[1], r[2] - t * axis[2]]
+            };
+            let (ra, rb) = (reject(a), reject(b));
+            let phi = dot3(cross3(ra, rb), cross3(ra, rb))
+                .sqrt()
+                .atan2(dot3(ra, rb));
+            let expected = unit / phi.tan() / 6.0;
+            let e = k.find_cell(1, &[a, b]).unwrap();
+            assert!(
+                (w[e] - expected).abs() < 1e-14,
+                "{a}{b}: {} vs {expected}",
+                w[e]
+            );
+        }
+    }
+
+    #[test]
+    fn unit_square_q1_block_reproduces_the_element_matrix() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]).unwrap();
+        let k = Complex::build(v, TopCells::cuboids([[0, 1, 2, 3]])).unwrap();
+        let omega = stiffness_metric(&k, &[isotropic(1.0)]).unwrap();
+        assert_eq!(omega.block_count(), 1);
+        let op = crate::canonical::Canonical::new(k.coboundary(0), omega).unwrap();
+        let m = op.assemble().to_dense();
+        // 4/6 on the diagonal, −1/6 along edges, −2/6 across the diagonal.
+        for i in 0..4usize {
+            for j in 0..4usize {
+                let expected = match (i ^ j).count_ones() {
+                    0 => 4.0 / 6.0,
+                    1 => -1.0 / 6.0,
+                    _ => -2.0 / 6.0,
+                };
+                assert!((m[(i, j)] - expected).abs() < 1e-14, "({i},{j})");
+            }
+        }
+    }
+
+    #[test]
+    fn non_cube_octagon_falls_back_to_the_virtual_element() {
+        // Eight vertices in 2D are not a Q1 cell.
+        let p: Vec<[f64; 2]> = (0..8)
+            .map(|i| {
+                let t = std::f64::consts::PI * i as f64 / 4.0;
+                [t.cos(), t.sin()]
+            })
+            .collect();
+        let v = Vertices::from_points(&p).unwrap();
+        let k = Complex::build(v, TopCells::polygons([[0, 1, 2, 3, 4, 5, 6, 7]])).unwrap();
+        let top = Topology::new(&k, "test").unwrap();
+        assert!(matches!(top.element(0, Route::ByShape), Ok(Element::Vem)));
+    }
+
+    #[test]
+    fn bad_input_is_a_typed_error() {
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+        assert!(matches!(
+            stiffness_metric(&k, &[]),
+            Err(MetricError::CoefficientCount { count: 0, cells: 1 })
+        ));
+        assert!(matches!(
+            load(&k, &|x: &[f64]| 1.0 / (x[0] - x[0])),
+            Err(MetricError::NonFinite { cell: 0 })
+        ));
+    }
+}
