@@ -5,6 +5,7 @@
 //! case files and the `hasse` command line.
 
 pub mod canonical;
+pub mod diffusion;
 pub mod info;
 pub mod linear;
 pub mod mesh_spec;

@@ -1,0 +1,865 @@
+//! Scalar diffusion −∇·(K ∇u) = f in canonical form, with boundary
+//! conditions on tagged boundary regions.
+//!
+//! Every method is the same assembly M = Aᵀ Ω A with a different Ω and,
+//! for the hybrid mimetic method, a different A. Boundary conditions are
+//! written in the same language:
+//!
+//! - Dirichlet on a cell-centred method keeps the boundary face as a row of
+//!   A (a "ghost" at the face) and moves the known value to the right-hand
+//!   side, b += Aᵀ Ω w with w the signed boundary values; on nodal and
+//!   hybrid unknowns the fixed values are eliminated symmetrically (the
+//!   system on the free unknowns stays symmetric positive definite).
+//! - Neumann, K∇u·n = g with n the outward normal, adds ∫_F g to the
+//!   equation of the unknown(s) at the face and removes the face's ghost.
+//! - Robin, K∇u·n + α u = g, adds a row to A with one entry at the boundary
+//!   unknown (a ghost with value g/α), weighted by α|F| in Ω (lumped on
+//!   vertices for nodal methods); for cell-centred methods the ghost sits
+//!   behind the cell-to-face transmissibility σ, giving σα|F|/(σ + α|F|).
+//!
+//! Unlisted boundary faces are homogeneous Neumann (no flux). A problem
+//! without any Dirichlet or Robin boundary is singular: it is detected,
+//! the data are checked for compatibility (Σ sources + Σ boundary fluxes
+//! = 0 up to quadrature error), and the solution with zero mean is returned.
+
+use crate::canonical::{BlockMetric, Canonical, CanonicalError};
+use crate::linear::{self, Factorization, SolveError, SolveReport};
+use crate::metric::{self, dec, fd, fe, fv, MetricError, Tensor};
+use faer::sparse::{SparseColMat, Triplet};
+use hasse_complex::dual::DualKind;
+use hasse_complex::Complex;
+use sprs::{CsMat, TriMat};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// A scalar function of position.
+pub type ScalarFn = Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>;
+/// A tensor-valued function of position.
+pub type TensorFn = Arc<dyn Fn(&[f64]) -> Tensor + Send + Sync>;
+/// A vector-valued function of position (gradients of exact solutions).
+pub type VectorFn = Arc<dyn Fn(&[f64]) -> [f64; 3] + Send + Sync>;
+
+/// The diffusion coefficient K.
+#[derive(Clone)]
+pub enum Conductivity {
+    /// K = λ(x) I.
+    Scalar(ScalarFn),
+    /// A symmetric positive definite tensor field.
+    Tensor(TensorFn),
+}
+
+/// The discretisation: which Ω (and A) to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// Five/seven-point finite differences on cell centres of an axis-aligned grid.
+    Fd,
+    /// Nodal finite elements: P1 on simplices, Q1 on quads/hexes, lowest-order
+    /// virtual elements on other polytopes.
+    Fe,
+    /// Cell-centred finite volumes with the two-point flux.
+    Fv,
+    /// Hybrid mimetic finite differences (cell and face unknowns).
+    FvMimetic,
+    /// Discrete exterior calculus on vertices with the given dual.
+    Dec(DualKind),
+}
+
+impl Method {
+    /// The name used in case files and reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Fd => "fd",
+            Method::Fe => "fe",
+            Method::Fv => "fv",
+            Method::FvMimetic => "fv-mimetic",
+            Method::Dec(DualKind::Circumcentric) => "dec",
+            Method::Dec(DualKind::Barycentric) => "dec-barycentric",
+        }
+    }
+}
+
+/// Where the unknowns of a method live.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Location {
+    /// On vertices (0-cells).
+    Nodal,
+    /// On top cells.
+    CellCentred,
+    /// On top cells, then on (n−1)-cells.
+    Hybrid,
+}
+
+/// A boundary condition's kind and data.
+#[derive(Clone)]
+pub enum BoundaryKind {
+    /// u = g.
+    Dirichlet(ScalarFn),
+    /// K∇u·n = g (n outward).
+    Neumann(ScalarFn),
+    /// K∇u·n + α u = g, α > 0.
+    Robin { alpha: ScalarFn, value: ScalarFn },
+}
+
+/// A condition on the boundary faces carrying a tag.
+#[derive(Clone)]
+pub struct BoundaryCondition {
+    pub tag: String,
+    pub kind: BoundaryKind,
+}
+
+/// The problem −∇·(K ∇u) = f with boundary conditions.
+#[derive(Clone)]
+pub struct Diffusion {
+    pub method: Method,
+    pub conductivity: Conductivity,
+    pub source: ScalarFn,
+    /// Applied in order; a later condition on the same face replaces an earlier one.
+    pub boundary: Vec<BoundaryCondition>,
+    /// Direct factorisation (default: LLᵀ, the systems are SPD).
+    pub factorization: Factorization,
+    /// Largest relative imbalance Σ b / Σ |b| accepted for pure-Neumann data
+    /// (quadrature makes consistent data slightly incompatible).
+    pub neumann_tolerance: f64,
+}
+
+/// Why a problem could not be solved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DiffusionError {
+    #[error("boundary condition on tag '{tag}': no such tag in the mesh (tags: {available})")]
+    UnknownTag { tag: String, available: String },
+    #[error("boundary condition on tag '{tag}': it tags {dim}-cells, but boundary conditions need (n−1)-cells (n = {n})")]
+    TagDimension { tag: String, dim: usize, n: usize },
+    #[error("boundary condition on tag '{tag}': face {face} is not on the boundary")]
+    InteriorFace { tag: String, face: usize },
+    #[error("Robin coefficient α = {alpha} at face {face} (tag '{tag}') must be positive")]
+    RobinAlpha {
+        tag: String,
+        face: usize,
+        alpha: f64,
+    },
+    #[error("{what} is not finite at {location:?}")]
+    NonFinite {
+        what: &'static str,
+        location: Vec<f64>,
+    },
+    #[error("pure Neumann problem with incompatible data: sources plus boundary fluxes sum to {imbalance:e} (relative {relative:e}); they must balance (∫f + ∮g = 0)")]
+    IncompatibleNeumann { imbalance: f64, relative: f64 },
+    #[error("pure Neumann problem on a disconnected domain ({components} parts): give every part a Dirichlet or Robin boundary")]
+    Disconnected { components: usize },
+    #[error("the {method} method cannot impose {what}")]
+    Unsupported {
+        method: &'static str,
+        what: &'static str,
+    },
+    #[error(transparent)]
+    Metric(#[from] MetricError),
+    #[error(transparent)]
+    Canonical(#[from] CanonicalError),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+}
+
+/// The discrete solution and how it was obtained.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    pub method: Method,
+    pub location: Location,
+    /// All unknowns (fixed ones included), in the layout of `location`.
+    pub values: Vec<f64>,
+    /// The flux cochain Ω A u on the rows of A (edges for nodal methods,
+    /// (n−1)-cells for cell-centred ones, half-faces for the hybrid one).
+    pub flux: Vec<f64>,
+    pub report: SolveReport,
+    pub assembly_seconds: f64,
+    /// Whether the problem was pure Neumann (solution normalised to zero mean).
+    pub pure_neumann: bool,
+    /// Relative imbalance of pure-Neumann data removed before solving.
+    pub neumann_imbalance: f64,
+}
+
+impl Solution {
+    /// Number of unknowns.
+    pub fn unknowns(&self) -> usize {
+        self.values.len()
+    }
+
+    /// The primary field on its cells (top cells for hybrid).
+    pub fn field(&self, complex: &Complex) -> &[f64] {
+        match self.location {
+            Location::Hybrid => &self.values[..complex.cell_count(complex.dim())],
+            _ => &self.values,
+        }
+    }
+}
+
+/// Error figures against an exact solution.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Errors {
+    /// Discrete L² error of the primary field (lumped-mass weights on
+    /// vertices, cell volumes on cells).
+    pub l2: f64,
+    /// Largest pointwise error of the primary field.
+    pub max: f64,
+    /// Discrete L² error of the cell-wise reconstructed gradient.
+    pub gradient_l2: f64,
+}
+
+struct Faces {
+    /// Condition index applied to each boundary (n−1)-cell, if any.
+    condition: Vec<Option<usize>>,
+}
+
+fn evaluate(f: &ScalarFn, x: &[f64], what: &'static str) -> Result<f64, DiffusionError> {
+    let v = f(x);
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(DiffusionError::NonFinite {
+            what,
+            location: x.to_vec(),
+        })
+    }
+}
+
+impl Diffusion {
+    /// A problem with default solver settings.
+    pub fn new(method: Method, conductivity: Conductivity, source: ScalarFn) -> Self {
+        Self {
+            method,
+            conductivity,
+            source,
+            boundary: Vec::new(),
+            factorization: Factorization::Llt,
+            neumann_tolerance: 1e-2,
+        }
+    }
+
+    /// Add a boundary condition on a tag.
+    pub fn with_boundary(mut self, tag: &str, kind: BoundaryKind) -> Self {
+        self.boundary.push(BoundaryCondition {
+            tag: tag.to_string(),
+            kind,
+        });
+        self
+    }
+
+    /// Where this method's unknowns live.
+    pub fn location(&self) -> Location {
+        match self.method {
+            Method::Fe | Method::Dec(_) => Location::Nodal,
+            Method::Fd | Method::Fv => Location::CellCentred,
+            Method::FvMimetic => Location::Hybrid,
+        }
+    }
+
+    fn tensors(&self, complex: &Complex) -> Result<Vec<Tensor>, DiffusionError> {
+        let n = complex.dim();
+        let d = complex.embedding_dim();
+        let centroids = complex.centroid(n);
+        let tensors: Vec<Tensor> = (0..complex.cell_count(n))
+            .map(|c| {
+                let x = &centroids[c * d..(c + 1) * d];
+                match &self.conductivity {
+                    Conductivity::Scalar(f) => metric::isotropic(f(x)),
+                    Conductivity::Tensor(f) => f(x),
+                }
+            })
+            .collect();
+        metric::check_tensors(&tensors, complex.cell_count(n), d)?;
+        Ok(tensors)
+    }
+
+    fn boundary_faces(&self, complex: &Complex) -> Result<Faces, DiffusionError> {
+        let n = complex.dim();
+        let top = complex.boundary(n);
+        let mut condition = vec![None; complex.cell_count(n - 1)];
+        for (k, bc) in self.boundary.iter().enumerate() {
+            let tag = complex
+                .tag(&bc.tag)
+                .ok_or_else(|| DiffusionError::UnknownTag {
+                    tag: bc.tag.clone(),
+                    available: {
+                        let names: Vec<&str> = complex.tags().names().collect();
+                        if names.is_empty() {
+                            "none".into()
+                        } else {
+                            names.join(", ")
+                        }
+                    },
+                })?;
+            if tag.dim != n - 1 {
+                return Err(DiffusionError::TagDimension {
+                    tag: bc.tag.clone(),
+                    dim: tag.dim,
+                    n,
+                });
+            }
+            for &f in &tag.cells {
+                if top.outer_view(f).map_or(0, |r| r.nnz()) != 1 {
+                    return Err(DiffusionError::InteriorFace {
+                        tag: bc.tag.clone(),
+                        face: f,
+                    });
+                }
+                condition[f] = Some(k);
+            }
+        }
+        Ok(Faces { condition })
+    }
+
+    /// Assemble and solve on `complex`.
+    pub fn solve(&self, complex: &Complex) -> Result<Solution, DiffusionError> {
+        let started = Instant::now();
+        let n = complex.dim();
+        let d = complex.embedding_dim();
+        let tensors = self.tensors(complex)?;
+        let faces = self.boundary_faces(complex)?;
+        let location = self.location();
+        let cells = complex.cell_count(n);
+        let face_count = complex.cell_count(n - 1);
+        let face_area = complex.measure(n - 1);
+        let face_centre = complex.centroid(n - 1);
+        let x_face = |f: usize| &face_centre[f * d..(f + 1) * d];
+
+        let (incidence, metric, unknowns) = match self.method {
+            Method::Fe => (
+                complex.coboundary(0),
+                fe::stiffness_metric(complex, &tensors)?,
+                complex.cell_count(0),
+            ),
+            Method::Dec(kind) => (
+                complex.coboundary(0),
+                dec::hodge_metric(complex, kind, &tensors)?,
+                complex.cell_count(0),
+            ),
+            Method::Fv => (
+                complex.boundary(n).clone(),
+                fv::two_point(complex, &tensors)?,
+                cells,
+            ),
+            Method::Fd => (
+                complex.boundary(n).clone(),
+                fd::five_point(complex, &tensors)?,
+                cells,
+            ),
+            Method::FvMimetic => {
+                let (a, omega, layout) = fv::mimetic_hybrid(complex, &tensors)?;
+                (a, omega, layout.cells + layout.faces)
+            }
+        };
+        let flux_rows = incidence.rows();
+
+        let mut rhs = vec![0.0; unknowns];
+        let mut fixed: Vec<Option<f64>> = vec![None; unknowns];
+        // Ghost rows: (unknown, weight, ghost value) appended to A and Ω.
+        let mut ghosts: Vec<(usize, f64, f64)> = Vec::new();
+        // Cell-centred boundary faces whose own row changes weight or value.
+        let mut face_weight: Vec<Option<f64>> = vec![None; flux_rows];
+        let mut face_value = vec![0.0; flux_rows];
+
+        // Sources.
+        match self.method {
+            Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x))?,
+            Method::Dec(kind) => rhs = dec::load(complex, kind, &|x| (self.source)(x))?,
+            _ => {
+                let volume = complex.measure(n);
+                let centre = complex.centroid(n);
+                for c in 0..cells {
+                    rhs[c] +=
+                        evaluate(&self.source, &centre[c * d..(c + 1) * d], "source")? * volume[c];
+                }
+            }
+        }
+        if rhs.iter().any(|v| !v.is_finite()) {
+            return Err(DiffusionError::NonFinite {
+                what: "source",
+                location: vec![],
+            });
+        }
+
+        // Boundary conditions.
+        let top = complex.boundary(n);
+        let diagonal_of = |metric: &BlockMetric| -> Vec<Option<f64>> {
+            let mut diag = vec![None; flux_rows];
+            for b in 0..metric.block_count() {
+                let (r, s, w) = metric.block(b);
+                if r.len() == 1 && r == s {
+                    diag[r[0]] = Some(diag[r[0]].unwrap_or(0.0) + w[0]);
+                }
+            }
+            diag
+        };
+        let cell_diagonal = match location {
+            Location::CellCentred => diagonal_of(&metric),
+            _ => Vec::new(),
+        };
+        for f in 0..face_count {
+            let Some(k) = faces.condition[f] else {
+                continue;
+            };
+            let bc = &self.boundary[k];
+            let area = face_area[f];
+            let xf = x_face(f);
+            match location {
+                Location::Nodal => {
+                    let verts = complex.cell_vertices(n - 1, f);
+                    let share = area / verts.len() as f64;
+                    for &v in verts {
+                        let xv = complex.vertices().point(v);
+                        match &bc.kind {
+                            BoundaryKind::Dirichlet(g) => {
+                                fixed[v] = Some(evaluate(g, xv, "Dirichlet value")?)
+                            }
+                            BoundaryKind::Neumann(g) => {
+                                rhs[v] += evaluate(g, xv, "Neumann value")? * share
+                            }
+                            BoundaryKind::Robin { alpha, value } => {
+                                let a = evaluate(alpha, xv, "Robin α")?;
+                                if a <= 0.0 {
+                                    return Err(DiffusionError::RobinAlpha {
+                                        tag: bc.tag.clone(),
+                                        face: f,
+                                        alpha: a,
+                                    });
+                                }
+                                let g = evaluate(value, xv, "Robin value")?;
+                                ghosts.push((v, a * share, g / a));
+                            }
+                        }
+                    }
+                }
+                Location::Hybrid => {
+                    let u = cells + f;
+                    match &bc.kind {
+                        BoundaryKind::Dirichlet(g) => {
+                            fixed[u] = Some(evaluate(g, xf, "Dirichlet value")?)
+                        }
+                        BoundaryKind::Neumann(g) => {
+                            rhs[u] += evaluate(g, xf, "Neumann value")? * area
+                        }
+                        BoundaryKind::Robin { alpha, value } => {
+                            let a = evaluate(alpha, xf, "Robin α")?;
+                            if a <= 0.0 {
+                                return Err(DiffusionError::RobinAlpha {
+                                    tag: bc.tag.clone(),
+                                    face: f,
+                                    alpha: a,
+                                });
+                            }
+                            ghosts.push((u, a * area, evaluate(value, xf, "Robin value")? / a));
+                        }
+                    }
+                }
+                Location::CellCentred => {
+                    let (cell, sign) = top
+                        .outer_view(f)
+                        .and_then(|r| r.iter().next().map(|(c, &s)| (c, f64::from(s))))
+                        .ok_or(DiffusionError::InteriorFace {
+                            tag: bc.tag.clone(),
+                            face: f,
+                        })?;
+                    let sigma = cell_diagonal[f].ok_or(DiffusionError::Unsupported {
+                        method: self.method.name(),
+                        what: "boundary conditions with a non-diagonal boundary metric",
+                    })?;
+                    match &bc.kind {
+                        BoundaryKind::Dirichlet(g) => {
+                            face_value[f] = sign * evaluate(g, xf, "Dirichlet value")?
+                        }
+                        BoundaryKind::Neumann(g) => {
+                            face_weight[f] = Some(0.0);
+                            rhs[cell] += evaluate(g, xf, "Neumann value")? * area;
+                        }
+                        BoundaryKind::Robin { alpha, value } => {
+                            let a = evaluate(alpha, xf, "Robin α")?;
+                            if a <= 0.0 {
+                                return Err(DiffusionError::RobinAlpha {
+                                    tag: bc.tag.clone(),
+                                    face: f,
+                                    alpha: a,
+                                });
+                            }
+                            face_weight[f] = Some(sigma * a * area / (sigma + a * area));
+                            face_value[f] = sign * evaluate(value, xf, "Robin value")? / a;
+                        }
+                    }
+                }
+            }
+        }
+        if location == Location::CellCentred {
+            // Boundary faces without a condition are homogeneous Neumann.
+            for (f, weight) in face_weight.iter_mut().enumerate().take(face_count) {
+                if faces.condition[f].is_none() && top.outer_view(f).map_or(0, |r| r.nnz()) == 1 {
+                    *weight = Some(0.0);
+                }
+            }
+        }
+
+        // A and Ω with the boundary changes and the ghost rows.
+        let mut metric_final = BlockMetric::new(flux_rows + ghosts.len());
+        for b in 0..metric.block_count() {
+            let (r, s, w) = metric.block(b);
+            if r.len() == 1 && r == s {
+                if let Some(weight) = face_weight[r[0]] {
+                    // The row's whole diagonal is replaced once, by its first block.
+                    let first = (0..b).all(|e| metric.block(e).0 != r || metric.block(e).1 != s);
+                    metric_final.push_block(r, s, &[if first { weight } else { 0.0 }]);
+                    continue;
+                }
+            }
+            metric_final.push_block(r, s, w);
+        }
+        let mut ghost_values = face_value.clone();
+        let incidence = if ghosts.is_empty() {
+            incidence
+        } else {
+            let mut tri = TriMat::new((flux_rows + ghosts.len(), unknowns));
+            for (v, (i, j)) in incidence.iter() {
+                tri.add_triplet(i, j, *v);
+            }
+            for (k, &(u, weight, value)) in ghosts.iter().enumerate() {
+                tri.add_triplet(flux_rows + k, u, 1i8);
+                metric_final.push_block(&[flux_rows + k], &[flux_rows + k], &[weight]);
+                ghost_values.push(value);
+            }
+            tri.to_csr()
+        };
+        let canonical = Canonical::new(incidence, metric_final)?;
+        // b += Aᵀ Ω w for ghost values w (Dirichlet faces, Robin ghosts).
+        if ghost_values.iter().any(|&v| v != 0.0) {
+            let lifted = canonical.sum_transpose(&canonical.metric().apply(&ghost_values));
+            for (b, l) in rhs.iter_mut().zip(lifted) {
+                *b += l;
+            }
+        }
+        let matrix = canonical.assemble();
+        let pure_neumann = fixed.iter().all(Option::is_none)
+            && ghosts.is_empty()
+            && (location != Location::CellCentred
+                || (0..face_count).all(|f| {
+                    top.outer_view(f).map_or(0, |r| r.nnz()) != 1 || face_weight[f] == Some(0.0)
+                }));
+        let assembly_seconds = started.elapsed().as_secs_f64();
+
+        let mut neumann_imbalance = 0.0;
+        if pure_neumann {
+            let components = complex.betti_numbers_over(hasse_complex::Field::Z2)[0];
+            if components != 1 {
+                return Err(DiffusionError::Disconnected { components });
+            }
+            let total: f64 = rhs.iter().sum();
+            let scale: f64 = rhs.iter().map(|b| b.abs()).sum();
+            let relative = if scale > 0.0 {
+                total.abs() / scale
+            } else {
+                0.0
+            };
+            if relative > self.neumann_tolerance {
+                return Err(DiffusionError::IncompatibleNeumann {
+                    imbalance: total,
+                    relative,
+                });
+            }
+            neumann_imbalance = relative;
+            // Remove the quadrature imbalance in proportion to each unknown's
+            // weight, so the system is compatible.
+            let weights = self.mean_weights(complex, location, unknowns);
+            let wsum: f64 = weights.iter().sum();
+            for (b, w) in rhs.iter_mut().zip(&weights) {
+                *b -= total * w / wsum;
+            }
+            // Pin one unknown; the zero-mean shift is applied after the solve.
+            fixed[0] = Some(0.0);
+        }
+
+        let (mut values, report) = solve_with_fixed(&matrix, &rhs, &fixed, self.factorization)?;
+        if pure_neumann {
+            let weights = self.mean_weights(complex, location, unknowns);
+            let wsum: f64 = weights.iter().sum();
+            let mean: f64 = values.iter().zip(&weights).map(|(u, w)| u * w).sum::<f64>() / wsum;
+            for u in &mut values {
+                *u -= mean;
+            }
+        }
+        let flux_all = canonical.flux(&values);
+        let mut flux = flux_all[..flux_rows].to_vec();
+        // The ghost part of boundary fluxes: Ω(Au − w) on Dirichlet/Robin faces.
+        if location == Location::CellCentred {
+            let lifted = canonical.metric().apply(&ghost_values);
+            for (q, l) in flux.iter_mut().zip(lifted) {
+                *q -= l;
+            }
+        }
+        Ok(Solution {
+            method: self.method,
+            location,
+            values,
+            flux,
+            report,
+            assembly_seconds,
+            pure_neumann,
+            neumann_imbalance,
+        })
+    }
+
+    /// Weights of the zero-mean normalisation: cell volumes, or lumped
+    /// (barycentric dual) vertex volumes.
+    fn mean_weights(&self, complex: &Complex, location: Location, unknowns: usize) -> Vec<f64> {
+        let n = complex.dim();
+        match location {
+            Location::Nodal => lumped_vertex_volumes(complex),
+            Location::CellCentred => complex.measure(n).to_vec(),
+            Location::Hybrid => {
+                let mut w = complex.measure(n).to_vec();
+                w.resize(unknowns, 0.0);
+                w
+            }
+        }
+    }
+}
+
+/// |c|/(vertices of c) summed over the top cells around each vertex.
+pub fn lumped_vertex_volumes(complex: &Complex) -> Vec<f64> {
+    let n = complex.dim();
+    let volume = complex.measure(n);
+    let mut w = vec![0.0; complex.cell_count(0)];
+    for (c, &vol) in volume.iter().enumerate() {
+        let verts = complex.cell_vertices(n, c);
+        for &v in verts {
+            w[v] += vol / verts.len() as f64;
+        }
+    }
+    w
+}
+
+/// Solve M u = b with some unknowns fixed, by symmetric elimination:
+/// M_FF u_F = b_F − M_FD u_D.
+pub fn solve_with_fixed(
+    matrix: &SparseColMat<usize, f64>,
+    rhs: &[f64],
+    fixed: &[Option<f64>],
+    factorization: Factorization,
+) -> Result<(Vec<f64>, SolveReport), DiffusionError> {
+    let n = rhs.len();
+    let mut free_index = vec![usize::MAX; n];
+    let mut free = Vec::new();
+    for i in 0..n {
+        if fixed[i].is_none() {
+            free_index[i] = free.len();
+            free.push(i);
+        }
+    }
+    let mut reduced_rhs: Vec<f64> = free.iter().map(|&i| rhs[i]).collect();
+    let mut triplets = Vec::with_capacity(matrix.compute_nnz());
+    for j in 0..n {
+        let range = matrix.col_range(j);
+        let rows = &matrix.row_idx()[range.clone()];
+        let vals = &matrix.val()[range];
+        for (&i, &v) in rows.iter().zip(vals) {
+            match (free_index[i], fixed[j]) {
+                (fi, None) if fi != usize::MAX => {
+                    triplets.push(Triplet::new(fi, free_index[j], v));
+                }
+                (fi, Some(g)) if fi != usize::MAX => reduced_rhs[fi] -= v * g,
+                _ => {}
+            }
+        }
+    }
+    let mut values: Vec<f64> = fixed.iter().map(|g| g.unwrap_or(0.0)).collect();
+    if free.is_empty() {
+        let report = SolveReport {
+            factorization,
+            unknowns: 0,
+            nonzeros: 0,
+            symbolic_seconds: 0.0,
+            numeric_seconds: 0.0,
+            solve_seconds: 0.0,
+            relative_residual: 0.0,
+        };
+        return Ok((values, report));
+    }
+    let reduced = SparseColMat::try_new_from_triplets(free.len(), free.len(), &triplets)
+        .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
+    let (x, report) = linear::solve(&reduced, &reduced_rhs, factorization)?;
+    for (k, &i) in free.iter().enumerate() {
+        values[i] = x[k];
+    }
+    Ok((values, report))
+}
+
+/// Cell-wise gradient of a discrete field, by least squares over the
+/// points that carry values: the cell's vertices (nodal), the centroids of
+/// the neighbouring cells (cell-centred) or of the cell's faces (hybrid).
+/// Exact for linear fields (for cell-centred values wherever a cell has at
+/// least d neighbours in general position).
+pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64; 3]> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let cells = complex.cell_count(n);
+    let centre = complex.centroid(n);
+    let face_centre = complex.centroid(n - 1);
+    let by_cell = complex.boundary_csc(n);
+    let top = complex.boundary(n);
+    (0..cells)
+        .map(|c| {
+            let mut points: Vec<(Vec<f64>, f64)> = Vec::new();
+            let xc = &centre[c * d..(c + 1) * d];
+            match solution.location {
+                Location::Nodal => {
+                    for &v in complex.cell_vertices(n, c) {
+                        points.push((complex.vertices().point(v).to_vec(), solution.values[v]));
+                    }
+                }
+                Location::Hybrid => {
+                    if let Some(col) = by_cell.outer_view(c) {
+                        for (f, _) in col.iter() {
+                            points.push((
+                                face_centre[f * d..(f + 1) * d].to_vec(),
+                                solution.values[cells + f],
+                            ));
+                        }
+                    }
+                }
+                Location::CellCentred => {
+                    points.push((xc.to_vec(), solution.values[c]));
+                    if let Some(col) = by_cell.outer_view(c) {
+                        for (f, _) in col.iter() {
+                            if let Some(row) = top.outer_view(f) {
+                                for (other, _) in row.iter() {
+                                    if other != c {
+                                        points.push((
+                                            centre[other * d..(other + 1) * d].to_vec(),
+                                            solution.values[other],
+                                        ));
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            least_squares_gradient(&points, d)
+        })
+        .collect()
+}
+
+fn least_squares_gradient(points: &[(Vec<f64>, f64)], d: usize) -> [f64; 3] {
+    let m = points.len() as f64;
+    let mut mean_x = vec![0.0; d];
+    let mut mean_u = 0.0;
+    for (x, u) in points {
+        for a in 0..d {
+            mean_x[a] += x[a] / m;
+        }
+        mean_u += u / m;
+    }
+    let mut normal = nalgebra::DMatrix::<f64>::zeros(d, d);
+    let mut right = nalgebra::DVector::<f64>::zeros(d);
+    for (x, u) in points {
+        for a in 0..d {
+            for b in 0..d {
+                normal[(a, b)] += (x[a] - mean_x[a]) * (x[b] - mean_x[b]);
+            }
+            right[a] += (x[a] - mean_x[a]) * (u - mean_u);
+        }
+    }
+    let mut g = [0.0; 3];
+    // A rank-deficient fit (too few points, e.g. on an embedded surface)
+    // falls back to the minimum-norm solution.
+    let solution = normal
+        .clone()
+        .pseudo_inverse(1e-14 * normal.norm().max(f64::MIN_POSITIVE))
+        .map(|p| p * right)
+        .unwrap_or_else(|_| nalgebra::DVector::zeros(d));
+    for a in 0..d {
+        g[a] = solution[a];
+    }
+    g
+}
+
+/// Errors of `solution` against the exact field `u` (and its gradient, if
+/// given). For pure-Neumann problems the mean of the difference is removed
+/// first (the solution is only defined up to a constant).
+pub fn errors(
+    complex: &Complex,
+    solution: &Solution,
+    exact: &ScalarFn,
+    exact_gradient: Option<&VectorFn>,
+) -> Errors {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let (points, weights): (Vec<Vec<f64>>, Vec<f64>) = match solution.location {
+        Location::Nodal => (
+            (0..complex.cell_count(0))
+                .map(|v| complex.vertices().point(v).to_vec())
+                .collect(),
+            lumped_vertex_volumes(complex),
+        ),
+        _ => (
+            complex.centroid(n).chunks(d).map(<[f64]>::to_vec).collect(),
+            complex.measure(n).to_vec(),
+        ),
+    };
+    let field = solution.field(complex);
+    let mut diff: Vec<f64> = points
+        .iter()
+        .zip(field)
+        .map(|(x, u)| u - exact(x))
+        .collect();
+    if solution.pure_neumann {
+        let wsum: f64 = weights.iter().sum();
+        let mean: f64 = diff.iter().zip(&weights).map(|(e, w)| e * w).sum::<f64>() / wsum;
+        for e in &mut diff {
+            *e -= mean;
+        }
+    }
+    let l2 = diff
+        .iter()
+        .zip(&weights)
+        .map(|(e, w)| e * e * w)
+        .sum::<f64>()
+        .sqrt();
+    let max = diff.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    let gradient_l2 = exact_gradient.map_or(f64::NAN, |grad| {
+        let g = reconstruct_gradient(complex, solution);
+        let volume = complex.measure(n);
+        let centre = complex.centroid(n);
+        (0..complex.cell_count(n))
+            .map(|c| {
+                let e = grad(&centre[c * d..(c + 1) * d]);
+                let s: f64 = (0..d).map(|a| (g[c][a] - e[a]).powi(2)).sum();
+                s * volume[c]
+            })
+            .sum::<f64>()
+            .sqrt()
+    });
+    Errors {
+        l2,
+        max,
+        gradient_l2,
+    }
+}
+
+/// Per-cell conservation residual of cell-centred fluxes: for every top
+/// cell, Σ_F ∂(F,c) q_F − ∫_c f (zero to rounding for FV/FD).
+pub fn conservation_residual(
+    complex: &Complex,
+    solution: &Solution,
+    source: &ScalarFn,
+) -> Vec<f64> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let volume = complex.measure(n);
+    let centre = complex.centroid(n);
+    let by_cell: CsMat<i8> = complex.boundary_csc(n);
+    (0..complex.cell_count(n))
+        .map(|c| {
+            let out: f64 = by_cell.outer_view(c).map_or(0.0, |col| {
+                col.iter()
+                    .map(|(f, &s)| f64::from(s) * solution.flux[f])
+                    .sum()
+            });
+            out - source(&centre[c * d..(c + 1) * d]) * volume[c]
+        })
+        .collect()
+}
