@@ -434,6 +434,18 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
         cell,
         vertices: verts.to_vec(),
     };
+    // Frames of the upper cells are needed by every facet of a non-simplex
+    // cell: compute them once per cell (a hex is met by six faces). Facet
+    // frames are computed once per row, so they are never stored.
+    let upper_frames: Option<Vec<Option<frame::Frame>>> = (0..lar.cell_count(p))
+        .into_par_iter()
+        .any(|j| lar.cell_vertices(p, j).len() != p + 1)
+        .then(|| {
+            (0..lar.cell_count(p))
+                .into_par_iter()
+                .map(|j| frame::frame(vertices, lar.cell_vertices(p, j), p))
+                .collect()
+        });
     let row_signs = |i: usize, out: &mut Vec<i8>| -> Result<()> {
         let facet = lar.cell_vertices(p - 1, i);
         let mut facet_frame = None;
@@ -454,8 +466,10 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
                         .ok_or_else(|| degenerate(p - 1, i, facet))?,
                 );
             }
-            let cell_frame =
-                frame::frame(vertices, cell, p).ok_or_else(|| degenerate(p, j, cell))?;
+            let cell_frame = upper_frames
+                .as_ref()
+                .and_then(|frames| frames[j])
+                .ok_or_else(|| degenerate(p, j, cell))?;
             let sign = facet_frame
                 .as_ref()
                 .and_then(|f| frame::induced_sign(&cell_frame, f, cell_frame.diameter))
