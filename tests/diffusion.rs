@@ -9,8 +9,8 @@
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
 use hasse_solver::diffusion::{
-    conservation_residual, errors, BoundaryKind, Conductivity, Diffusion, DiffusionError, Method,
-    ScalarFn, VectorFn,
+    conservation_residual, errors, flux_error, BoundaryKind, Conductivity, Diffusion,
+    DiffusionError, Method, ScalarFn, VectorFn,
 };
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -73,6 +73,7 @@ struct Study {
     h: Vec<f64>,
     l2: Vec<f64>,
     gradient: Vec<f64>,
+    flux: Vec<f64>,
 }
 
 fn study(
@@ -85,6 +86,7 @@ fn study(
         h: vec![],
         l2: vec![],
         gradient: vec![],
+        flux: vec![],
     };
     for mesh in meshes {
         let solution = problem.solve(&mesh).unwrap();
@@ -93,6 +95,9 @@ fn study(
         s.h.push(mesh.mesh_size());
         s.l2.push(e.l2);
         s.gradient.push(e.gradient_l2);
+        if let Some(q) = flux_error(&mesh, &solution, problem, gradient) {
+            s.flux.push(q);
+        }
     }
     s
 }
@@ -155,6 +160,14 @@ fn second_order_in_2d_for_every_method() {
         let (problem, exact, gradient) = square_problem(method);
         let s = study(meshes, &problem, &exact, &gradient);
         assert_order(name, &s, 2.0, Some(1.0));
+        if !s.flux.is_empty() {
+            let observed = order(&s.h, &s.flux);
+            assert!(
+                observed >= 0.85,
+                "{name}: flux order {observed:.3} (errors {:?})",
+                s.flux
+            );
+        }
     }
 }
 
