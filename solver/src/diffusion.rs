@@ -417,49 +417,20 @@ impl Diffusion {
                     let share = area / verts.len() as f64;
                     for &v in verts {
                         let xv = complex.vertices().point(v);
-                        match &bc.kind {
-                            BoundaryKind::Dirichlet(g) => {
-                                fixed[v] = Some(evaluate(g, xv, "Dirichlet value")?)
-                            }
-                            BoundaryKind::Neumann(g) => {
-                                rhs[v] += evaluate(g, xv, "Neumann value")? * share
-                            }
-                            BoundaryKind::Robin { alpha, value } => {
-                                let a = evaluate(alpha, xv, "Robin α")?;
-                                if a <= 0.0 {
-                                    return Err(DiffusionError::RobinAlpha {
-                                        tag: bc.tag.clone(),
-                                        face: f,
-                                        alpha: a,
-                                    });
-                                }
-                                let g = evaluate(value, xv, "Robin value")?;
-                                ghosts.push((v, a * share, g / a));
-                            }
-                        }
+                        apply_at_unknown(bc, f, v, xv, share, &mut fixed, &mut rhs, &mut ghosts)?;
                     }
                 }
                 Location::Hybrid => {
-                    let u = cells + f;
-                    match &bc.kind {
-                        BoundaryKind::Dirichlet(g) => {
-                            fixed[u] = Some(evaluate(g, xf, "Dirichlet value")?)
-                        }
-                        BoundaryKind::Neumann(g) => {
-                            rhs[u] += evaluate(g, xf, "Neumann value")? * area
-                        }
-                        BoundaryKind::Robin { alpha, value } => {
-                            let a = evaluate(alpha, xf, "Robin α")?;
-                            if a <= 0.0 {
-                                return Err(DiffusionError::RobinAlpha {
-                                    tag: bc.tag.clone(),
-                                    face: f,
-                                    alpha: a,
-                                });
-                            }
-                            ghosts.push((u, a * area, evaluate(value, xf, "Robin value")? / a));
-                        }
-                    }
+                    apply_at_unknown(
+                        bc,
+                        f,
+                        cells + f,
+                        xf,
+                        area,
+                        &mut fixed,
+                        &mut rhs,
+                        &mut ghosts,
+                    )?;
                 }
                 Location::CellCentred => {
                     let (cell, sign) = top
@@ -482,14 +453,7 @@ impl Diffusion {
                             rhs[cell] += evaluate(g, xf, "Neumann value")? * area;
                         }
                         BoundaryKind::Robin { alpha, value } => {
-                            let a = evaluate(alpha, xf, "Robin α")?;
-                            if a <= 0.0 {
-                                return Err(DiffusionError::RobinAlpha {
-                                    tag: bc.tag.clone(),
-                                    face: f,
-                                    alpha: a,
-                                });
-                            }
+                            let a = robin_alpha(bc, f, alpha, xf)?;
                             face_weight[f] = Some(sigma * a * area / (sigma + a * area));
                             face_value[f] = sign * evaluate(value, xf, "Robin value")? / a;
                         }
@@ -627,6 +591,49 @@ impl Diffusion {
             }
         }
     }
+}
+
+/// α of a Robin condition at a point, which must be positive.
+fn robin_alpha(
+    bc: &BoundaryCondition,
+    face: usize,
+    alpha: &ScalarFn,
+    x: &[f64],
+) -> Result<f64, DiffusionError> {
+    let a = evaluate(alpha, x, "Robin α")?;
+    if a <= 0.0 {
+        return Err(DiffusionError::RobinAlpha {
+            tag: bc.tag.clone(),
+            face,
+            alpha: a,
+        });
+    }
+    Ok(a)
+}
+
+/// A boundary condition at one unknown of a nodal or hybrid method, with
+/// `weight` the part of the face it stands for: Dirichlet fixes it, Neumann
+/// adds ∫g, Robin adds a ghost row of weight α·weight and value g/α.
+#[allow(clippy::too_many_arguments)]
+fn apply_at_unknown(
+    bc: &BoundaryCondition,
+    face: usize,
+    unknown: usize,
+    x: &[f64],
+    weight: f64,
+    fixed: &mut [Option<f64>],
+    rhs: &mut [f64],
+    ghosts: &mut Vec<(usize, f64, f64)>,
+) -> Result<(), DiffusionError> {
+    match &bc.kind {
+        BoundaryKind::Dirichlet(g) => fixed[unknown] = Some(evaluate(g, x, "Dirichlet value")?),
+        BoundaryKind::Neumann(g) => rhs[unknown] += evaluate(g, x, "Neumann value")? * weight,
+        BoundaryKind::Robin { alpha, value } => {
+            let a = robin_alpha(bc, face, alpha, x)?;
+            ghosts.push((unknown, a * weight, evaluate(value, x, "Robin value")? / a));
+        }
+    }
+    Ok(())
 }
 
 /// |c|/(vertices of c) summed over the top cells around each vertex.
