@@ -194,9 +194,10 @@ impl Complex {
         Ok(&self.boundaries[p - 1])
     }
 
-    /// ∂_p in CSC storage, for column (cell → facets) access.
-    pub fn boundary_csc(&self, p: usize) -> CsMat<i8> {
-        self.boundary(p).to_csc()
+    /// ∂_p in CSC storage, for column (cell → facets) access; built on
+    /// first use and kept.
+    pub fn boundary_csc(&self, p: usize) -> &CsMat<i8> {
+        self.geometry.facets[p].get_or_init(|| self.boundary(p).to_csc())
     }
 
     /// The coboundary δ^p = ∂_{p+1}ᵀ (|K_{p+1}| × |K_p|, CSR), 0 ≤ p < n.
@@ -553,11 +554,7 @@ fn orient_top_cells(lar: &Lar, top: &CsMat<i8>, ambient: Vec<i8>) -> Result<Vec<
                 }
             }
         }
-        if closed
-            && n == 2
-            && d == 3
-            && enclosed_volume(lar, top, &by_cell, &flags, &component) < 0.0
-        {
+        if closed && n == 2 && d == 3 && enclosed_volume(lar, &by_cell, &flags, &component) < 0.0 {
             for &c in &component {
                 flags[c] = -flags[c];
             }
@@ -568,14 +565,7 @@ fn orient_top_cells(lar: &Lar, top: &CsMat<i8>, ambient: Vec<i8>) -> Result<Vec<
 
 /// Signed volume enclosed by a closed oriented surface component:
 /// (1/6) Σ_cells Σ_{oriented boundary edges a→b} det[x_c, x_a, x_b].
-fn enclosed_volume(
-    lar: &Lar,
-    top: &CsMat<i8>,
-    by_cell: &CsMat<i8>,
-    flags: &[i8],
-    component: &[usize],
-) -> f64 {
-    let _ = top;
+fn enclosed_volume(lar: &Lar, by_cell: &CsMat<i8>, flags: &[i8], component: &[usize]) -> f64 {
     let vertices = lar.vertices();
     let mut volume = 0.0;
     for &c in component {

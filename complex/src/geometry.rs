@@ -43,7 +43,7 @@ const LEVELS: usize = 4;
 #[derive(Clone, Debug, Default)]
 pub(crate) struct GeometryCache {
     /// ∂_p in CSC storage (index p ≥ 1): the facets of each p-cell.
-    facets: [OnceLock<CsMat<i8>>; LEVELS],
+    pub(crate) facets: [OnceLock<CsMat<i8>>; LEVELS],
     /// Measures and centroids of the p-cells.
     cells: [OnceLock<CellGeometry>; LEVELS],
     /// Unit normals of the (n−1)-cells.
@@ -190,11 +190,6 @@ impl Complex {
                 .reduce(|| 0.0, f64::max);
             largest_squared.sqrt()
         })
-    }
-
-    /// ∂_p in CSC storage, cached: column j lists the facets of p-cell j.
-    pub(crate) fn facets_csc(&self, p: usize) -> &CsMat<i8> {
-        self.geometry.facets[p].get_or_init(|| self.boundary_csc(p))
     }
 
     fn cell_geometry(&self, p: usize) -> Option<&CellGeometry> {
@@ -351,7 +346,7 @@ impl<'a> Mesh<'a> {
     /// Fan of triangles (apex, v₀, v₁) over the edges of a 2-cell, apex the
     /// vertex average (every vertex of the cycle ends two edges).
     fn polygon(&self, f: usize) -> (f64, Point) {
-        let (edges, _) = column(self.complex.facets_csc(2), f);
+        let (edges, _) = column(self.complex.boundary_csc(2), f);
         let Some(&first) = edges.first() else {
             return (0.0, [0.0; 3]);
         };
@@ -391,8 +386,8 @@ impl<'a> Mesh<'a> {
     /// loads. Per face, with primes relative to o and C = r (v₀′ × v₁′):
     /// 6 vol = s a_f′·ΣC and 24 moment = s [a_f′ (a_f′·ΣC) + Σ (v₀′ + v₁′)(C·a_f′)].
     fn polyhedron(&self, c: usize) -> (f64, Point) {
-        let (faces, face_signs) = column(self.complex.facets_csc(3), c);
-        let edge_csc = self.complex.facets_csc(2);
+        let (faces, face_signs) = column(self.complex.boundary_csc(3), c);
+        let edge_csc = self.complex.boundary_csc(2);
         let Some(&first_face) = faces.first() else {
             return (0.0, [0.0; 3]);
         };
@@ -438,7 +433,7 @@ impl<'a> Mesh<'a> {
     /// Vector area of 2-cell `f` in its own orientation: ½ Σ r (v₀ − o) × (v₁ − o)
     /// over its edges with their ∂₂ signs, for any o.
     fn vector_area(&self, f: usize) -> Point {
-        let (edges, signs) = column(self.complex.facets_csc(2), f);
+        let (edges, signs) = column(self.complex.boundary_csc(2), f);
         let Some(&first) = edges.first() else {
             return [0.0; 3];
         };

@@ -28,7 +28,7 @@ use crate::metric::{self, dec, fd, fe, fv, MetricError, Tensor};
 use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::dual::DualKind;
 use hasse_complex::Complex;
-use sprs::{CsMat, TriMat};
+use sprs::TriMat;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -949,7 +949,7 @@ pub fn conservation_residual(
     let d = complex.embedding_dim();
     let volume = complex.measure(n);
     let centre = complex.centroid(n);
-    let by_cell: CsMat<i8> = complex.boundary_csc(n);
+    let by_cell = complex.boundary_csc(n);
     (0..complex.cell_count(n))
         .map(|c| {
             let out: f64 = by_cell.outer_view(c).map_or(0.0, |col| {

@@ -238,7 +238,7 @@ pub(crate) struct Topology<'a> {
     /// δ⁰ (rows: edges), to read each edge's tail (−1) and head (+1).
     delta0: CsMat<i8>,
     /// ∂_p in CSC storage for p = 2..=n, at index p − 2.
-    facets: Vec<CsMat<i8>>,
+    facets: Vec<&'a CsMat<i8>>,
 }
 
 impl<'a> Topology<'a> {
