@@ -5,8 +5,10 @@
 //! case files and the `hasse` command line.
 
 pub mod canonical;
+pub mod case;
 pub mod diffusion;
 pub mod info;
 pub mod linear;
 pub mod mesh_spec;
 pub mod metric;
+pub mod run;

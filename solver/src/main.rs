@@ -1,7 +1,9 @@
 //! The `hasse` command line.
 
 use clap::{Parser, Subcommand};
-use hasse_solver::{info, mesh_spec};
+use hasse_solver::case::{Case, CaseError};
+use hasse_solver::{info, mesh_spec, run};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -15,6 +17,47 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Solve a case file and write its results (HDF5 + XDMF).
+    ///
+    /// Prints a summary: mesh, unknowns, method, solver, residual, errors
+    /// against the exact solution when the case gives one, and timings.
+    /// Exit code 0 on success, 1 when the solve fails, 2 for bad input.
+    ///
+    /// Examples:
+    ///   hasse run cases/poisson-square.toml
+    ///   hasse run cases/poisson-square.toml --set problem.method=fv --set mesh.n=[64,64] -o out/fv
+    Run {
+        /// The case file (.toml).
+        case: PathBuf,
+        /// Output stem: writes OUT.h5 and OUT.xdmf (default: [output] of the
+        /// case, else the case file's name in the current directory).
+        #[arg(short, long, value_name = "OUT")]
+        output: Option<PathBuf>,
+        /// Override a case key, e.g. --set problem.method=fv (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Print only errors.
+        #[arg(short, long, conflicts_with = "verbose")]
+        quiet: bool,
+        /// Print each phase as it starts.
+        #[arg(short, long)]
+        verbose: bool,
+    },
+    /// Check a case file without solving: report every problem at once.
+    ///
+    /// Reports unknown or misspelt keys (with a suggestion), wrong types,
+    /// missing files, expressions that do not parse or use unknown names,
+    /// and boundary tags that the mesh does not have, each with file, line
+    /// and column. Exit code 0 when the case is valid, 2 otherwise.
+    ///
+    /// Example: hasse check cases/l-shape.toml
+    Check {
+        /// The case file (.toml).
+        case: PathBuf,
+        /// Override a case key, as for `run`.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Report on a mesh: cell counts per dimension, Euler characteristic,
     /// Betti numbers, boundary regions (tags) and cell quality.
     ///
@@ -37,6 +80,8 @@ enum Command {
 
 /// Exit code for bad input (case file, mesh file, parameters).
 const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code for a failed or untrustworthy solve.
+const EXIT_SOLVE_FAILED: u8 = 1;
 
 fn load_timed(path: &Path, timing: bool) -> Result<hasse_complex::Complex, mesh_spec::MeshError> {
     let started = std::time::Instant::now();
@@ -61,6 +106,14 @@ fn load(path: &Path) -> Result<hasse_complex::Complex, mesh_spec::MeshError> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Run {
+            case,
+            output,
+            set,
+            quiet,
+            verbose,
+        } => run_case(&case, output.as_deref(), &set, quiet, verbose),
+        Command::Check { case, set } => check_case(&case, &set),
         Command::Info {
             mesh,
             betti,
@@ -85,4 +138,179 @@ fn main() -> ExitCode {
             }
         },
     }
+}
+
+fn read_case(path: &Path, set: &[String]) -> Result<Case, ExitCode> {
+    Case::read(path, set).map_err(|e| {
+        match e {
+            CaseError::Invalid(diagnostics) => eprintln!("{diagnostics}"),
+            other => eprintln!("error: {other}"),
+        }
+        ExitCode::from(EXIT_BAD_INPUT)
+    })
+}
+
+fn check_case(path: &Path, set: &[String]) -> ExitCode {
+    let case = match Case::read(path, set) {
+        Ok(case) => case,
+        Err(CaseError::Invalid(diagnostics)) => {
+            eprintln!("{diagnostics}");
+            eprintln!(
+                "{}: {} problem{} found",
+                path.display(),
+                diagnostics.len(),
+                if diagnostics.len() == 1 { "" } else { "s" }
+            );
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+        Err(other) => {
+            eprintln!("error: {other}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    match case.build_mesh() {
+        Ok(complex) => {
+            println!(
+                "{}: ok ({}, mesh cells per dimension {:?})",
+                path.display(),
+                describe_problem(&case),
+                complex.cell_counts()
+            );
+            ExitCode::SUCCESS
+        }
+        Err(diagnostics) => {
+            eprintln!("{diagnostics}");
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
+    }
+}
+
+fn describe_problem(case: &Case) -> String {
+    match case.method() {
+        Some(m) => format!("diffusion, method {}", m.name()),
+        None => "gradient".to_string(),
+    }
+}
+
+/// Progress on stderr: a spinner on a terminal, plain lines with -v
+/// otherwise, nothing with -q.
+struct Progress {
+    spinner: Option<indicatif::ProgressBar>,
+    verbose: bool,
+    started: std::time::Instant,
+}
+
+impl Progress {
+    fn new(quiet: bool, verbose: bool) -> Self {
+        let spinner = (!quiet && std::io::stderr().is_terminal()).then(|| {
+            let bar = indicatif::ProgressBar::new_spinner();
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            bar
+        });
+        Self {
+            spinner,
+            verbose: verbose && !quiet,
+            started: std::time::Instant::now(),
+        }
+    }
+
+    fn phase(&self, name: &str) {
+        if let Some(bar) = &self.spinner {
+            bar.set_message(name.to_string());
+        } else if self.verbose {
+            eprintln!("[{:8.3} s] {name}", self.started.elapsed().as_secs_f64());
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.spinner {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+fn run_case(
+    path: &Path,
+    output: Option<&Path>,
+    set: &[String],
+    quiet: bool,
+    verbose: bool,
+) -> ExitCode {
+    let case = match read_case(path, set) {
+        Ok(case) => case,
+        Err(code) => return code,
+    };
+    let progress = Progress::new(quiet, verbose);
+    progress.phase("building the mesh");
+    let mesh_started = std::time::Instant::now();
+    let complex = match case.build_mesh() {
+        Ok(complex) => complex,
+        Err(diagnostics) => {
+            progress.finish();
+            eprintln!("{diagnostics}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let mesh_seconds = mesh_started.elapsed().as_secs_f64();
+    let result = run::solve(&case, &complex, &mut |name| progress.phase(name));
+    let mut result = match result {
+        Ok(result) => result,
+        Err(e) => {
+            progress.finish();
+            eprintln!("error: {}: {e}", path.display());
+            eprintln!("no output written");
+            return ExitCode::from(if e.is_input() {
+                EXIT_BAD_INPUT
+            } else {
+                EXIT_SOLVE_FAILED
+            });
+        }
+    };
+    result.timings.insert(0, ("mesh".into(), mesh_seconds));
+    let written = if case.output.write || output.is_some() {
+        progress.phase("writing output");
+        let stem = output
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| case.output.directory.join(&case.output.name));
+        match run::write_output(&case, &complex, &result, &stem) {
+            Ok(files) => Some(files),
+            Err(e) => {
+                progress.finish();
+                eprintln!("error: writing output: {e}");
+                eprintln!("no output written");
+                return ExitCode::from(EXIT_SOLVE_FAILED);
+            }
+        }
+    } else {
+        None
+    };
+    progress.finish();
+    if !quiet {
+        println!("case       {}", path.display());
+        if let Some(title) = &case.title {
+            println!("title      {title}");
+        }
+        println!(
+            "mesh       {} (cells per dimension {:?})",
+            complex_kind(&complex),
+            complex.cell_counts()
+        );
+        print!("{result}");
+        if let Some(files) = written {
+            println!("output     {}, {}", files.hdf5.display(), files.xdmf.display());
+        }
+    } else {
+        for w in &result.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+fn complex_kind(complex: &hasse_complex::Complex) -> String {
+    format!(
+        "{}-dimensional in R^{}",
+        complex.dim(),
+        complex.embedding_dim()
+    )
 }

@@ -1,0 +1,156 @@
+//! Problems found in a case file, each with the file, line, column and key
+//! it concerns, and a hint on how to fix it.
+
+use std::fmt;
+use std::ops::Range;
+
+/// One problem in a case file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Diagnostic {
+    /// The case file (as given on the command line).
+    pub file: String,
+    /// 1-based line, 0 when the problem concerns the file as a whole.
+    pub line: usize,
+    /// 1-based column (in characters).
+    pub column: usize,
+    /// The dotted key, e.g. `boundary[1].value`; empty for file-level problems.
+    pub key: String,
+    pub message: String,
+    /// How to fix it.
+    pub help: Option<String>,
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line > 0 {
+            write!(f, "{}:{}:{}: ", self.file, self.line, self.column)?;
+        } else {
+            write!(f, "{}: ", self.file)?;
+        }
+        if !self.key.is_empty() {
+            write!(f, "`{}`: ", self.key)?;
+        }
+        write!(f, "{}", self.message)?;
+        if let Some(help) = &self.help {
+            write!(f, "\n    help: {help}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Every problem found in one case file; reading reports all of them at
+/// once rather than stopping at the first.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Diagnostics(pub Vec<Diagnostic>);
+
+impl Diagnostics {
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.0.iter()
+    }
+}
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.0.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "error: {d}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Diagnostics {}
+
+/// Turns byte offsets of the case text into line and column numbers and
+/// collects diagnostics.
+#[derive(Clone, Debug)]
+pub struct Collector {
+    file: String,
+    text: String,
+    line_starts: Vec<usize>,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+impl Collector {
+    pub fn new(file: &str, text: &str) -> Self {
+        let line_starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Self {
+            file: file.to_string(),
+            text: text.to_string(),
+            line_starts,
+            diagnostics: Vec::new(),
+        }
+    }
+
+    /// The file name used in messages.
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// 1-based (line, column) of a byte offset.
+    pub fn position(&self, offset: usize) -> (usize, usize) {
+        let offset = offset.min(self.text.len());
+        let line = self.line_starts.partition_point(|&s| s <= offset);
+        let start = self.line_starts[line - 1];
+        let column = self.text[start..offset].chars().count() + 1;
+        (line, column)
+    }
+
+    /// Record a problem at `span` (the start of the span is reported).
+    pub fn error(
+        &mut self,
+        span: Option<Range<usize>>,
+        key: &str,
+        message: impl Into<String>,
+        help: Option<String>,
+    ) {
+        let (line, column) = span.map_or((0, 0), |s| self.position(s.start));
+        self.diagnostics.push(Diagnostic {
+            file: self.file.clone(),
+            line,
+            column,
+            key: key.to_string(),
+            message: message.into(),
+            help,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn offsets_become_lines_and_columns() {
+        let c = Collector::new("case.toml", "a = 1\nbé = 2\n\nc = 3");
+        assert_eq!(c.position(0), (1, 1));
+        assert_eq!(c.position(4), (1, 5));
+        assert_eq!(c.position(6), (2, 1));
+        // Columns count characters, not bytes: `é` is two bytes.
+        assert_eq!(c.position(6 + 3), (2, 3));
+        assert_eq!(c.position(14), (3, 1));
+        assert_eq!(c.position(15), (4, 1));
+    }
+
+    #[test]
+    fn display_names_file_line_key_and_help() {
+        let mut c = Collector::new("x.toml", "\n[problem]\nmethdo = 1\n");
+        c.error(Some(11..17), "problem.methdo", "unknown key", Some("did you mean `method`?".into()));
+        assert_eq!(
+            c.diagnostics[0].to_string(),
+            "x.toml:3:1: `problem.methdo`: unknown key\n    help: did you mean `method`?"
+        );
+    }
+}

@@ -1,0 +1,301 @@
+//! Case files: a TOML description of a problem that `hasse run` solves.
+//!
+//! Every key is documented in `cases/README.md`. A minimal case:
+//!
+//! ```toml
+//! [mesh]
+//! generator = "rectangle"
+//! n = [16, 16]
+//!
+//! [problem]
+//! method = "fe"
+//! source = "2 * pi^2 * sin(pi*x) * sin(pi*y)"
+//!
+//! [[boundary]]
+//! tag = "boundary"
+//! type = "dirichlet"
+//! value = 0
+//! ```
+//!
+//! Reading checks the whole file and reports every problem at once, each
+//! with its line, column and key ([`Diagnostics`]); building the mesh and
+//! checking the boundary tags against it is a second step
+//! ([`Case::build_mesh`]) because it can be expensive.
+//!
+//! ```
+//! use hasse_solver::case::Case;
+//! let text = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n\n[problem]\nmethod = \"fv\"\nsource = 1\n\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = \"x*y\"\n";
+//! let case = Case::from_text("demo.toml", text, &[]).unwrap();
+//! let complex = case.build_mesh().unwrap();
+//! assert_eq!(complex.cell_count(2), 16);
+//! let bad = Case::from_text("demo.toml", &text.replace("method", "methdo"), &[]).unwrap_err();
+//! assert!(bad.to_string().contains("demo.toml:6:1: `problem.methdo`: unknown key"));
+//! ```
+
+pub mod diagnostic;
+pub mod expr;
+mod reader;
+
+pub use diagnostic::{Diagnostic, Diagnostics};
+
+use crate::diffusion::Method;
+use crate::linear::Factorization;
+use crate::mesh_spec::{MeshError, MeshSpec};
+use diagnostic::Collector;
+use expr::{Expression, Scope};
+use hasse_complex::Complex;
+use reader::Reader;
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+/// A diffusion coefficient: scalar or a full symmetric tensor, each entry
+/// an expression.
+#[derive(Clone, Debug)]
+pub enum Coefficient {
+    Scalar(Expression),
+    /// Rows of the tensor (d × d, d the embedding dimension).
+    Tensor(Vec<Vec<Expression>>),
+}
+
+/// A boundary condition of the case.
+#[derive(Clone, Debug)]
+pub struct BoundarySpec {
+    /// Tag of (n−1)-cells in the mesh.
+    pub tag: String,
+    pub kind: BoundaryKindSpec,
+    /// Where the `tag` key is, for messages about the mesh.
+    pub(crate) tag_span: Option<Range<usize>>,
+    pub(crate) key: String,
+}
+
+/// Kind and data of a boundary condition.
+#[derive(Clone, Debug)]
+pub enum BoundaryKindSpec {
+    Dirichlet(Expression),
+    Neumann(Expression),
+    Robin {
+        alpha: Expression,
+        value: Expression,
+    },
+}
+
+/// The metric of a gradient problem (the face-to-face Ω of the thesis's
+/// Ch. 6).
+#[derive(Clone, Debug, PartialEq)]
+pub enum GradientMetric {
+    /// Ω = σ I.
+    Diagonal(f64),
+    /// Ω read from a file of `row column value` triplets (face ids of the
+    /// mesh, 0-based), times `scale`.
+    File { path: PathBuf, scale: f64 },
+    /// The two-point metric σ_F = |F| / d_F of the mesh geometry.
+    TwoPoint,
+}
+
+/// −∇·(K∇u) = f with boundary conditions.
+#[derive(Clone, Debug)]
+pub struct DiffusionSpec {
+    pub method: Method,
+    pub conductivity: Coefficient,
+    pub source: Expression,
+    pub boundary: Vec<BoundarySpec>,
+}
+
+/// g = Ω δ f: a cell field's "normal gradient" as a face cochain.
+#[derive(Clone, Debug)]
+pub struct GradientSpec {
+    /// The field sampled at top-cell centroids.
+    pub field: Expression,
+    pub metric: GradientMetric,
+}
+
+/// What the case solves.
+#[derive(Clone, Debug)]
+pub enum Problem {
+    Diffusion(DiffusionSpec),
+    Gradient(GradientSpec),
+}
+
+/// The exact solution, when known.
+#[derive(Clone, Debug)]
+pub struct ExactSpec {
+    pub solution: Expression,
+    /// ∇u, one expression per coordinate (enables flux errors).
+    pub gradient: Option<Vec<Expression>>,
+}
+
+/// Linear solver settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SolverSpec {
+    pub factorization: Option<Factorization>,
+    /// A relative residual above this is reported as a warning.
+    pub residual_warning: f64,
+    /// A relative residual above this fails the run (exit code 1).
+    pub residual_limit: f64,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        Self {
+            factorization: None,
+            residual_warning: 1e-10,
+            residual_limit: 1e-6,
+        }
+    }
+}
+
+/// Where results go.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutputSpec {
+    /// Directory (relative to the working directory).
+    pub directory: PathBuf,
+    /// File stem: `<directory>/<name>.h5` and `.xdmf`.
+    pub name: String,
+    /// Whether to write files at all.
+    pub write: bool,
+}
+
+/// A case file, read and checked.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// The case file's path as given.
+    pub path: PathBuf,
+    /// The text after `--set` overrides (stored with the results).
+    pub text: String,
+    pub title: Option<String>,
+    pub constants: BTreeMap<String, f64>,
+    pub scope: Scope,
+    pub mesh: MeshSpec,
+    pub problem: Problem,
+    pub exact: Option<ExactSpec>,
+    pub solver: SolverSpec,
+    pub output: OutputSpec,
+    /// Keeps spans for messages found after reading (mesh problems).
+    collector: Collector,
+    mesh_spans: BTreeMap<String, Range<usize>>,
+}
+
+/// Why a case could not be loaded or its mesh built.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error("{path}: cannot read the case file: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{0}")]
+    Invalid(Diagnostics),
+}
+
+impl Case {
+    /// Read a case file, apply `key=value` overrides, check everything.
+    pub fn read(path: &Path, overrides: &[String]) -> Result<Case, CaseError> {
+        let text = std::fs::read_to_string(path).map_err(|source| CaseError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        let mut case = Case::from_text(&path.display().to_string(), &text, overrides)
+            .map_err(CaseError::Invalid)?;
+        case.path = path.to_path_buf();
+        Ok(case)
+    }
+
+    /// Read a case from text; `file` names it in messages and anchors
+    /// relative paths (mesh files, metric files).
+    pub fn from_text(file: &str, text: &str, overrides: &[String]) -> Result<Case, Diagnostics> {
+        let text = reader::apply_overrides(file, text, overrides)?;
+        Reader::read(file, &text)
+    }
+
+    /// Build the mesh and check the boundary tags against it; problems are
+    /// reported with the case file's line numbers.
+    pub fn build_mesh(&self) -> Result<Complex, Diagnostics> {
+        let mut collector = self.collector.clone();
+        collector.diagnostics.clear();
+        let complex = match self.mesh.build(&self.path) {
+            Ok(complex) => complex,
+            Err(e) => {
+                let (key, message) = match &e {
+                    MeshError::Key { key, message, .. } => (key.to_string(), message.clone()),
+                    other => ("file".to_string(), other.to_string()),
+                };
+                let span = self
+                    .mesh_spans
+                    .get(&key)
+                    .or_else(|| self.mesh_spans.get(""))
+                    .cloned();
+                collector.error(span, &format!("mesh.{key}"), message, None);
+                return Err(Diagnostics(collector.diagnostics));
+            }
+        };
+        if let Problem::Diffusion(spec) = &self.problem {
+            let n = complex.dim();
+            let available: Vec<String> = complex
+                .tags()
+                .iter()
+                .filter(|(_, t)| n > 0 && t.dim == n - 1)
+                .map(|(name, _)| name.to_string())
+                .collect();
+            for b in &spec.boundary {
+                match complex.tag(&b.tag) {
+                    None => {
+                        let help = match expr::closest(&b.tag, &available) {
+                            Some(s) => format!("did you mean `{s}`? the mesh has: {}", available.join(", ")),
+                            None if available.is_empty() => {
+                                "the mesh has no boundary tags (a closed surface has no boundary)".into()
+                            }
+                            None => format!("the mesh has: {}", available.join(", ")),
+                        };
+                        collector.error(
+                            b.tag_span.clone(),
+                            &format!("{}.tag", b.key),
+                            format!("no tag `{}` in the mesh", b.tag),
+                            Some(help),
+                        );
+                    }
+                    Some(t) if t.dim + 1 != n => collector.error(
+                        b.tag_span.clone(),
+                        &format!("{}.tag", b.key),
+                        format!(
+                            "tag `{}` names {}-cells; boundary conditions need {}-cells",
+                            b.tag,
+                            t.dim,
+                            n.saturating_sub(1)
+                        ),
+                        None,
+                    ),
+                    Some(_) => {}
+                }
+            }
+            if let Coefficient::Tensor(rows) = &spec.conductivity {
+                let d = complex.embedding_dim();
+                if rows.len() != d {
+                    collector.error(
+                        self.mesh_spans.get("@conductivity").cloned(),
+                        "problem.conductivity",
+                        format!(
+                            "a {}×{} tensor, but the mesh lives in {d} dimensions",
+                            rows.len(),
+                            rows.len()
+                        ),
+                        Some(format!("give {d} rows of {d} entries")),
+                    );
+                }
+            }
+        }
+        if collector.diagnostics.is_empty() {
+            Ok(complex)
+        } else {
+            Err(Diagnostics(collector.diagnostics))
+        }
+    }
+
+    /// The method of a diffusion problem.
+    pub fn method(&self) -> Option<Method> {
+        match &self.problem {
+            Problem::Diffusion(d) => Some(d.method),
+            Problem::Gradient(_) => None,
+        }
+    }
+}

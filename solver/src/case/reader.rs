@@ -1,0 +1,829 @@
+//! Reading a case file's TOML into a [`Case`], key by key, collecting every
+//! problem with its position instead of stopping at the first (so `hasse
+//! check` can list them all).
+
+use super::diagnostic::{Collector, Diagnostics};
+use super::expr::{closest, ExprError, Expression, Scope};
+use super::{
+    BoundaryKindSpec, BoundarySpec, Case, Coefficient, DiffusionSpec, ExactSpec, GradientMetric,
+    GradientSpec, OutputSpec, Problem, SolverSpec,
+};
+use crate::diffusion::Method;
+use crate::linear::Factorization;
+use crate::mesh_spec::MeshSpec;
+use hasse_complex::DualKind;
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use toml_edit::{ImDocument, Item, TableLike, Value};
+
+const TOP_KEYS: &[&str] = &[
+    "title",
+    "description",
+    "constants",
+    "definitions",
+    "mesh",
+    "problem",
+    "boundary",
+    "exact",
+    "solver",
+    "output",
+];
+const MESH_KEYS: &[&str] = &[
+    "generator",
+    "file",
+    "n",
+    "x",
+    "y",
+    "z",
+    "grading",
+    "cells",
+    "perturb",
+    "seed",
+    "radius",
+    "subdivisions",
+    "inner_radius",
+    "outer_radius",
+    "major_radius",
+    "minor_radius",
+    "cavity",
+];
+const PROBLEM_KEYS: &[&str] = &["kind", "method", "conductivity", "source", "field", "metric"];
+const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha"];
+const EXACT_KEYS: &[&str] = &["solution", "gradient"];
+const SOLVER_KEYS: &[&str] = &[
+    "type",
+    "factorization",
+    "residual_warning",
+    "residual_limit",
+];
+const OUTPUT_KEYS: &[&str] = &["directory", "name", "write"];
+const METRIC_KEYS: &[&str] = &["type", "value", "file", "scale"];
+const METHODS: &[&str] = &["fd", "fe", "fv", "fv-mimetic", "dec", "dec-barycentric"];
+
+/// Apply `key.path=value` overrides to the case text. Values are TOML
+/// (`n=[64,64]`, `problem.method="fv"`); a value that is not valid TOML is
+/// taken as a string, so `problem.method=fv` works too.
+pub(super) fn apply_overrides(
+    file: &str,
+    text: &str,
+    overrides: &[String],
+) -> Result<String, Diagnostics> {
+    if overrides.is_empty() {
+        return Ok(text.to_string());
+    }
+    let mut collector = Collector::new(file, text);
+    let mut doc: toml_edit::DocumentMut = match text.parse() {
+        Ok(doc) => doc,
+        // The syntax error is reported with its position by the reader.
+        Err(_) => return Ok(text.to_string()),
+    };
+    for assignment in overrides {
+        let Some((path, raw)) = assignment.split_once('=') else {
+            collector.error(
+                None,
+                "",
+                format!("--set {assignment}: expected KEY=VALUE"),
+                Some("e.g. --set problem.method=fv or --set mesh.n=[64,64]".into()),
+            );
+            continue;
+        };
+        let value: Value = raw
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| Value::from(raw.trim()));
+        let segments: Vec<&str> = path.trim().split('.').collect();
+        if segments.iter().any(|s| s.is_empty()) || !set_path(doc.as_table_mut(), &segments, value) {
+            collector.error(
+                None,
+                path.trim(),
+                format!("--set {assignment}: `{}` does not name a value in this case file", path.trim()),
+                Some("use dotted keys such as problem.method, mesh.n or boundary.0.value".into()),
+            );
+        }
+    }
+    if collector.diagnostics.is_empty() {
+        Ok(doc.to_string())
+    } else {
+        Err(Diagnostics(collector.diagnostics))
+    }
+}
+
+/// Set the value at a dotted path, creating tables on the way; a numeric
+/// segment indexes an array of tables (`boundary.0.value`).
+fn set_path(table: &mut dyn TableLike, segments: &[&str], value: Value) -> bool {
+    let Some((head, rest)) = segments.split_first() else {
+        return false;
+    };
+    if rest.is_empty() {
+        table.insert(head, Item::Value(value));
+        return true;
+    }
+    if table.get(head).is_none() {
+        table.insert(head, Item::Table(toml_edit::Table::new()));
+    }
+    match table.get_mut(head) {
+        Some(Item::ArrayOfTables(array)) => {
+            let (Some(index), Some(rest)) = (rest[0].parse::<usize>().ok(), rest.get(1..)) else {
+                return false;
+            };
+            match array.get_mut(index) {
+                Some(t) if !rest.is_empty() => set_path(t, rest, value),
+                _ => false,
+            }
+        }
+        Some(item) => match item.as_table_like_mut() {
+            Some(t) => set_path(t, rest, value),
+            None => false,
+        },
+        None => false,
+    }
+}
+
+/// Walks the parsed document and records what it finds.
+pub(super) struct Reader {
+    collector: Collector,
+    file: String,
+}
+
+/// A key found in a table: its dotted name, the span of the key and the item.
+struct Entry<'a> {
+    name: String,
+    key_span: Option<Range<usize>>,
+    item: &'a Item,
+}
+
+impl Entry<'_> {
+    fn span(&self) -> Option<Range<usize>> {
+        self.item.span().or_else(|| self.key_span.clone())
+    }
+}
+
+impl Reader {
+    pub(super) fn read(file: &str, text: &str) -> Result<Case, Diagnostics> {
+        let mut reader = Reader {
+            collector: Collector::new(file, text),
+            file: file.to_string(),
+        };
+        let doc = match ImDocument::parse(text.to_string()) {
+            Ok(doc) => doc,
+            Err(e) => {
+                reader.collector.error(
+                    e.span(),
+                    "",
+                    format!("not valid TOML: {}", e.message().trim()),
+                    Some("see https://toml.io for the syntax".into()),
+                );
+                return Err(Diagnostics(reader.collector.diagnostics));
+            }
+        };
+        let root = doc.as_table();
+        reader.check_keys(root, "", TOP_KEYS);
+
+        let title = reader.string_at(root, "", "title");
+        let mut scope = Scope::new();
+        let constants = reader.constants(root, &mut scope);
+        reader.definitions(root, &mut scope);
+        let (mesh, mesh_spans) = reader.mesh(root, text);
+        let problem = reader.problem(root, &scope);
+        let exact = reader.exact(root, &scope);
+        let solver = reader.solver(root);
+        let output = reader.output(root);
+
+        if !reader.collector.diagnostics.is_empty() {
+            return Err(Diagnostics(reader.collector.diagnostics));
+        }
+        match (mesh, problem) {
+            (Some(mesh), Some(problem)) => Ok(Case {
+                path: PathBuf::from(file),
+                text: text.to_string(),
+                title,
+                constants,
+                scope,
+                mesh,
+                problem,
+                exact,
+                solver,
+                output,
+                collector: reader.collector,
+                mesh_spans,
+            }),
+            // Every `None` above came with a diagnostic.
+            _ => Err(Diagnostics(reader.collector.diagnostics)),
+        }
+    }
+
+    fn error(&mut self, span: Option<Range<usize>>, key: &str, message: impl Into<String>, help: Option<String>) {
+        self.collector.error(span, key, message, help);
+    }
+
+    fn check_keys(&mut self, table: &dyn TableLike, prefix: &str, known: &[&str]) {
+        let owned: Vec<String> = known.iter().map(|s| s.to_string()).collect();
+        for (key, _) in table.iter() {
+            if known.contains(&key) {
+                continue;
+            }
+            let span = table.get_key_value(key).and_then(|(k, _)| k.span());
+            let help = match closest(key, &owned) {
+                Some(s) => format!("did you mean `{s}`?"),
+                None => format!("known keys here: {}", known.join(", ")),
+            };
+            self.error(span, &join(prefix, key), "unknown key", Some(help));
+        }
+    }
+
+    fn entry<'a>(&self, table: &'a dyn TableLike, prefix: &str, key: &str) -> Option<Entry<'a>> {
+        table.get_key_value(key).map(|(k, item)| Entry {
+            name: join(prefix, key),
+            key_span: k.span(),
+            item,
+        })
+    }
+
+    fn type_error(&mut self, entry: &Entry, expected: &str) {
+        let found = describe(entry.item);
+        self.error(entry.span(), &entry.name, format!("expected {expected}, found {found}"), None);
+    }
+
+    fn string_at(&mut self, table: &dyn TableLike, prefix: &str, key: &str) -> Option<String> {
+        let entry = self.entry(table, prefix, key)?;
+        match entry.item.as_str() {
+            Some(s) => Some(s.to_string()),
+            None => {
+                self.type_error(&entry, "a string");
+                None
+            }
+        }
+    }
+
+    fn number(&mut self, entry: &Entry) -> Option<f64> {
+        match entry.item.as_value() {
+            Some(Value::Float(f)) => Some(*f.value()),
+            Some(Value::Integer(i)) => Some(*i.value() as f64),
+            _ => {
+                self.type_error(entry, "a number");
+                None
+            }
+        }
+    }
+
+    fn number_at(&mut self, table: &dyn TableLike, prefix: &str, key: &str) -> Option<f64> {
+        let entry = self.entry(table, prefix, key)?;
+        self.number(&entry)
+    }
+
+    fn expression_of(&mut self, item: &Item, name: &str, span: Option<Range<usize>>, scope: &Scope) -> Option<Expression> {
+        let text = match item.as_value() {
+            Some(Value::String(s)) => s.value().clone(),
+            Some(Value::Float(f)) => format_number(*f.value()),
+            Some(Value::Integer(i)) => i.value().to_string(),
+            _ => {
+                let found = describe(item);
+                self.error(span, name, format!("expected a number or an expression string, found {found}"), None);
+                return None;
+            }
+        };
+        match scope.parse(&text) {
+            Ok(e) => Some(e),
+            Err(e) => {
+                let help = expression_help(&e, scope);
+                self.error(span, name, e.to_string(), Some(help));
+                None
+            }
+        }
+    }
+
+    fn expression_at(&mut self, table: &dyn TableLike, prefix: &str, key: &str, scope: &Scope) -> Option<Expression> {
+        let entry = self.entry(table, prefix, key)?;
+        self.expression_of(entry.item, &entry.name, entry.span(), scope)
+    }
+
+    fn subtable<'a>(&mut self, table: &'a dyn TableLike, prefix: &str, key: &str) -> Option<(&'a dyn TableLike, Entry<'a>)> {
+        let entry = self.entry(table, prefix, key)?;
+        match entry.item.as_table_like() {
+            Some(t) => Some((t, entry)),
+            None => {
+                self.type_error(&entry, "a table");
+                None
+            }
+        }
+    }
+
+    fn constants(&mut self, root: &dyn TableLike, scope: &mut Scope) -> BTreeMap<String, f64> {
+        let mut out = BTreeMap::new();
+        let Some((table, _)) = self.subtable(root, "", "constants") else {
+            return out;
+        };
+        for (key, _) in table.iter() {
+            let Some(entry) = self.entry(table, "constants", key) else { continue };
+            // A constant may be a number or an expression of earlier constants.
+            let value = match entry.item.as_value() {
+                Some(Value::String(_)) => self
+                    .expression_of(entry.item, &entry.name, entry.span(), scope)
+                    .and_then(|e| {
+                        if e.is_constant() {
+                            Some(e.eval(&[], 0.0))
+                        } else {
+                            self.error(entry.span(), &entry.name, "a constant may not depend on x, y, z or t", Some("move it to [definitions]".into()));
+                            None
+                        }
+                    }),
+                _ => self.number(&entry),
+            };
+            if let Some(v) = value {
+                match scope.add_constant(key, v) {
+                    Ok(()) => {
+                        out.insert(key.to_string(), v);
+                    }
+                    Err(e) => self.error(entry.key_span.clone(), &entry.name, e.to_string(), None),
+                }
+            }
+        }
+        out
+    }
+
+    fn definitions(&mut self, root: &dyn TableLike, scope: &mut Scope) {
+        let Some((table, _)) = self.subtable(root, "", "definitions") else {
+            return;
+        };
+        for (key, item) in table.iter() {
+            let Some(entry) = self.entry(table, "definitions", key) else { continue };
+            let Some(text) = item.as_str() else {
+                self.type_error(&entry, "an expression string");
+                continue;
+            };
+            if let Err(e) = scope.add_definition(key, text) {
+                let span = match e {
+                    ExprError::ReservedName { .. } => entry.key_span.clone(),
+                    _ => entry.span(),
+                };
+                let help = expression_help(&e, scope);
+                self.error(span, &entry.name, e.to_string(), Some(help));
+            }
+        }
+    }
+
+    fn mesh(&mut self, root: &dyn TableLike, text: &str) -> (Option<MeshSpec>, BTreeMap<String, Range<usize>>) {
+        let mut spans = BTreeMap::new();
+        let Some((table, entry)) = self.subtable(root, "", "mesh") else {
+            if root.get("mesh").is_none() {
+                self.error(None, "mesh", "no [mesh] table", Some("add [mesh] with `generator = \"rectangle\"` and `n = [16, 16]`, or `file = \"mesh.msh\"`".into()));
+            }
+            return (None, spans);
+        };
+        spans.insert(String::new(), entry.span().unwrap_or(0..0));
+        let before = self.collector.diagnostics.len();
+        self.check_keys(table, "mesh", MESH_KEYS);
+        for (key, item) in table.iter() {
+            if let Some(span) = item.span().or_else(|| table.get_key_value(key).and_then(|(k, _)| k.span())) {
+                spans.insert(key.to_string(), span);
+            }
+        }
+        if self.collector.diagnostics.len() > before {
+            return (None, spans);
+        }
+        // The keys are known: let serde check the types, through toml (which
+        // reports the line and column of a bad value).
+        #[derive(serde::Deserialize)]
+        struct MeshOnly {
+            mesh: MeshSpec,
+        }
+        match toml::from_str::<toml::Table>(text).map(|mut t| t.remove("mesh")) {
+            Ok(Some(value)) => {
+                let mut wrapper = toml::Table::new();
+                wrapper.insert("mesh".into(), value);
+                match toml::Value::Table(wrapper).try_into::<MeshOnly>() {
+                    Ok(m) => return (Some(m.mesh), spans),
+                    Err(e) => {
+                        // Find which key the message is about to point at it.
+                        let message = e.message().trim().to_string();
+                        let key = MESH_KEYS.iter().find(|k| message.contains(&format!("mesh.{k}")) || message.contains(&format!("`{k}`")));
+                        let span = key.and_then(|k| spans.get(*k).cloned()).or_else(|| entry.span());
+                        let name = key.map_or("mesh".to_string(), |k| format!("mesh.{k}"));
+                        self.error(span, &name, message, None);
+                    }
+                }
+            }
+            _ => self.error(entry.span(), "mesh", "cannot read the [mesh] table", None),
+        }
+        (None, spans)
+    }
+
+    fn problem(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<Problem> {
+        let Some((table, _)) = self.subtable(root, "", "problem") else {
+            if root.get("problem").is_none() {
+                self.error(None, "problem", "no [problem] table", Some("add [problem] with `method = \"fe\"` and `source = ...`".into()));
+            }
+            return None;
+        };
+        self.check_keys(table, "problem", PROBLEM_KEYS);
+        let kind = self.string_at(table, "problem", "kind").unwrap_or_else(|| "diffusion".into());
+        match kind.as_str() {
+            "diffusion" => {
+                for key in ["field", "metric"] {
+                    if let Some(e) = self.entry(table, "problem", key) {
+                        self.error(e.key_span.clone(), &e.name, "only used by kind = \"gradient\"", None);
+                    }
+                }
+                let method = self.method(table);
+                let conductivity = self.conductivity(table, scope);
+                let source = match self.entry(table, "problem", "source") {
+                    Some(_) => self.expression_at(table, "problem", "source", scope),
+                    None => scope.parse("0").ok(),
+                };
+                let boundary = self.boundary(root, scope);
+                Some(Problem::Diffusion(DiffusionSpec {
+                    method: method?,
+                    conductivity: conductivity?,
+                    source: source?,
+                    boundary,
+                }))
+            }
+            "gradient" => {
+                for key in ["method", "conductivity", "source"] {
+                    if let Some(e) = self.entry(table, "problem", key) {
+                        self.error(e.key_span.clone(), &e.name, "not used by kind = \"gradient\"", Some("a gradient problem takes `field` and `metric`".into()));
+                    }
+                }
+                if let Some(e) = self.entry(root, "", "boundary") {
+                    self.error(e.key_span.clone(), "boundary", "a gradient problem has no boundary conditions", None);
+                }
+                let field = match self.entry(table, "problem", "field") {
+                    Some(_) => self.expression_at(table, "problem", "field", scope),
+                    None => {
+                        self.error(None, "problem.field", "missing: the cell field whose gradient is computed", Some("e.g. field = \"sin(pi*x)\"".into()));
+                        None
+                    }
+                };
+                let metric = self.gradient_metric(table);
+                Some(Problem::Gradient(GradientSpec { field: field?, metric: metric? }))
+            }
+            other => {
+                let span = self.entry(table, "problem", "kind").and_then(|e| e.span());
+                self.error(span, "problem.kind", format!("unknown problem kind \"{other}\""), Some("use \"diffusion\" (default) or \"gradient\"".into()));
+                None
+            }
+        }
+    }
+
+    fn method(&mut self, table: &dyn TableLike) -> Option<Method> {
+        let Some(entry) = self.entry(table, "problem", "method") else {
+            self.error(None, "problem.method", "missing: which discretisation to use", Some(format!("one of {}", METHODS.join(", "))));
+            return None;
+        };
+        let name = entry.item.as_str().map(str::to_string);
+        let method = match name.as_deref() {
+            Some("fd") => Method::Fd,
+            Some("fe") => Method::Fe,
+            Some("fv") => Method::Fv,
+            Some("fv-mimetic") => Method::FvMimetic,
+            Some("dec") => Method::Dec(DualKind::Circumcentric),
+            Some("dec-barycentric") => Method::Dec(DualKind::Barycentric),
+            Some(other) => {
+                let owned: Vec<String> = METHODS.iter().map(|s| s.to_string()).collect();
+                let help = match closest(other, &owned) {
+                    Some(s) => format!("did you mean \"{s}\"? methods: {}", METHODS.join(", ")),
+                    None => format!("methods: {}", METHODS.join(", ")),
+                };
+                self.error(entry.span(), &entry.name, format!("unknown method \"{other}\""), Some(help));
+                return None;
+            }
+            None => {
+                self.type_error(&entry, "a string");
+                return None;
+            }
+        };
+        Some(method)
+    }
+
+    fn conductivity(&mut self, table: &dyn TableLike, scope: &Scope) -> Option<Coefficient> {
+        let Some(entry) = self.entry(table, "problem", "conductivity") else {
+            return scope.parse("1").ok().map(Coefficient::Scalar);
+        };
+        let Some(Value::Array(rows)) = entry.item.as_value() else {
+            return self
+                .expression_of(entry.item, &entry.name, entry.span(), scope)
+                .map(Coefficient::Scalar);
+        };
+        let size = rows.len();
+        if !(1..=3).contains(&size) {
+            self.error(entry.span(), &entry.name, format!("a tensor has 1 to 3 rows, found {size}"), None);
+            return None;
+        }
+        let mut tensor = Vec::with_capacity(size);
+        let mut ok = true;
+        for (i, row) in rows.iter().enumerate() {
+            let name = format!("{}[{i}]", entry.name);
+            let Value::Array(cols) = row else {
+                self.error(row.span(), &name, "expected a row (an array)", Some("write the tensor as [[kxx, kxy], [kxy, kyy]]".into()));
+                ok = false;
+                continue;
+            };
+            if cols.len() != size {
+                self.error(row.span(), &name, format!("row has {} entries; the tensor is {size}×{size}", cols.len()), None);
+                ok = false;
+                continue;
+            }
+            let mut parsed = Vec::with_capacity(size);
+            for (j, v) in cols.iter().enumerate() {
+                let item = Item::Value(v.clone());
+                match self.expression_of(&item, &format!("{name}[{j}]"), v.span(), scope) {
+                    Some(e) => parsed.push(e),
+                    None => ok = false,
+                }
+            }
+            tensor.push(parsed);
+        }
+        if !ok {
+            return None;
+        }
+        // Symmetry can be checked textually for constant entries here; entries
+        // that vary are checked where they are evaluated.
+        for i in 0..size {
+            for j in 0..i {
+                let (a, b) = (&tensor[i][j], &tensor[j][i]);
+                if a.is_constant() && b.is_constant() && a.eval(&[], 0.0) != b.eval(&[], 0.0) {
+                    self.error(entry.span(), &entry.name, format!("the tensor is not symmetric: entry [{i}][{j}] = {} but [{j}][{i}] = {}", a.text(), b.text()), Some("a diffusion tensor is symmetric positive definite".into()));
+                    return None;
+                }
+            }
+        }
+        Some(Coefficient::Tensor(tensor))
+    }
+
+    fn boundary(&mut self, root: &dyn TableLike, scope: &Scope) -> Vec<BoundarySpec> {
+        let mut out = Vec::new();
+        let Some(entry) = self.entry(root, "", "boundary") else {
+            return out;
+        };
+        let Some(array) = entry.item.as_array_of_tables() else {
+            self.error(entry.span(), "boundary", "expected [[boundary]] tables", Some("write each condition as a [[boundary]] table with tag, type and value".into()));
+            return out;
+        };
+        for (i, table) in array.iter().enumerate() {
+            let prefix = format!("boundary[{i}]");
+            self.check_keys(table, &prefix, BOUNDARY_KEYS);
+            let header = table.span();
+            let tag_entry = self.entry(table, &prefix, "tag");
+            let tag_span = tag_entry.as_ref().and_then(|e| e.span());
+            let tag = match tag_entry {
+                Some(_) => self.string_at(table, &prefix, "tag"),
+                None => {
+                    self.error(header.clone(), &format!("{prefix}.tag"), "missing: the boundary region's tag", Some("generated meshes tag \"boundary\" and each side (\"xmin\", \"xmax\", ...)".into()));
+                    None
+                }
+            };
+            let kind_name = match self.entry(table, &prefix, "type") {
+                Some(_) => self.string_at(table, &prefix, "type"),
+                None => {
+                    self.error(header.clone(), &format!("{prefix}.type"), "missing: dirichlet, neumann or robin", None);
+                    None
+                }
+            };
+            let value = match self.entry(table, &prefix, "value") {
+                Some(_) => self.expression_at(table, &prefix, "value", scope),
+                None => {
+                    self.error(header.clone(), &format!("{prefix}.value"), "missing: the boundary value (a number or an expression)", None);
+                    None
+                }
+            };
+            let kind = match kind_name.as_deref() {
+                Some("dirichlet") => value.map(BoundaryKindSpec::Dirichlet),
+                Some("neumann") => value.map(BoundaryKindSpec::Neumann),
+                Some("robin") => {
+                    let alpha = match self.entry(table, &prefix, "alpha") {
+                        Some(_) => self.expression_at(table, &prefix, "alpha", scope),
+                        None => {
+                            self.error(header.clone(), &format!("{prefix}.alpha"), "missing: a Robin condition K∇u·n + α u = g needs α", None);
+                            None
+                        }
+                    };
+                    match (alpha, value) {
+                        (Some(alpha), Some(value)) => Some(BoundaryKindSpec::Robin { alpha, value }),
+                        _ => None,
+                    }
+                }
+                Some(other) => {
+                    let span = self.entry(table, &prefix, "type").and_then(|e| e.span());
+                    let kinds = ["dirichlet".to_string(), "neumann".into(), "robin".into()];
+                    let help = closest(other, &kinds).map_or("use dirichlet, neumann or robin".into(), |s| format!("did you mean \"{s}\"?"));
+                    self.error(span, &format!("{prefix}.type"), format!("unknown boundary type \"{other}\""), Some(help));
+                    None
+                }
+                None => None,
+            };
+            if kind_name.as_deref() != Some("robin") {
+                if let Some(e) = self.entry(table, &prefix, "alpha") {
+                    self.error(e.key_span.clone(), &e.name, "only a robin condition takes alpha", None);
+                }
+            }
+            if let (Some(tag), Some(kind)) = (tag, kind) {
+                out.push(BoundarySpec { tag, kind, tag_span, key: prefix });
+            }
+        }
+        out
+    }
+
+    fn gradient_metric(&mut self, table: &dyn TableLike) -> Option<GradientMetric> {
+        let Some((metric, entry)) = self.subtable(table, "problem", "metric") else {
+            if table.get("metric").is_none() {
+                self.error(None, "problem.metric", "missing: the face metric Ω", Some("e.g. metric = { type = \"diagonal\", value = 0.2 }".into()));
+            }
+            return None;
+        };
+        self.check_keys(metric, "problem.metric", METRIC_KEYS);
+        let kind = self.string_at(metric, "problem.metric", "type");
+        match kind.as_deref() {
+            Some("diagonal") => match self.number_at(metric, "problem.metric", "value") {
+                Some(v) if v.is_finite() => Some(GradientMetric::Diagonal(v)),
+                Some(v) => {
+                    self.error(entry.span(), "problem.metric.value", format!("not finite: {v}"), None);
+                    None
+                }
+                None => {
+                    if metric.get("value").is_none() {
+                        self.error(entry.span(), "problem.metric.value", "missing: the diagonal value σ of Ω = σ I", None);
+                    }
+                    None
+                }
+            },
+            Some("file") => {
+                let scale = self.number_at(metric, "problem.metric", "scale").unwrap_or(1.0);
+                let file = self.string_at(metric, "problem.metric", "file");
+                let Some(file) = file else {
+                    if metric.get("file").is_none() {
+                        self.error(entry.span(), "problem.metric.file", "missing: the file of `row column value` lines", None);
+                    }
+                    return None;
+                };
+                let path = self.relative(&file);
+                if !path.is_file() {
+                    let span = self.entry(metric, "problem.metric", "file").and_then(|e| e.span());
+                    self.error(span, "problem.metric.file", format!("no such file: {}", path.display()), Some("paths are relative to the case file".into()));
+                    return None;
+                }
+                Some(GradientMetric::File { path, scale })
+            }
+            Some("two-point") => Some(GradientMetric::TwoPoint),
+            Some(other) => {
+                let span = self.entry(metric, "problem.metric", "type").and_then(|e| e.span());
+                self.error(span, "problem.metric.type", format!("unknown metric type \"{other}\""), Some("use \"diagonal\", \"file\" or \"two-point\"".into()));
+                None
+            }
+            None => {
+                if metric.get("type").is_none() {
+                    self.error(entry.span(), "problem.metric.type", "missing: \"diagonal\", \"file\" or \"two-point\"", None);
+                }
+                None
+            }
+        }
+    }
+
+    fn relative(&self, file: &str) -> PathBuf {
+        Path::new(&self.file).parent().unwrap_or(Path::new(".")).join(file)
+    }
+
+    fn exact(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<ExactSpec> {
+        let (table, entry) = self.subtable(root, "", "exact")?;
+        self.check_keys(table, "exact", EXACT_KEYS);
+        let solution = match self.entry(table, "exact", "solution") {
+            Some(_) => self.expression_at(table, "exact", "solution", scope),
+            None => {
+                self.error(entry.span(), "exact.solution", "missing: the exact solution u(x, y, z)", None);
+                None
+            }
+        };
+        let gradient = match self.entry(table, "exact", "gradient") {
+            None => None,
+            Some(g) => match g.item.as_array() {
+                Some(array) if (1..=3).contains(&array.len()) => {
+                    let mut parts = Vec::new();
+                    for (i, v) in array.iter().enumerate() {
+                        let item = Item::Value(v.clone());
+                        if let Some(e) = self.expression_of(&item, &format!("exact.gradient[{i}]"), v.span(), scope) {
+                            parts.push(e);
+                        }
+                    }
+                    (parts.len() == array.len()).then_some(parts)
+                }
+                _ => {
+                    self.type_error(&g, "an array of 1 to 3 expressions (∂u/∂x, ∂u/∂y, ∂u/∂z)");
+                    None
+                }
+            },
+        };
+        Some(ExactSpec { solution: solution?, gradient })
+    }
+
+    fn solver(&mut self, root: &dyn TableLike) -> SolverSpec {
+        let mut spec = SolverSpec::default();
+        let Some((table, _)) = self.subtable(root, "", "solver") else {
+            return spec;
+        };
+        self.check_keys(table, "solver", SOLVER_KEYS);
+        if let Some(kind) = self.string_at(table, "solver", "type") {
+            if kind != "direct" {
+                let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                self.error(span, "solver.type", format!("unknown solver type \"{kind}\""), Some("\"direct\" (sparse Cholesky/LDLᵀ/LU from faer) is available".into()));
+            }
+        }
+        if let Some(name) = self.string_at(table, "solver", "factorization") {
+            spec.factorization = match name.as_str() {
+                "llt" | "cholesky" => Some(Factorization::Llt),
+                "ldlt" => Some(Factorization::Ldlt),
+                "lu" => Some(Factorization::Lu),
+                other => {
+                    let span = self.entry(table, "solver", "factorization").and_then(|e| e.span());
+                    self.error(span, "solver.factorization", format!("unknown factorisation \"{other}\""), Some("use \"llt\", \"ldlt\" or \"lu\"".into()));
+                    None
+                }
+            };
+        }
+        for (key, slot) in [("residual_warning", &mut spec.residual_warning), ("residual_limit", &mut spec.residual_limit)] {
+            if let Some(v) = self.number_at(table, "solver", key) {
+                if v > 0.0 && v.is_finite() {
+                    *slot = v;
+                } else {
+                    let span = self.entry(table, "solver", key).and_then(|e| e.span());
+                    self.error(span, &format!("solver.{key}"), format!("must be a positive number, found {v}"), None);
+                }
+            }
+        }
+        spec
+    }
+
+    fn output(&mut self, root: &dyn TableLike) -> OutputSpec {
+        let stem = Path::new(&self.file)
+            .file_stem()
+            .map_or("hasse".to_string(), |s| s.to_string_lossy().into_owned());
+        let mut spec = OutputSpec { directory: PathBuf::from("."), name: stem, write: true };
+        let Some((table, _)) = self.subtable(root, "", "output") else {
+            return spec;
+        };
+        self.check_keys(table, "output", OUTPUT_KEYS);
+        if let Some(d) = self.string_at(table, "output", "directory") {
+            spec.directory = PathBuf::from(d);
+        }
+        if let Some(n) = self.string_at(table, "output", "name") {
+            if n.is_empty() || n.contains(['/', '\\']) {
+                let span = self.entry(table, "output", "name").and_then(|e| e.span());
+                self.error(span, "output.name", "a file stem without directories", Some("put directories in output.directory".into()));
+            } else {
+                spec.name = n;
+            }
+        }
+        if let Some(e) = self.entry(table, "output", "write") {
+            match e.item.as_bool() {
+                Some(b) => spec.write = b,
+                None => self.type_error(&e, "true or false"),
+            }
+        }
+        spec
+    }
+}
+
+fn join(prefix: &str, key: &str) -> String {
+    if prefix.is_empty() {
+        key.to_string()
+    } else {
+        format!("{prefix}.{key}")
+    }
+}
+
+fn describe(item: &Item) -> &'static str {
+    match item {
+        Item::None => "nothing",
+        Item::Table(_) => "a table",
+        Item::ArrayOfTables(_) => "an array of tables",
+        Item::Value(v) => match v {
+            Value::String(_) => "a string",
+            Value::Integer(_) => "an integer",
+            Value::Float(_) => "a float",
+            Value::Boolean(_) => "a boolean",
+            Value::Datetime(_) => "a date",
+            Value::Array(_) => "an array",
+            Value::InlineTable(_) => "an inline table",
+        },
+    }
+}
+
+/// A number as expression text that parses back to the same f64.
+fn format_number(v: f64) -> String {
+    if v.is_finite() {
+        format!("{v:?}")
+    } else {
+        v.to_string()
+    }
+}
+
+fn expression_help(e: &ExprError, scope: &Scope) -> String {
+    match e {
+        ExprError::UnknownVariable { .. } => format!(
+            "expressions may use {}; add other names under [constants] or [definitions]",
+            scope.names().join(", ")
+        ),
+        ExprError::Syntax { .. } => "operators: + - * / ^; functions: sin cos tan exp ln sqrt abs min max atan2 ...; write powers as x^2".into(),
+        ExprError::ReservedName { .. } => "choose another name".into(),
+        ExprError::NonFiniteConstant { .. } => "give a finite number".into(),
+    }
+}

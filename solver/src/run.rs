@@ -1,0 +1,572 @@
+//! Running a case: build the mesh, assemble and solve the problem, compute
+//! errors against the exact solution, collect the cochains to write.
+//!
+//! ```
+//! use hasse_solver::{case::Case, run};
+//! let text = r#"
+//! [mesh]
+//! generator = "rectangle"
+//! n = [8, 8]
+//! [problem]
+//! method = "fe"
+//! source = "2*pi^2*sin(pi*x)*sin(pi*y)"
+//! [[boundary]]
+//! tag = "boundary"
+//! type = "dirichlet"
+//! value = 0
+//! [exact]
+//! solution = "sin(pi*x)*sin(pi*y)"
+//! "#;
+//! let case = Case::from_text("demo.toml", text, &[]).unwrap();
+//! let complex = case.build_mesh().unwrap();
+//! let result = run::solve(&case, &complex, &mut |_| {}).unwrap();
+//! assert!(result.errors.unwrap().l2 < 0.02);
+//! ```
+
+use crate::case::{
+    BoundaryKindSpec, Case, Coefficient, DiffusionSpec, GradientMetric, GradientSpec, Problem,
+};
+use crate::diffusion::{
+    self, BoundaryKind, Conductivity, Diffusion, DiffusionError, Errors, Location, ScalarFn,
+    TensorFn, VectorFn,
+};
+use crate::linear::Factorization;
+use crate::metric::Tensor;
+use hasse_complex::Complex;
+use std::fmt;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// A scalar cochain computed by a run: values on the `dim`-cells.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Field {
+    pub name: String,
+    pub dim: usize,
+    pub values: Vec<f64>,
+    pub description: String,
+}
+
+/// What a run produced.
+#[derive(Clone, Debug)]
+pub struct RunResult {
+    /// Short name of the problem and method, e.g. `diffusion/fe`.
+    pub problem: String,
+    pub method: Option<String>,
+    pub unknowns: usize,
+    pub fields: Vec<Field>,
+    pub errors: Option<Errors>,
+    /// L² error of face fluxes (cell-centred and hybrid methods).
+    pub flux_error: Option<f64>,
+    pub relative_residual: Option<f64>,
+    pub factorization: Option<Factorization>,
+    /// Phase name and seconds.
+    pub timings: Vec<(String, f64)>,
+    /// Messages worth a user's attention (large residual, pure Neumann…).
+    pub warnings: Vec<String>,
+    pub pure_neumann: bool,
+}
+
+/// Why a run failed after the case was read.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// Bad data discovered while evaluating or assembling (exit code 2).
+    #[error("{0}")]
+    Input(String),
+    /// The solve failed or is not trustworthy (exit code 1).
+    #[error("{0}")]
+    Solve(String),
+}
+
+impl RunError {
+    /// Whether the user's input is at fault (as opposed to the numerics).
+    pub fn is_input(&self) -> bool {
+        matches!(self, RunError::Input(_))
+    }
+}
+
+fn scalar_fn(e: &crate::case::expr::Expression) -> ScalarFn {
+    let e = e.clone();
+    Arc::new(move |x: &[f64]| e.eval(x, 0.0))
+}
+
+/// Solve the case's problem on `complex`; `phase` is told when each long
+/// phase starts (for progress display).
+pub fn solve(
+    case: &Case,
+    complex: &Complex,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    match &case.problem {
+        Problem::Diffusion(spec) => solve_diffusion(case, spec, complex, phase),
+        Problem::Gradient(spec) => gradient(case, spec, complex, phase),
+    }
+}
+
+fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
+    let conductivity = match &spec.conductivity {
+        Coefficient::Scalar(e) => Conductivity::Scalar(scalar_fn(e)),
+        Coefficient::Tensor(rows) => {
+            let rows = rows.clone();
+            let f: TensorFn = Arc::new(move |x: &[f64]| {
+                let mut t: Tensor = [[0.0; 3]; 3];
+                for (i, row) in rows.iter().enumerate() {
+                    for (j, e) in row.iter().enumerate() {
+                        t[i][j] = e.eval(x, 0.0);
+                    }
+                }
+                t
+            });
+            Conductivity::Tensor(f)
+        }
+    };
+    let mut problem = Diffusion::new(spec.method, conductivity, scalar_fn(&spec.source));
+    for b in &spec.boundary {
+        let kind = match &b.kind {
+            BoundaryKindSpec::Dirichlet(v) => BoundaryKind::Dirichlet(scalar_fn(v)),
+            BoundaryKindSpec::Neumann(v) => BoundaryKind::Neumann(scalar_fn(v)),
+            BoundaryKindSpec::Robin { alpha, value } => BoundaryKind::Robin {
+                alpha: scalar_fn(alpha),
+                value: scalar_fn(value),
+            },
+        };
+        problem = problem.with_boundary(&b.tag, kind);
+    }
+    if let Some(f) = case.solver.factorization {
+        problem.factorization = f;
+    }
+    problem
+}
+
+fn is_input_error(e: &DiffusionError) -> bool {
+    !matches!(e, DiffusionError::Solve(_) | DiffusionError::Canonical(_))
+}
+
+fn solve_diffusion(
+    case: &Case,
+    spec: &DiffusionSpec,
+    complex: &Complex,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    let problem = diffusion_problem(case, spec);
+    phase("assembling and solving");
+    let started = Instant::now();
+    let solution = problem.solve(complex).map_err(|e| {
+        if is_input_error(&e) {
+            RunError::Input(e.to_string())
+        } else {
+            RunError::Solve(e.to_string())
+        }
+    })?;
+    let total = started.elapsed().as_secs_f64();
+    let report = &solution.report;
+    let mut timings = vec![
+        ("assembly".to_string(), solution.assembly_seconds),
+        (
+            "factorisation".to_string(),
+            report.symbolic_seconds + report.numeric_seconds,
+        ),
+        ("solve".to_string(), report.solve_seconds),
+    ];
+    let mut warnings = Vec::new();
+    if solution.pure_neumann {
+        warnings.push(format!(
+            "pure Neumann problem: solved with zero mean (data imbalance {:.2e} removed)",
+            solution.neumann_imbalance
+        ));
+    }
+    check_residual(case, report.relative_residual, &mut warnings)?;
+
+    phase("post-processing");
+    let post = Instant::now();
+    let n = complex.dim();
+    let field_dim = match solution.location {
+        Location::Nodal => 0,
+        _ => n,
+    };
+    let field = solution.field(complex).to_vec();
+    let mut fields = vec![Field {
+        name: "u".into(),
+        dim: field_dim,
+        values: field.clone(),
+        description: "the solution".into(),
+    }];
+    match solution.location {
+        Location::Nodal => fields.push(Field {
+            name: "flux".into(),
+            dim: 1,
+            values: solution.flux.clone(),
+            description: "edge cochain Ω A u (the discrete flux along edges)".into(),
+        }),
+        Location::CellCentred => fields.push(Field {
+            name: "flux".into(),
+            dim: n - 1,
+            values: solution.flux.clone(),
+            description: "flux through each (n−1)-cell along its orientation".into(),
+        }),
+        // Half-face fluxes have no cells of their own to live on.
+        Location::Hybrid => {}
+    }
+    let gradient = diffusion::reconstruct_gradient(complex, &solution);
+    for (axis, name) in ["x", "y", "z"]
+        .iter()
+        .enumerate()
+        .take(complex.embedding_dim())
+    {
+        fields.push(Field {
+            name: format!("grad_{name}"),
+            dim: n,
+            values: gradient.iter().map(|g| g[axis]).collect(),
+            description: format!("∂u/∂{name} reconstructed per cell"),
+        });
+    }
+    let (errors, flux_error) = match &case.exact {
+        None => (None, None),
+        Some(exact) => {
+            let u = scalar_fn(&exact.solution);
+            let grad: Option<VectorFn> = exact.gradient.as_ref().map(|g| {
+                let g = g.clone();
+                let f: VectorFn = Arc::new(move |x: &[f64]| {
+                    let mut v = [0.0; 3];
+                    for (i, e) in g.iter().enumerate() {
+                        v[i] = e.eval(x, 0.0);
+                    }
+                    v
+                });
+                f
+            });
+            let errors = diffusion::errors(complex, &solution, &u, grad.as_ref());
+            let flux_error = grad
+                .as_ref()
+                .and_then(|g| diffusion::flux_error(complex, &solution, &problem, g));
+            let points = field_points(complex, field_dim);
+            let exact_values: Vec<f64> = points.iter().map(|x| u(x)).collect();
+            let mut difference: Vec<f64> =
+                field.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
+            if solution.pure_neumann {
+                // u is defined up to a constant: compare with the mean removed,
+                // as `errors` does.
+                let mean = difference.iter().sum::<f64>() / difference.len().max(1) as f64;
+                difference.iter_mut().for_each(|d| *d -= mean);
+            }
+            fields.push(Field {
+                name: "u_exact".into(),
+                dim: field_dim,
+                values: exact_values,
+                description: "the exact solution at the unknowns' points".into(),
+            });
+            fields.push(Field {
+                name: "error".into(),
+                dim: field_dim,
+                values: difference,
+                description: "u − u_exact".into(),
+            });
+            (Some(errors), flux_error)
+        }
+    };
+    timings.push(("post-processing".into(), post.elapsed().as_secs_f64()));
+    timings.push(("assembly + solve".into(), total));
+    Ok(RunResult {
+        problem: "diffusion".into(),
+        method: Some(spec.method.name().into()),
+        unknowns: solution.unknowns(),
+        fields,
+        errors,
+        flux_error,
+        relative_residual: Some(report.relative_residual),
+        factorization: Some(report.factorization),
+        timings,
+        warnings,
+        pure_neumann: solution.pure_neumann,
+    })
+}
+
+fn check_residual(case: &Case, residual: f64, warnings: &mut Vec<String>) -> Result<(), RunError> {
+    if !(residual <= case.solver.residual_limit) {
+        return Err(RunError::Solve(format!(
+            "relative residual {residual:.3e} exceeds solver.residual_limit = {:.1e}: the system is (nearly) singular or badly conditioned",
+            case.solver.residual_limit
+        )));
+    }
+    if residual > case.solver.residual_warning {
+        warnings.push(format!(
+            "relative residual {residual:.3e} is above solver.residual_warning = {:.1e}",
+            case.solver.residual_warning
+        ));
+    }
+    Ok(())
+}
+
+/// Where the values of a `dim`-cochain are sampled: vertices or centroids.
+fn field_points(complex: &Complex, dim: usize) -> Vec<Vec<f64>> {
+    let d = complex.embedding_dim();
+    if dim == 0 {
+        (0..complex.cell_count(0))
+            .map(|v| complex.vertices().point(v).to_vec())
+            .collect()
+    } else {
+        complex
+            .centroid(dim)
+            .chunks(d)
+            .map(<[f64]>::to_vec)
+            .collect()
+    }
+}
+
+/// Read a metric file: `row column value` per line, `#` comments.
+fn read_metric_file(path: &PathBuf, faces: usize) -> Result<Vec<(usize, usize, f64)>, RunError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| RunError::Input(format!("{}: cannot read: {e}", path.display())))?;
+    let mut entries = Vec::new();
+    for (number, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let bad = |what: String| {
+            RunError::Input(format!("{}:{}: {what}", path.display(), number + 1))
+        };
+        let parts: Vec<&str> = line.split_whitespace().collect();
+        if parts.len() != 3 {
+            return Err(bad(format!(
+                "expected `row column value`, found {} fields",
+                parts.len()
+            )));
+        }
+        let index = |s: &str| -> Result<usize, RunError> {
+            let i: usize = s
+                .parse()
+                .map_err(|_| bad(format!("`{s}` is not a face index")))?;
+            if i >= faces {
+                return Err(bad(format!(
+                    "face {i} does not exist (the mesh has {faces} faces, numbered from 0)"
+                )));
+            }
+            Ok(i)
+        };
+        let value: f64 = parts[2]
+            .parse()
+            .map_err(|_| bad(format!("`{}` is not a number", parts[2])))?;
+        if !value.is_finite() {
+            return Err(bad(format!("value {value} is not finite")));
+        }
+        entries.push((index(parts[0])?, index(parts[1])?, value));
+    }
+    Ok(entries)
+}
+
+/// g = −Ω ∂_nᵀ f: for an interior face F between cells c₁ (F oriented
+/// outward of c₁) and c₂, (∂_nᵀ f)_F = f(c₁) − f(c₂), so −∂_nᵀ f is the
+/// jump of f along F's normal and g approximates ∇f·n_F once Ω carries
+/// 1/distance. Boundary faces (one cell) get no row: g = 0 there.
+fn gradient(
+    case: &Case,
+    spec: &GradientSpec,
+    complex: &Complex,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    let _ = case;
+    phase("sampling and applying Ω δ");
+    let started = Instant::now();
+    let n = complex.dim();
+    if n == 0 {
+        return Err(RunError::Input(
+            "a gradient problem needs a mesh of dimension ≥ 1".into(),
+        ));
+    }
+    let points = field_points(complex, n);
+    let f: Vec<f64> = points.iter().map(|x| spec.field.eval(x, 0.0)).collect();
+    if let Some(c) = f.iter().position(|v| !v.is_finite()) {
+        return Err(RunError::Input(format!(
+            "problem.field is not finite ({}) at cell {c}, centroid {:?}",
+            f[c], points[c]
+        )));
+    }
+    let faces = complex.cell_count(n - 1);
+    // jump_F = Σ_c −∂(F,c) f_c over the face's cells, interior faces only.
+    let boundary = complex.boundary(n);
+    let mut jump = vec![0.0; faces];
+    let mut incident = vec![0u8; faces];
+    for (value, (face, cell)) in boundary.iter() {
+        jump[face] -= f64::from(*value) * f[cell];
+        incident[face] += 1;
+    }
+    for (j, &k) in jump.iter_mut().zip(&incident) {
+        if k != 2 {
+            *j = 0.0;
+        }
+    }
+    let g: Vec<f64> = match &spec.metric {
+        GradientMetric::Diagonal(sigma) => jump.iter().map(|j| sigma * j).collect(),
+        GradientMetric::TwoPoint => {
+            let d = complex.embedding_dim();
+            let centre = complex.centroid(n);
+            let csc = complex.boundary_csc(n);
+            let mut cells_of: Vec<Vec<usize>> = vec![Vec::new(); faces];
+            for c in 0..complex.cell_count(n) {
+                if let Some(col) = csc.outer_view(c) {
+                    for (face, _) in col.iter() {
+                        cells_of[face].push(c);
+                    }
+                }
+            }
+            jump.iter()
+                .enumerate()
+                .map(|(face, j)| match cells_of[face].as_slice() {
+                    [a, b] => {
+                        let distance: f64 = (0..d)
+                            .map(|k| (centre[a * d + k] - centre[b * d + k]).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        j / distance
+                    }
+                    _ => 0.0,
+                })
+                .collect()
+        }
+        GradientMetric::File { path, scale } => {
+            let entries = read_metric_file(path, faces)?;
+            let mut g = vec![0.0; faces];
+            for (row, col, value) in entries {
+                g[row] += scale * value * jump[col];
+            }
+            g
+        }
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    Ok(RunResult {
+        problem: "gradient".into(),
+        method: None,
+        unknowns: 0,
+        fields: vec![
+            Field {
+                name: "f".into(),
+                dim: n,
+                values: f,
+                description: "the field sampled at cell centroids".into(),
+            },
+            Field {
+                name: "jump".into(),
+                dim: n - 1,
+                values: jump,
+                description: "−∂ᵀ f: the jump of f across each interior face along its normal"
+                    .into(),
+            },
+            Field {
+                name: "normal_gradient".into(),
+                dim: n - 1,
+                values: g,
+                description: "Ω (−∂ᵀ f): the normal gradient as a face cochain".into(),
+            },
+        ],
+        errors: None,
+        flux_error: None,
+        relative_residual: None,
+        factorization: None,
+        timings: vec![("sample + Ω δ".into(), seconds)],
+        warnings: Vec::new(),
+        pure_neumann: false,
+    })
+}
+
+impl fmt::Display for RunResult {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.method {
+            Some(m) => writeln!(f, "problem    {} ({m})", self.problem)?,
+            None => writeln!(f, "problem    {}", self.problem)?,
+        }
+        if self.unknowns > 0 {
+            write!(f, "unknowns   {}", self.unknowns)?;
+            if let Some(fact) = self.factorization {
+                write!(f, ", solver {fact}")?;
+            }
+            if let Some(r) = self.relative_residual {
+                write!(f, ", relative residual {r:.2e}")?;
+            }
+            writeln!(f)?;
+        }
+        if let Some(e) = &self.errors {
+            writeln!(
+                f,
+                "error      L2 {:.6e}, max {:.6e}, gradient L2 {:.6e}",
+                e.l2, e.max, e.gradient_l2
+            )?;
+        }
+        if let Some(q) = self.flux_error {
+            writeln!(f, "flux error L2 {q:.6e}")?;
+        }
+        let timing: Vec<String> = self
+            .timings
+            .iter()
+            .map(|(name, s)| format!("{name} {s:.3} s"))
+            .collect();
+        writeln!(f, "timing     {}", timing.join(", "))?;
+        for w in &self.warnings {
+            writeln!(f, "warning    {w}")?;
+        }
+        Ok(())
+    }
+}
+
+impl RunResult {
+    /// The report stored with the output (and printed by `-v`), as JSON.
+    pub fn report_json(&self, complex: &Complex) -> serde_json::Value {
+        let errors = self.errors.map(|e| {
+            serde_json::json!({"l2": e.l2, "max": e.max, "gradient_l2": e.gradient_l2})
+        });
+        let timings: serde_json::Map<String, serde_json::Value> = self
+            .timings
+            .iter()
+            .map(|(name, s)| (name.clone(), serde_json::json!(s)))
+            .collect();
+        serde_json::json!({
+            "problem": self.problem,
+            "method": self.method,
+            "cells_per_dimension": complex.cell_counts(),
+            "unknowns": self.unknowns,
+            "factorization": self.factorization.map(|f| f.to_string()),
+            "relative_residual": self.relative_residual,
+            "errors": errors,
+            "flux_error": self.flux_error,
+            "pure_neumann": self.pure_neumann,
+            "timings_seconds": timings,
+            "warnings": self.warnings,
+        })
+    }
+}
+
+/// Write the run's fields, mesh and provenance to `<stem>.h5` and
+/// `<stem>.xdmf` (atomically: nothing appears under those names unless
+/// both were written completely).
+pub fn write_output(
+    case: &Case,
+    complex: &Complex,
+    result: &RunResult,
+    stem: &std::path::Path,
+) -> Result<crate::output::OutputFiles, crate::output::OutputError> {
+    use crate::output::{Cochain, Provenance, RunOutput, Step};
+    let cochains = result
+        .fields
+        .iter()
+        .map(|f| {
+            let c = Cochain::new(f.name.clone(), f.dim, f.values.clone())
+                .with_description(f.description.clone());
+            match &result.method {
+                Some(m) => c.with_method(m.clone()),
+                None => c,
+            }
+        })
+        .collect();
+    let mut provenance = Provenance::new(result.report_json(complex));
+    provenance.case_text = Some(case.text.clone());
+    provenance.case_path = Some(case.path.display().to_string());
+    let run = RunOutput {
+        complex,
+        steps: vec![Step {
+            time: 0.0,
+            cochains,
+        }],
+        provenance,
+    };
+    crate::output::write_run(stem, &run)
+}
