@@ -10,3 +10,4 @@ pub mod info;
 pub mod linear;
 pub mod mesh_spec;
 pub mod metric;
+pub mod output;
