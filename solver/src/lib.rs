@@ -2,7 +2,7 @@
 //!
 //! The canonical form δΩ∂ = Aᵀ Ω A on cell complexes: the operator type,
 //! the metrics Ω of FD, FE, FV and DEC, boundary conditions, faer solves,
-//! case files and the `hasse` command line.
+//! case files, output and the `hasse` command line.
 
 pub mod canonical;
 pub mod case;
@@ -11,4 +11,5 @@ pub mod info;
 pub mod linear;
 pub mod mesh_spec;
 pub mod metric;
+pub mod output;
 pub mod run;

@@ -1,0 +1,270 @@
+//! The HDF5 file of a run; the layout is documented on the `output` module.
+
+use super::topology::GridTopology;
+use super::xdmf::{center, Center};
+use super::{OutputError, RunOutput};
+use hdf5::types::VarLenUnicode;
+use hdf5::{Group, H5Type, Location};
+use ndarray::ArrayView2;
+use sprs::CsMat;
+use std::borrow::Cow;
+use std::path::Path;
+
+/// Version of the layout below `/`; bumped when a reader would need to change.
+pub(crate) const FORMAT_VERSION: u64 = 1;
+
+/// Attach the file path to an HDF5 error.
+trait At<T> {
+    fn at(self, path: &Path) -> Result<T, OutputError>;
+}
+
+impl<T> At<T> for hdf5::Result<T> {
+    fn at(self, path: &Path) -> Result<T, OutputError> {
+        self.map_err(|e| OutputError::Hdf5 {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })
+    }
+}
+
+struct Writer<'p> {
+    path: &'p Path,
+}
+
+impl Writer<'_> {
+    fn group(&self, parent: &Group, name: &str) -> Result<Group, OutputError> {
+        parent.create_group(name).at(self.path)
+    }
+
+    fn vector<T: H5Type>(&self, g: &Group, name: &str, data: &[T]) -> Result<(), OutputError> {
+        g.new_dataset_builder()
+            .with_data(data)
+            .create(name)
+            .at(self.path)
+            .map(|_| ())
+    }
+
+    fn matrix<T: H5Type>(
+        &self,
+        g: &Group,
+        name: &str,
+        data: &[T],
+        columns: usize,
+    ) -> Result<(), OutputError> {
+        let rows = data.len().checked_div(columns).unwrap_or(0);
+        let view =
+            ArrayView2::from_shape((rows, columns), data).map_err(|e| OutputError::Hdf5 {
+                path: self.path.to_path_buf(),
+                message: format!("dataset {name}: {e}"),
+            })?;
+        g.new_dataset_builder()
+            .with_data(view)
+            .create(name)
+            .at(self.path)
+            .map(|_| ())
+    }
+
+    fn scalar_attr<T: H5Type>(
+        &self,
+        loc: &Location,
+        name: &str,
+        value: T,
+    ) -> Result<(), OutputError> {
+        loc.new_attr::<T>()
+            .shape(())
+            .create(name)
+            .and_then(|a| a.write_scalar(&value))
+            .at(self.path)
+    }
+
+    fn array_attr<T: H5Type>(
+        &self,
+        loc: &Location,
+        name: &str,
+        data: &[T],
+    ) -> Result<(), OutputError> {
+        loc.new_attr_builder()
+            .with_data(data)
+            .create(name)
+            .at(self.path)
+            .map(|_| ())
+    }
+
+    fn text(field: &str, value: &str) -> Result<VarLenUnicode, OutputError> {
+        value
+            .parse::<VarLenUnicode>()
+            .map_err(|e| OutputError::Text {
+                field: field.to_string(),
+                reason: e.to_string(),
+            })
+    }
+
+    fn string_attr(&self, loc: &Location, name: &str, value: &str) -> Result<(), OutputError> {
+        let s = Self::text(name, value)?;
+        self.scalar_attr(loc, name, s)
+    }
+
+    /// Long text goes in datasets: attributes are limited to 64 KiB.
+    fn string_dataset(&self, g: &Group, name: &str, value: &str) -> Result<(), OutputError> {
+        let s = Self::text(name, value)?;
+        g.new_dataset::<VarLenUnicode>()
+            .shape(())
+            .create(name)
+            .and_then(|d| d.write_scalar(&s))
+            .at(self.path)
+    }
+
+    /// A sparse matrix as CSR datasets `indptr`, `indices` (and `data`).
+    fn csr<T: Copy + Default + H5Type>(
+        &self,
+        g: &Group,
+        m: &CsMat<T>,
+        with_data: bool,
+    ) -> Result<(), OutputError> {
+        let m: Cow<CsMat<T>> = if m.is_csr() {
+            Cow::Borrowed(m)
+        } else {
+            Cow::Owned(m.to_csr())
+        };
+        let indptr: Vec<u64> = m.indptr().to_proper().iter().map(|&x| x as u64).collect();
+        let indices: Vec<u64> = m.indices().iter().map(|&x| x as u64).collect();
+        self.vector(g, "indptr", &indptr)?;
+        self.vector(g, "indices", &indices)?;
+        if with_data {
+            self.vector(g, "data", m.data())?;
+        }
+        self.array_attr(g, "shape", &[m.rows() as u64, m.cols() as u64])
+    }
+}
+
+/// Write the whole h5 file at `path` (a temporary name) and close it.
+pub(crate) fn write(
+    path: &Path,
+    run: &RunOutput,
+    grids: &[GridTopology],
+    written_at: &str,
+) -> Result<(), OutputError> {
+    let file = hdf5::File::create(path).at(path)?;
+    write_contents(&Writer { path }, &file, run, grids, written_at)?;
+    file.flush().at(path)?;
+    file.close().at(path)
+}
+
+fn write_contents(
+    w: &Writer,
+    root: &Group,
+    run: &RunOutput,
+    grids: &[GridTopology],
+    written_at: &str,
+) -> Result<(), OutputError> {
+    let complex = run.complex;
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let times: Vec<f64> = run.steps.iter().map(|s| s.time).collect();
+    w.string_attr(root, "format", "hasse-output")?;
+    w.scalar_attr(root, "format_version", FORMAT_VERSION)?;
+    w.scalar_attr(root, "step_count", run.steps.len() as u64)?;
+    w.array_attr(root, "times", &times)?;
+
+    let mesh = w.group(root, "mesh")?;
+    w.scalar_attr(&mesh, "dim", n as u64)?;
+    w.scalar_attr(&mesh, "embedding_dim", d as u64)?;
+    let nv = complex.cell_count(0);
+    let mut xyz = vec![0.0; nv * 3];
+    for v in 0..nv {
+        xyz[3 * v..3 * v + d].copy_from_slice(complex.vertices().point(v));
+    }
+    w.matrix(&mesh, "vertices", &xyz, 3)?;
+    let vertices = mesh.dataset("vertices").at(w.path)?;
+    w.scalar_attr(&vertices, "embedding_dim", d as u64)?;
+
+    let cells = w.group(&mesh, "cells")?;
+    let identity = CsMat::new(
+        (nv, nv),
+        (0..=nv).collect(),
+        (0..nv).collect(),
+        vec![1u8; nv],
+    );
+    w.csr(&w.group(&cells, "0")?, &identity, false)?;
+    for p in 1..=n {
+        let m = complex
+            .lar()
+            .characteristic(p)
+            .map_err(|e| OutputError::Topology {
+                message: e.to_string(),
+            })?;
+        w.csr(&w.group(&cells, &p.to_string())?, m, false)?;
+    }
+    let boundary = w.group(&mesh, "boundary")?;
+    for p in 1..=n {
+        w.csr(
+            &w.group(&boundary, &p.to_string())?,
+            complex.boundary(p),
+            true,
+        )?;
+    }
+    let tags = w.group(&mesh, "tags")?;
+    for (name, tag) in complex.tags().iter() {
+        let ids: Vec<u64> = tag.cells.iter().map(|&c| c as u64).collect();
+        w.vector(&tags, name, &ids)?;
+        let ds = tags.dataset(name).at(w.path)?;
+        w.scalar_attr(&ds, "dim", tag.dim as u64)?;
+    }
+
+    let steps = w.group(root, "steps")?;
+    for (k, step) in run.steps.iter().enumerate() {
+        let g = w.group(&steps, &k.to_string())?;
+        w.scalar_attr(&g, "time", step.time)?;
+        for c in &step.cochains {
+            w.vector(&g, &c.name, &c.values)?;
+            let ds = g.dataset(&c.name).at(w.path)?;
+            w.scalar_attr(&ds, "dim", c.dim as u64)?;
+            for (key, value) in [
+                ("units", &c.units),
+                ("method", &c.method),
+                ("description", &c.description),
+            ] {
+                if let Some(value) = value {
+                    w.string_attr(&ds, key, value)?;
+                }
+            }
+        }
+    }
+
+    let prov = w.group(root, "provenance")?;
+    let p = &run.provenance;
+    w.string_attr(&prov, "hasse_version", &p.hasse_version)?;
+    w.string_attr(&prov, "written_at", written_at)?;
+    if let Some(path) = &p.case_path {
+        w.string_attr(&prov, "case_path", path)?;
+    }
+    if let Some(text) = &p.case_text {
+        w.string_dataset(&prov, "case_text", text)?;
+    }
+    w.string_dataset(&prov, "report", &p.report.to_string())?;
+
+    let xdmf = w.group(root, "xdmf")?;
+    for grid in grids {
+        let g = w.group(&xdmf, &grid.degree.to_string())?;
+        match grid.uniform {
+            Some((_, nodes)) => w.matrix(&g, "topology", &grid.connectivity, nodes)?,
+            None => w.vector(&g, "topology", &grid.connectivity)?,
+        }
+        let Some(cell_ids) = &grid.cell_ids else {
+            continue;
+        };
+        w.vector(&g, "cell_ids", cell_ids)?;
+        let expanded = w.group(&g, "steps")?;
+        for (k, step) in run.steps.iter().enumerate() {
+            let sg = w.group(&expanded, &k.to_string())?;
+            for c in &step.cochains {
+                if center(grid, n, c) != Some(Center::Cell) {
+                    continue;
+                }
+                let values: Vec<f64> = cell_ids.iter().map(|&i| c.values[i as usize]).collect();
+                w.vector(&sg, &c.name, &values)?;
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,447 @@
+//! Output of a run: one HDF5 file holding the complex, every cochain of
+//! every time level and the provenance, plus an XDMF 3 file beside it so
+//! ParaView, VisIt and meshio open the same data.
+//!
+//! # HDF5 layout (`<stem>.h5`)
+//!
+//! Everything is readable with h5py alone; `cases/OUTPUT.md` has examples.
+//!
+//! | path | content |
+//! | --- | --- |
+//! | `/` attrs `step_count` (u64), `times` (f64 array), `format` = `"hasse-output"`, `format_version` (u64) | |
+//! | `/mesh` attrs `dim` (n), `embedding_dim` (d) | |
+//! | `/mesh/vertices` | (N, 3) f64, zero-padded when d < 3; attr `embedding_dim` |
+//! | `/mesh/cells/<p>/indptr`, `indices` | CSR characteristic matrix M_p (u64), p = 0..=n; attr `shape` = (rows, cols). Row i lists the sorted vertex ids of p-cell i; p-cell ids everywhere else are these row numbers |
+//! | `/mesh/boundary/<p>/indptr`, `indices` (u64), `data` (i8) | signed ∂_p in CSR, rows (p-1)-cells, columns p-cells, p = 1..=n; attr `shape` |
+//! | `/mesh/tags/<name>` | u64 ids of the tagged cells; attr `dim` |
+//! | `/steps/<k>` attr `time` | one group per time level k = 0, 1, … |
+//! | `/steps/<k>/<name>` | f64 cochain, one value per p-cell; attrs `dim`, and `units`, `method`, `description` when given |
+//! | `/provenance` attrs `hasse_version`, `written_at` (RFC 3339 UTC), `case_path` (if known) | |
+//! | `/provenance/case_text`, `/provenance/report` | scalar UTF-8 string datasets (the case file, the run report as JSON) |
+//! | `/xdmf/<p>/topology` | connectivity of the XDMF grid of the p-cells (i64), see below |
+//! | `/xdmf/<p>/cell_ids` | only when the grid's elements are not the p-cells one to one: the p-cell of each element |
+//! | `/xdmf/<p>/steps/<k>/<name>` | only with `cell_ids`: the cochain expanded to the elements |
+//!
+//! Strings are variable-length UTF-8, so h5py returns attributes as `str`
+//! (string datasets need `.asstr()[()]`).
+//!
+//! # XDMF (`<stem>.xdmf`)
+//!
+//! ParaView and VisIt ignore `Center="Edge"`/`"Face"`, so each cochain
+//! degree gets its own grid with ordinary cell data: the top cells
+//! (carrying the top-degree cochains as cell data and the 0-cochains as
+//! point data), the edges as 2-node polylines when n ≥ 2 and there are
+//! 1-cochains, and the faces as polygons when n = 3 and there are
+//! 2-cochains. Cells are written with VTK vertex order (cyclic polygons,
+//! VTK hexahedra, positive tetrahedra), rebuilt from ∂ since hasse keeps
+//! only sorted vertex sets. Triangles, quadrilaterals, tetrahedra and
+//! hexahedra keep their own types (uniform topology when all cells agree,
+//! `Mixed` otherwise); polygons with five or more vertices are XDMF
+//! `Polygon` cells; other convex polyhedra are split into tetrahedra from
+//! their lowest vertex (XDMF `Polyhedron` is read by neither meshio nor
+//! reliably by ParaView), with `cell_ids` mapping elements back.
+//!
+//! One time level gives plain uniform grids (a spatial collection holding
+//! them, top grid first, when there are several degrees). Several levels
+//! give one temporal collection per degree grid, the top-cell collection
+//! last, because meshio's `TimeSeriesReader` reads the last collection of
+//! the domain.
+
+mod hdf5_file;
+mod topology;
+mod xdmf;
+
+use hasse_complex::Complex;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+/// One cochain: values on the p-cells of the complex (`values.len() == complex.cell_count(dim)`).
+///
+/// ```
+/// use hasse_solver::output::Cochain;
+/// let u = Cochain::new("u", 0, vec![0.0, 1.0, 2.0]).with_units("K");
+/// assert_eq!(u.units.as_deref(), Some("K"));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cochain {
+    /// Name of the field; unique within a step, used as HDF5 and XDMF name.
+    pub name: String,
+    /// Degree p: the values live on the p-cells.
+    pub dim: usize,
+    /// One value per p-cell, in cell-id order.
+    pub values: Vec<f64>,
+    /// Physical units, e.g. `"K"`.
+    pub units: Option<String>,
+    /// Discretisation that produced the values, e.g. `"fe"`.
+    pub method: Option<String>,
+    /// Free text.
+    pub description: Option<String>,
+}
+
+impl Cochain {
+    /// A cochain without metadata.
+    pub fn new(name: impl Into<String>, dim: usize, values: Vec<f64>) -> Self {
+        Self {
+            name: name.into(),
+            dim,
+            values,
+            units: None,
+            method: None,
+            description: None,
+        }
+    }
+
+    /// The same cochain with its units set.
+    pub fn with_units(mut self, units: impl Into<String>) -> Self {
+        self.units = Some(units.into());
+        self
+    }
+
+    /// The same cochain with the method that produced it.
+    pub fn with_method(mut self, method: impl Into<String>) -> Self {
+        self.method = Some(method.into());
+        self
+    }
+
+    /// The same cochain with a description.
+    pub fn with_description(mut self, description: impl Into<String>) -> Self {
+        self.description = Some(description.into());
+        self
+    }
+}
+
+/// One time level (a steady run has exactly one step with time 0.0).
+///
+/// ```
+/// use hasse_solver::output::{Cochain, Step};
+/// let step = Step { time: 0.5, cochains: vec![Cochain::new("u", 0, vec![1.0])] };
+/// assert_eq!(step.cochains.len(), 1);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    /// Time of the level; times must be finite and strictly increasing.
+    pub time: f64,
+    /// The fields at this time.
+    pub cochains: Vec<Cochain>,
+}
+
+/// Where a run came from, stored under `/provenance`.
+///
+/// ```
+/// use hasse_solver::output::Provenance;
+/// let p = Provenance::new(serde_json::json!({"iterations": 3}));
+/// assert_eq!(p.hasse_version, env!("CARGO_PKG_VERSION"));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Provenance {
+    /// Full text of the case file.
+    pub case_text: Option<String>,
+    /// Path of the case file as given.
+    pub case_path: Option<String>,
+    /// Version of hasse that wrote the file.
+    pub hasse_version: String,
+    /// The run report (errors, iterations, timings…), stored as JSON text.
+    pub report: serde_json::Value,
+}
+
+impl Provenance {
+    /// Provenance of this build of hasse with the given report and no case file.
+    pub fn new(report: serde_json::Value) -> Self {
+        Self {
+            case_text: None,
+            case_path: None,
+            hasse_version: env!("CARGO_PKG_VERSION").to_string(),
+            report,
+        }
+    }
+}
+
+/// Everything [`write_run`] stores: the complex, the time levels and the provenance.
+///
+/// ```
+/// use hasse_solver::output::{Provenance, RunOutput};
+/// let k = hasse_complex::generate::interval(2, 0.0, 1.0).unwrap();
+/// let run = RunOutput { complex: &k, steps: vec![], provenance: Provenance::new(serde_json::Value::Null) };
+/// assert!(run.steps.is_empty());
+/// ```
+#[derive(Clone, Debug)]
+pub struct RunOutput<'a> {
+    pub complex: &'a Complex,
+    pub steps: Vec<Step>,
+    pub provenance: Provenance,
+}
+
+/// The two files [`write_run`] wrote.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OutputFiles {
+    pub hdf5: PathBuf,
+    pub xdmf: PathBuf,
+}
+
+/// Why an output could not be written. Nothing is left under the final
+/// file names when any of these is returned.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("{path}: HDF5 error: {message}")]
+    Hdf5 { path: PathBuf, message: String },
+    #[error(
+        "cochain '{name}' of degree {dim} has {got} values, the complex has {expected} {dim}-cells"
+    )]
+    Shape {
+        name: String,
+        dim: usize,
+        expected: usize,
+        got: usize,
+    },
+    #[error("cochain '{name}' has degree {dim}, the complex has dimension {complex_dim}")]
+    Degree {
+        name: String,
+        dim: usize,
+        complex_dim: usize,
+    },
+    #[error(
+        "cochain '{name}' (step {step}) has the non-finite value {value} on {dim}-cell {cell}"
+    )]
+    NonFinite {
+        step: usize,
+        name: String,
+        dim: usize,
+        cell: usize,
+        value: f64,
+    },
+    #[error("step {step} has two cochains named '{name}'")]
+    DuplicateName { step: usize, name: String },
+    #[error("cochain name '{name}' cannot be stored: {reason}")]
+    InvalidName { name: String, reason: &'static str },
+    #[error("step {step} has time {time}: times must be finite and strictly increasing")]
+    Time { step: usize, time: f64 },
+    #[error("output stem '{path}' has no file name")]
+    Stem { path: PathBuf },
+    #[error("{field} cannot be stored as an HDF5 string: {reason}")]
+    Text { field: String, reason: String },
+    #[error("cannot write the XDMF cells: {message}")]
+    Topology { message: String },
+}
+
+/// Writes `<stem>.h5` and `<stem>.xdmf` (stem may include a directory,
+/// created if missing) and returns their paths.
+///
+/// Inputs are checked before anything is written. Both files are first
+/// written under temporary names in the target directory and renamed into
+/// place only when complete, so an error never leaves a truncated file and
+/// never replaces an older output.
+///
+/// ```
+/// use hasse_solver::output::{write_run, Cochain, Provenance, RunOutput, Step};
+/// let k = hasse_complex::generate::rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// let x: Vec<f64> = (0..k.cell_count(0)).map(|v| k.vertices().point(v)[0]).collect();
+/// let run = RunOutput {
+///     complex: &k,
+///     steps: vec![Step { time: 0.0, cochains: vec![Cochain::new("x", 0, x)] }],
+///     provenance: Provenance::new(serde_json::json!({"note": "doctest"})),
+/// };
+/// let dir = std::env::temp_dir().join(format!("hasse-doc-{}", std::process::id()));
+/// let files = write_run(&dir.join("run"), &run).unwrap();
+/// assert!(files.hdf5.ends_with("run.h5") && files.xdmf.exists());
+/// let xdmf = std::fs::read_to_string(&files.xdmf).unwrap();
+/// assert!(xdmf.contains("run.h5:/steps/0/x"));
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputError> {
+    validate(run)?;
+    let file_name = stem
+        .file_name()
+        .and_then(|s| s.to_str())
+        .ok_or_else(|| OutputError::Stem {
+            path: stem.to_path_buf(),
+        })?
+        .to_string();
+    let dir = match stem.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let grids = xdmf::grids(run)?;
+
+    std::fs::create_dir_all(&dir).map_err(|source| OutputError::Io {
+        path: dir.clone(),
+        source,
+    })?;
+    let h5_name = format!("{file_name}.h5");
+    let xdmf_name = format!("{file_name}.xdmf");
+    let final_h5 = dir.join(&h5_name);
+    let final_xdmf = dir.join(&xdmf_name);
+    let pid = std::process::id();
+    let mut temps = Temporaries(vec![
+        dir.join(format!(".{h5_name}.tmp-{pid}")),
+        dir.join(format!(".{xdmf_name}.tmp-{pid}")),
+    ]);
+
+    hdf5_file::write(&temps.0[0], run, &grids, &rfc3339_now())?;
+    let text = xdmf::document(run, &grids, &h5_name);
+    std::fs::write(&temps.0[1], text).map_err(|source| OutputError::Io {
+        path: temps.0[1].clone(),
+        source,
+    })?;
+
+    // The h5 goes first: an xdmf must never point at a file that is not there.
+    rename(&temps.0[0], &final_h5)?;
+    temps.0.remove(0);
+    rename(&temps.0[0], &final_xdmf)?;
+    temps.0.clear();
+    Ok(OutputFiles {
+        hdf5: final_h5,
+        xdmf: final_xdmf,
+    })
+}
+
+fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
+    std::fs::rename(from, to).map_err(|source| OutputError::Io {
+        path: to.to_path_buf(),
+        source,
+    })
+}
+
+/// Temporary files removed on drop unless taken out of the list.
+struct Temporaries(Vec<PathBuf>);
+
+impl Drop for Temporaries {
+    fn drop(&mut self) {
+        for path in &self.0 {
+            // Best effort: the file may not have been created yet.
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
+fn validate(run: &RunOutput) -> Result<(), OutputError> {
+    let complex = run.complex;
+    let mut previous: Option<f64> = None;
+    for (k, step) in run.steps.iter().enumerate() {
+        if !step.time.is_finite() || previous.is_some_and(|t| step.time <= t) {
+            return Err(OutputError::Time {
+                step: k,
+                time: step.time,
+            });
+        }
+        previous = Some(step.time);
+        let mut names = HashSet::new();
+        for c in &step.cochains {
+            check_name(&c.name)?;
+            if !names.insert(c.name.as_str()) {
+                return Err(OutputError::DuplicateName {
+                    step: k,
+                    name: c.name.clone(),
+                });
+            }
+            if c.dim > complex.dim() {
+                return Err(OutputError::Degree {
+                    name: c.name.clone(),
+                    dim: c.dim,
+                    complex_dim: complex.dim(),
+                });
+            }
+            let expected = complex.cell_count(c.dim);
+            if c.values.len() != expected {
+                return Err(OutputError::Shape {
+                    name: c.name.clone(),
+                    dim: c.dim,
+                    expected,
+                    got: c.values.len(),
+                });
+            }
+            if let Some(cell) = c.values.iter().position(|v| !v.is_finite()) {
+                return Err(OutputError::NonFinite {
+                    step: k,
+                    name: c.name.clone(),
+                    dim: c.dim,
+                    cell,
+                    value: c.values[cell],
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Names become HDF5 link names and XML attribute values.
+fn check_name(name: &str) -> Result<(), OutputError> {
+    let reason = if name.is_empty() {
+        Some("it is empty")
+    } else if name == "." || name == ".." {
+        Some("'.' and '..' are HDF5 path components")
+    } else if name.contains('/') {
+        Some("'/' separates HDF5 groups")
+    } else if name.contains(':') {
+        Some("':' separates file and path in XDMF data references")
+    } else if name.chars().any(char::is_control) {
+        Some("it contains a control character")
+    } else {
+        None
+    };
+    match reason {
+        Some(reason) => Err(OutputError::InvalidName {
+            name: name.to_string(),
+            reason,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The current time as RFC 3339 UTC (`YYYY-MM-DDTHH:MM:SSZ`).
+fn rfc3339_now() -> String {
+    let seconds = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    rfc3339(seconds)
+}
+
+/// Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
+fn rfc3339(seconds: u64) -> String {
+    let days = (seconds / 86_400) as i64;
+    let rem = seconds % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        (rem / 60) % 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rfc3339_matches_known_dates() {
+        assert_eq!(rfc3339(0), "1970-01-01T00:00:00Z");
+        // 2000-02-29 is a leap day of a century leap year.
+        assert_eq!(rfc3339(951_782_400 + 3661), "2000-02-29T01:01:01Z");
+        assert_eq!(rfc3339(1_700_000_000), "2023-11-14T22:13:20Z");
+    }
+
+    #[test]
+    fn names_that_break_paths_are_rejected() {
+        for bad in ["", ".", "a/b", "a:b", "a\nb"] {
+            assert!(matches!(
+                check_name(bad),
+                Err(OutputError::InvalidName { .. })
+            ));
+        }
+        assert!(check_name("u_h (K)").is_ok());
+    }
+}

@@ -1,0 +1,659 @@
+//! `output::write_run` read back with the `hdf5` crate: every array is
+//! compared exactly with the complex it came from or with the analytic
+//! formula the cochain was filled with, the XDMF text is checked for the
+//! grids and topology arrays a reader needs, and failed writes are shown
+//! to leave no file behind and an older output untouched.
+
+use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
+use hasse_complex::{Complex, TopCells, Vertices};
+use hasse_solver::output::{write_run, Cochain, OutputError, Provenance, RunOutput, Step};
+use hdf5::types::VarLenUnicode;
+use sprs::CsMat;
+use std::path::{Path, PathBuf};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("output_files-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn files_in(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .map(|r| {
+            r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect()
+        })
+        .unwrap_or_default();
+    names.sort();
+    names
+}
+
+fn point(k: &Complex, v: usize) -> [f64; 3] {
+    let mut p = [0.0; 3];
+    p[..k.embedding_dim()].copy_from_slice(k.vertices().point(v));
+    p
+}
+
+/// x + 2y − z at every vertex.
+fn linear(k: &Complex) -> Vec<f64> {
+    (0..k.cell_count(0))
+        .map(|v| {
+            let p = point(k, v);
+            p[0] + 2.0 * p[1] - p[2]
+        })
+        .collect()
+}
+
+fn index_cochain(k: &Complex, p: usize) -> Vec<f64> {
+    (0..k.cell_count(p)).map(|i| i as f64).collect()
+}
+
+fn run<'a>(k: &'a Complex, steps: Vec<Step>) -> RunOutput<'a> {
+    RunOutput {
+        complex: k,
+        steps,
+        provenance: Provenance {
+            case_text: Some("[mesh]\nkind = \"test\" # ünïcode\n".into()),
+            case_path: Some("cases/test.toml".into()),
+            hasse_version: "9.9.9-test".into(),
+            report: serde_json::json!({"iterations": 7, "residual": 1e-12}),
+        },
+    }
+}
+
+fn steady(k: &Complex, cochains: Vec<Cochain>) -> RunOutput<'_> {
+    run(
+        k,
+        vec![Step {
+            time: 0.0,
+            cochains,
+        }],
+    )
+}
+
+fn read_u64(f: &hdf5::File, path: &str) -> Vec<u64> {
+    f.dataset(path).unwrap().read_raw::<u64>().unwrap()
+}
+
+fn read_f64(f: &hdf5::File, path: &str) -> Vec<f64> {
+    f.dataset(path).unwrap().read_raw::<f64>().unwrap()
+}
+
+fn read_i64(f: &hdf5::File, path: &str) -> Vec<i64> {
+    f.dataset(path).unwrap().read_raw::<i64>().unwrap()
+}
+
+fn str_attr(loc: &hdf5::Location, name: &str) -> String {
+    loc.attr(name)
+        .unwrap()
+        .read_scalar::<VarLenUnicode>()
+        .unwrap()
+        .as_str()
+        .to_string()
+}
+
+fn usizes(v: &[u64]) -> Vec<usize> {
+    v.iter().map(|&x| x as usize).collect()
+}
+
+/// The mesh part of the file equals the complex: coordinates, every M_p and
+/// every ∂_p rebuilt as a `CsMat` and compared with `complex.boundary(p)`.
+fn check_mesh(f: &hdf5::File, k: &Complex) {
+    let n = k.dim();
+    let mesh = f.group("mesh").unwrap();
+    assert_eq!(
+        mesh.attr("dim").unwrap().read_scalar::<u64>().unwrap(),
+        n as u64
+    );
+    let vertices = f.dataset("mesh/vertices").unwrap();
+    assert_eq!(vertices.shape(), vec![k.cell_count(0), 3]);
+    let xyz = vertices.read_raw::<f64>().unwrap();
+    for v in 0..k.cell_count(0) {
+        assert_eq!(&xyz[3 * v..3 * v + 3], &point(k, v));
+    }
+    for p in 0..=n {
+        let indptr = usizes(&read_u64(f, &format!("mesh/cells/{p}/indptr")));
+        let indices = usizes(&read_u64(f, &format!("mesh/cells/{p}/indices")));
+        assert_eq!(indptr.len(), k.cell_count(p) + 1);
+        for i in 0..k.cell_count(p) {
+            assert_eq!(&indices[indptr[i]..indptr[i + 1]], k.cell_vertices(p, i));
+        }
+    }
+    for p in 1..=n {
+        let g = format!("mesh/boundary/{p}");
+        let shape: Vec<u64> = f
+            .group(&g)
+            .unwrap()
+            .attr("shape")
+            .unwrap()
+            .read_raw()
+            .unwrap();
+        let data = f
+            .dataset(&format!("{g}/data"))
+            .unwrap()
+            .read_raw::<i8>()
+            .unwrap();
+        let m = CsMat::new(
+            (shape[0] as usize, shape[1] as usize),
+            usizes(&read_u64(f, &format!("{g}/indptr"))),
+            usizes(&read_u64(f, &format!("{g}/indices"))),
+            data,
+        );
+        assert_eq!(&m, k.boundary(p));
+        assert_eq!((m.rows(), m.cols()), (k.cell_count(p - 1), k.cell_count(p)));
+    }
+}
+
+fn shoelace(points: &[[f64; 3]]) -> f64 {
+    (0..points.len())
+        .map(|i| {
+            let (a, b) = (points[i], points[(i + 1) % points.len()]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum::<f64>()
+        / 2.0
+}
+
+fn vol6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
+    let (u, v, w) = (
+        [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+        [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+        [d[0] - a[0], d[1] - a[1], d[2] - a[2]],
+    );
+    u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+        + u[2] * (v[0] * w[1] - v[1] * w[0])
+}
+
+/// Tags are balanced and every opened element is closed in order.
+fn assert_well_formed(xml: &str) {
+    assert!(xml.starts_with("<?xml version=\"1.0\""));
+    let mut stack: Vec<String> = Vec::new();
+    let mut rest = xml;
+    while let Some(start) = rest.find('<') {
+        let end = rest[start..].find('>').expect("unclosed tag") + start;
+        let tag = &rest[start + 1..end];
+        rest = &rest[end + 1..];
+        if tag.starts_with('?') {
+            continue;
+        }
+        let name: String = tag
+            .trim_start_matches('/')
+            .chars()
+            .take_while(|c| c.is_alphanumeric())
+            .collect();
+        if tag.starts_with('/') {
+            assert_eq!(
+                stack.pop().as_deref(),
+                Some(name.as_str()),
+                "mismatched </{name}>"
+            );
+        } else if !tag.ends_with('/') {
+            stack.push(name);
+        }
+        assert!(!tag.contains('<'), "'<' inside a tag");
+    }
+    assert!(stack.is_empty(), "unclosed elements {stack:?}");
+}
+
+#[test]
+fn quad_grid_round_trips_exactly() {
+    let k = rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+    let dir = scratch("quad");
+    let u = Cochain::new("u", 0, linear(&k))
+        .with_units("K")
+        .with_method("fe")
+        .with_description("x + 2y");
+    let q = Cochain::new("flux", 1, index_cochain(&k, 1));
+    let c = Cochain::new("cell id", 2, index_cochain(&k, 2));
+    let files = write_run(&dir.join("quad"), &steady(&k, vec![u, q, c])).unwrap();
+    assert_eq!(files.hdf5, dir.join("quad.h5"));
+    assert_eq!(files_in(&dir), ["quad.h5", "quad.xdmf"]);
+
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    check_mesh(&f, &k);
+    assert_eq!(
+        f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
+        1
+    );
+    assert_eq!(f.attr("times").unwrap().read_raw::<f64>().unwrap(), [0.0]);
+    let step = f.group("steps/0").unwrap();
+    assert_eq!(
+        step.attr("time").unwrap().read_scalar::<f64>().unwrap(),
+        0.0
+    );
+    let xyz = read_f64(&f, "mesh/vertices");
+    let expected: Vec<f64> = xyz.chunks(3).map(|p| p[0] + 2.0 * p[1]).collect();
+    assert_eq!(read_f64(&f, "steps/0/u"), expected);
+    // Vertex 11 is the corner (3, 2) in x-fastest numbering: 3 + 2·2.
+    assert_eq!(read_f64(&f, "steps/0/u")[11], 7.0);
+    let u = f.dataset("steps/0/u").unwrap();
+    assert_eq!(u.attr("dim").unwrap().read_scalar::<u64>().unwrap(), 0);
+    assert_eq!(str_attr(&u, "units"), "K");
+    assert_eq!(str_attr(&u, "method"), "fe");
+    assert_eq!(str_attr(&u, "description"), "x + 2y");
+    assert_eq!(
+        read_f64(&f, "steps/0/cell id"),
+        [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+    );
+    let flux = f.dataset("steps/0/flux").unwrap();
+    assert!(flux.attr("units").is_err());
+    assert_eq!(flux.read_raw::<f64>().unwrap().len(), 17);
+
+    for (name, tag) in k.tags().iter() {
+        let ds = f.dataset(&format!("mesh/tags/{name}")).unwrap();
+        assert_eq!(usizes(&ds.read_raw::<u64>().unwrap()), tag.cells);
+        assert_eq!(
+            ds.attr("dim").unwrap().read_scalar::<u64>().unwrap(),
+            tag.dim as u64
+        );
+    }
+    assert_eq!(read_u64(&f, "mesh/tags/boundary").len(), 10);
+
+    let prov = f.group("provenance").unwrap();
+    assert_eq!(str_attr(&prov, "hasse_version"), "9.9.9-test");
+    assert_eq!(str_attr(&prov, "case_path"), "cases/test.toml");
+    let written = str_attr(&prov, "written_at");
+    assert_eq!(written.len(), 20);
+    assert!(written.ends_with('Z') && written.as_bytes()[10] == b'T');
+    let text = f
+        .dataset("provenance/case_text")
+        .unwrap()
+        .read_scalar::<VarLenUnicode>()
+        .unwrap();
+    assert_eq!(text.as_str(), "[mesh]\nkind = \"test\" # ünïcode\n");
+    let report = f
+        .dataset("provenance/report")
+        .unwrap()
+        .read_scalar::<VarLenUnicode>()
+        .unwrap();
+    let report: serde_json::Value = serde_json::from_str(report.as_str()).unwrap();
+    assert_eq!(report["iterations"], 7);
+
+    // Quads are cyclic and counter-clockwise (positive area 1 each).
+    let quads = f.dataset("xdmf/2/topology").unwrap();
+    assert_eq!(quads.shape(), vec![6, 4]);
+    let quads = read_i64(&f, "xdmf/2/topology");
+    for q in quads.chunks(4) {
+        let pts: Vec<[f64; 3]> = q.iter().map(|&v| point(&k, v as usize)).collect();
+        assert_eq!(shoelace(&pts), 1.0);
+    }
+    let edges = read_i64(&f, "xdmf/1/topology");
+    assert_eq!(edges.len(), 2 * 17);
+    for (e, pair) in edges.chunks(2).enumerate() {
+        let mut pair = usizes(&[pair[0] as u64, pair[1] as u64]);
+        pair.sort_unstable();
+        assert_eq!(pair, k.cell_vertices(1, e));
+    }
+
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    assert!(xml.contains("<Xdmf Version=\"3.0\">"));
+    assert!(xml.contains("GridType=\"Collection\" CollectionType=\"Spatial\""));
+    assert!(xml.find("<Grid Name=\"cells\"").unwrap() < xml.find("<Grid Name=\"edges\"").unwrap());
+    assert!(xml.contains("TopologyType=\"Quadrilateral\" NumberOfElements=\"6\""));
+    assert!(xml.contains("TopologyType=\"Polyline\" NumberOfElements=\"17\" NodesPerElement=\"2\""));
+    assert!(xml.contains(">quad.h5:/mesh/vertices<"));
+    assert!(xml.contains("<Attribute Name=\"u\" AttributeType=\"Scalar\" Center=\"Node\">"));
+    assert!(xml.contains("<Attribute Name=\"cell id\" AttributeType=\"Scalar\" Center=\"Cell\">"));
+    assert!(xml.contains("Dimensions=\"17\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">quad.h5:/steps/0/flux<"));
+}
+
+#[test]
+fn triangles_and_hexes_get_reader_vertex_order() {
+    let x = uniform_axis(3, 0.0, 1.5).unwrap();
+    let tri = kuhn(&[x.clone(), x]).unwrap();
+    let dir = scratch("tri-hex");
+    let files = write_run(
+        &dir.join("tri"),
+        &steady(&tri, vec![Cochain::new("id", 2, index_cochain(&tri, 2))]),
+    )
+    .unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    check_mesh(&f, &tri);
+    let t = read_i64(&f, "xdmf/2/topology");
+    assert_eq!(t.len(), 3 * 18);
+    for tri_vertices in t.chunks(3) {
+        let pts: Vec<[f64; 3]> = tri_vertices
+            .iter()
+            .map(|&v| point(&tri, v as usize))
+            .collect();
+        assert!((shoelace(&pts) - 0.125).abs() < 1e-15);
+    }
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert!(xml.contains("TopologyType=\"Triangle\" NumberOfElements=\"18\" NodesPerElement=\"3\""));
+    assert!(!xml.contains("Collection"));
+
+    let hex = box3(2, 1, 2, [0.0, 2.0], [0.0, 1.0], [0.0, 4.0]).unwrap();
+    let cochains = vec![
+        Cochain::new("u", 0, linear(&hex)),
+        Cochain::new("face", 2, index_cochain(&hex, 2)),
+        Cochain::new("id", 3, index_cochain(&hex, 3)),
+    ];
+    let files = write_run(&dir.join("hex"), &steady(&hex, cochains)).unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    check_mesh(&f, &hex);
+    let h = read_i64(&f, "xdmf/3/topology");
+    assert_eq!(h.len(), 8 * 4);
+    for cell in h.chunks(8) {
+        let p: Vec<[f64; 3]> = cell.iter().map(|&v| point(&hex, v as usize)).collect();
+        // VTK hexahedron: the five-tetrahedron split has all volumes positive
+        // and sums to the cell volume 1·1·2.
+        let tets = [
+            [0, 1, 3, 4],
+            [1, 2, 3, 6],
+            [1, 4, 5, 6],
+            [3, 6, 7, 4],
+            [1, 3, 4, 6],
+        ];
+        let mut total = 0.0;
+        for t in tets {
+            let v = vol6(p[t[0]], p[t[1]], p[t[2]], p[t[3]]);
+            assert!(v > 0.0);
+            total += v / 6.0;
+        }
+        assert!((total - 2.0).abs() < 1e-12);
+    }
+    // Faces: every 2-cell of a box is a quad with area of its axis-aligned sides.
+    let faces = f.dataset("xdmf/2/topology").unwrap();
+    assert_eq!(faces.shape(), vec![hex.cell_count(2), 4]);
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    assert!(
+        xml.contains("TopologyType=\"Hexahedron\" NumberOfElements=\"4\" NodesPerElement=\"8\"")
+    );
+    assert!(xml.contains(&format!(
+        "<Grid Name=\"faces\" GridType=\"Uniform\">\n        <Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"{}\"",
+        hex.cell_count(2)
+    )));
+    assert!(!xml.contains("Name=\"edges\""));
+}
+
+#[test]
+fn polygons_mix_in_one_topology_array() {
+    // Pentagon, quad and triangle around the point (2, 1).
+    let v = Vertices::from_points(&[
+        [0.0, 0.0],
+        [2.0, 0.0],
+        [2.0, 1.0],
+        [1.0, 2.0],
+        [0.0, 1.0],
+        [4.0, 0.0],
+        [4.0, 2.0],
+        [2.5, 2.5],
+    ])
+    .unwrap();
+    let cells = TopCells::polygons([vec![0, 1, 2, 3, 4], vec![1, 5, 6, 2], vec![2, 6, 7]]);
+    let k = Complex::build(v, cells).unwrap();
+    let dir = scratch("polygons");
+    let files = write_run(
+        &dir.join("poly"),
+        &steady(&k, vec![Cochain::new("id", 2, index_cochain(&k, 2))]),
+    )
+    .unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    check_mesh(&f, &k);
+    let mixed = read_i64(&f, "xdmf/2/topology");
+    assert_eq!(mixed.len(), (2 + 5) + (1 + 4) + (1 + 3));
+    // Walk the array as a reader does; each cell must enclose its own area.
+    // By hand: pentagon = 2x1 rectangle + triangle of area 1; quad = trapezoid
+    // of parallel sides 2 and 1 at distance 2; triangle = |(2,1)×(0.5,1.5)|/2.
+    let areas = [3.0, 3.0, 1.25];
+    let mut r = 0;
+    let mut cell = 0;
+    while r < mixed.len() {
+        let (count, start) = match mixed[r] {
+            3 => (mixed[r + 1] as usize, r + 2),
+            4 => (3, r + 1),
+            5 => (4, r + 1),
+            other => panic!("unexpected code {other}"),
+        };
+        let pts: Vec<[f64; 3]> = mixed[start..start + count]
+            .iter()
+            .map(|&v| point(&k, v as usize))
+            .collect();
+        let mut ids: Vec<usize> = mixed[start..start + count]
+            .iter()
+            .map(|&v| v as usize)
+            .collect();
+        ids.sort_unstable();
+        assert_eq!(ids, k.cell_vertices(2, cell));
+        let expected = match count {
+            5 => areas[0],
+            4 => areas[1],
+            _ => areas[2],
+        };
+        assert!((shoelace(&pts) - expected).abs() < 1e-12);
+        r = start + count;
+        cell += 1;
+    }
+    assert_eq!(cell, 3);
+    let codes: Vec<i64> = vec![mixed[0], mixed[7], mixed[12]];
+    let mut sorted = codes.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, [3, 4, 5]);
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert!(xml.contains("<Topology TopologyType=\"Mixed\" NumberOfElements=\"3\">"));
+    assert!(xml.contains("<DataItem Dimensions=\"16\" DataType=\"Int\""));
+}
+
+#[test]
+fn polyhedra_are_written_as_tetrahedra_with_their_cell_ids() {
+    // A cube split into two triangular prisms by the plane x = y.
+    let v = Vertices::from_points(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ])
+    .unwrap();
+    let prism = |a: usize, b: usize, c: usize| {
+        vec![
+            vec![a, b, c],
+            vec![a + 4, b + 4, c + 4],
+            vec![a, b, b + 4, a + 4],
+            vec![b, c, c + 4, b + 4],
+            vec![c, a, a + 4, c + 4],
+        ]
+    };
+    let k = Complex::build(v, TopCells::polyhedra([prism(0, 1, 2), prism(0, 2, 3)])).unwrap();
+    let dir = scratch("polyhedra");
+    let values = vec![10.0, 20.0];
+    let files = write_run(
+        &dir.join("prisms"),
+        &steady(&k, vec![Cochain::new("p", 3, values.clone())]),
+    )
+    .unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let ids = usizes(&read_u64(&f, "xdmf/3/cell_ids"));
+    let tets = read_i64(&f, "xdmf/3/topology");
+    assert_eq!(tets.len(), 4 * ids.len());
+    let mut volume = [0.0; 2];
+    for (t, &cell) in tets.chunks(4).zip(&ids) {
+        let p: Vec<[f64; 3]> = t.iter().map(|&v| point(&k, v as usize)).collect();
+        let v6 = vol6(p[0], p[1], p[2], p[3]);
+        assert!(v6 > 0.0);
+        volume[cell] += v6 / 6.0;
+        let mut verts: Vec<usize> = t.iter().map(|&v| v as usize).collect();
+        verts.retain(|v| k.cell_vertices(3, cell).contains(v));
+        assert_eq!(verts.len(), 4);
+    }
+    assert!((volume[0] - 0.5).abs() < 1e-12 && (volume[1] - 0.5).abs() < 1e-12);
+    let expanded = read_f64(&f, "xdmf/3/steps/0/p");
+    let expected: Vec<f64> = ids.iter().map(|&c| values[c]).collect();
+    assert_eq!(expanded, expected);
+    assert_eq!(read_f64(&f, "steps/0/p"), values);
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert!(xml.contains(&format!(
+        "TopologyType=\"Tetrahedron\" NumberOfElements=\"{}\"",
+        ids.len()
+    )));
+    assert!(xml.contains("prisms.h5:/xdmf/3/steps/0/p<"));
+}
+
+#[test]
+fn time_series_stores_every_level() {
+    let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let times = [0.0, 0.5, 1.25];
+    let steps: Vec<Step> = times
+        .iter()
+        .map(|&t| Step {
+            time: t,
+            cochains: vec![Cochain::new(
+                "u",
+                0,
+                linear(&k).iter().map(|u| u * (1.0 + t)).collect(),
+            )],
+        })
+        .collect();
+    let dir = scratch("series");
+    let files = write_run(&dir.join("heat"), &run(&k, steps)).unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    assert_eq!(
+        f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
+        3
+    );
+    assert_eq!(f.attr("times").unwrap().read_raw::<f64>().unwrap(), times);
+    for (i, &t) in times.iter().enumerate() {
+        let g = f.group(&format!("steps/{i}")).unwrap();
+        assert_eq!(g.attr("time").unwrap().read_scalar::<f64>().unwrap(), t);
+        let expected: Vec<f64> = linear(&k).iter().map(|u| u * (1.0 + t)).collect();
+        assert_eq!(read_f64(&f, &format!("steps/{i}/u")), expected);
+    }
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    assert_eq!(xml.matches("CollectionType=\"Temporal\"").count(), 1);
+    for t in ["0.0", "0.5", "1.25"] {
+        assert!(xml.contains(&format!("<Time Value=\"{t}\"/>")));
+    }
+    assert!(xml.contains("heat.h5:/steps/2/u<"));
+}
+
+#[test]
+fn bad_cochains_are_rejected_before_anything_is_written() {
+    let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    let dir = scratch("bad");
+    let short = steady(&k, vec![Cochain::new("u", 0, vec![1.0; 5])]);
+    match write_run(&dir.join("run"), &short) {
+        Err(OutputError::Shape {
+            name,
+            dim: 0,
+            expected: 6,
+            got: 5,
+        }) => assert_eq!(name, "u"),
+        other => panic!("expected a shape error, got {other:?}"),
+    }
+    assert!(
+        !dir.exists(),
+        "a rejected run must not even create the directory"
+    );
+
+    let mut values = linear(&k);
+    values[4] = f64::NAN;
+    values[5] = f64::INFINITY;
+    let err = write_run(
+        &dir.join("run"),
+        &steady(&k, vec![Cochain::new("T", 0, values)]),
+    )
+    .unwrap_err();
+    assert!(matches!(err, OutputError::NonFinite { cell: 4, .. }));
+    let message = err.to_string();
+    assert!(
+        message.contains("'T'") && message.contains("0-cell 4"),
+        "{message}"
+    );
+
+    let twice = steady(
+        &k,
+        vec![
+            Cochain::new("u", 0, linear(&k)),
+            Cochain::new("u", 2, vec![0.0; 2]),
+        ],
+    );
+    assert!(matches!(
+        write_run(&dir.join("run"), &twice),
+        Err(OutputError::DuplicateName { step: 0, .. })
+    ));
+    let high = steady(&k, vec![Cochain::new("w", 3, vec![])]);
+    assert!(matches!(
+        write_run(&dir.join("run"), &high),
+        Err(OutputError::Degree {
+            dim: 3,
+            complex_dim: 2,
+            ..
+        })
+    ));
+    let backwards = run(
+        &k,
+        vec![
+            Step {
+                time: 1.0,
+                cochains: vec![],
+            },
+            Step {
+                time: 1.0,
+                cochains: vec![],
+            },
+        ],
+    );
+    assert!(matches!(
+        write_run(&dir.join("run"), &backwards),
+        Err(OutputError::Time { step: 1, .. })
+    ));
+    assert!(!dir.exists());
+}
+
+#[test]
+fn an_older_output_is_replaced_only_by_a_complete_one() {
+    let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    let dir = scratch("replace");
+    let stem = dir.join("nested").join("run");
+    let first = write_run(&stem, &steady(&k, vec![Cochain::new("u", 0, linear(&k))])).unwrap();
+    let old_h5 = std::fs::read(&first.hdf5).unwrap();
+    let old_xdmf = std::fs::read(&first.xdmf).unwrap();
+
+    // Fails validation.
+    let bad = steady(&k, vec![Cochain::new("u", 2, vec![1.0; 3])]);
+    assert!(write_run(&stem, &bad).is_err());
+    // Passes validation but the provenance cannot be stored (NUL in an HDF5
+    // string), so the failure happens halfway through the h5 file.
+    let mut late = steady(&k, vec![Cochain::new("v", 0, linear(&k))]);
+    late.provenance.case_text = Some("a\0b".into());
+    assert!(matches!(
+        write_run(&stem, &late),
+        Err(OutputError::Text { .. })
+    ));
+    assert_eq!(std::fs::read(&first.hdf5).unwrap(), old_h5);
+    assert_eq!(std::fs::read(&first.xdmf).unwrap(), old_xdmf);
+    assert_eq!(files_in(&dir.join("nested")), ["run.h5", "run.xdmf"]);
+
+    let second = write_run(
+        &stem,
+        &run(
+            &k,
+            vec![
+                Step {
+                    time: 0.0,
+                    cochains: vec![Cochain::new("w", 2, vec![1.0, 2.0])],
+                },
+                Step {
+                    time: 1.0,
+                    cochains: vec![Cochain::new("w", 2, vec![3.0, 4.0])],
+                },
+            ],
+        ),
+    )
+    .unwrap();
+    assert_eq!(second, first);
+    let f = hdf5::File::open(&second.hdf5).unwrap();
+    assert_eq!(
+        f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
+        2
+    );
+    assert_eq!(read_f64(&f, "steps/1/w"), [3.0, 4.0]);
+    assert!(f.dataset("steps/0/u").is_err());
+    assert_eq!(files_in(&dir.join("nested")), ["run.h5", "run.xdmf"]);
+}

@@ -1,0 +1,262 @@
+//! The output files read by real clients: `tests/python/check_output.py`
+//! opens them with h5py and meshio (`meshio.read` on steady runs,
+//! `meshio.xdmf.TimeSeriesReader` on a time series) and compares with the
+//! values this test computes from analytic formulas.
+//!
+//! Python runs in a private venv at `<target>/pyenv`, created with
+//! `pip install h5py meshio` when missing. Without network the test fails
+//! under `CI` and is skipped loudly elsewhere.
+
+use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
+use hasse_complex::{Complex, TopCells, Vertices};
+use hasse_solver::output::{write_run, Cochain, Provenance, RunOutput, Step};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"))
+}
+
+fn imports_work(python: &Path) -> bool {
+    Command::new(python)
+        .args(["-c", "import h5py, meshio"])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+/// The venv's python with h5py and meshio, or why it could not be had.
+fn python() -> Result<PathBuf, String> {
+    let venv = target_dir().join("pyenv");
+    let python = venv.join("bin").join("python");
+    if imports_work(&python) {
+        return Ok(python);
+    }
+    let run = |cmd: &mut Command| -> Result<(), String> {
+        let out = cmd.output().map_err(|e| format!("{cmd:?}: {e}"))?;
+        if out.status.success() {
+            Ok(())
+        } else {
+            Err(format!(
+                "{cmd:?} failed:\n{}",
+                String::from_utf8_lossy(&out.stderr)
+            ))
+        }
+    };
+    run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
+    run(Command::new(venv.join("bin").join("pip")).args(["install", "--quiet", "h5py", "meshio"]))?;
+    if imports_work(&python) {
+        Ok(python)
+    } else {
+        Err("h5py and meshio installed but do not import".into())
+    }
+}
+
+fn padded(k: &Complex) -> Vec<[f64; 3]> {
+    (0..k.cell_count(0))
+        .map(|v| {
+            let mut p = [0.0; 3];
+            p[..k.embedding_dim()].copy_from_slice(k.vertices().point(v));
+            p
+        })
+        .collect()
+}
+
+/// u(x, y, z) = x + 2y + 3z at the vertices.
+fn linear(k: &Complex) -> Vec<f64> {
+    padded(k)
+        .iter()
+        .map(|p| p[0] + 2.0 * p[1] + 3.0 * p[2])
+        .collect()
+}
+
+/// Cell-centred analytic values: 10 + 0.5 i on cell i.
+fn per_cell(k: &Complex, p: usize) -> Vec<f64> {
+    (0..k.cell_count(p))
+        .map(|i| 10.0 + 0.5 * i as f64)
+        .collect()
+}
+
+fn provenance() -> Provenance {
+    Provenance {
+        case_text: Some("[mesh]\n".into()),
+        case_path: None,
+        hasse_version: env!("CARGO_PKG_VERSION").into(),
+        report: json!({"case": "python"}),
+    }
+}
+
+/// Write one steady case and describe what a reader must find in it.
+fn steady_case(
+    dir: &Path,
+    name: &str,
+    k: &Complex,
+    cell_counts: Value,
+    split_cells: bool,
+) -> Value {
+    let n = k.dim();
+    let u = linear(k);
+    let c = per_cell(k, n);
+    let run = RunOutput {
+        complex: k,
+        steps: vec![Step {
+            time: 0.0,
+            cochains: vec![
+                Cochain::new("u", 0, u.clone()),
+                Cochain::new("c", n, c.clone()),
+            ],
+        }],
+        provenance: provenance(),
+    };
+    let files = write_run(&dir.join(name), &run).unwrap();
+    let mut case = describe(name, k, &files.hdf5, &files.xdmf, &[0.0], cell_counts);
+    case["datasets"] = json!({"steps/0/u": u, "steps/0/c": c});
+    case["point_data"] = json!({ "u": u });
+    case["cell_data"] = json!({ "c": c });
+    if split_cells {
+        case["cells_of"] = json!(n);
+    }
+    case
+}
+
+fn describe(
+    name: &str,
+    k: &Complex,
+    h5: &Path,
+    xdmf: &Path,
+    times: &[f64],
+    cell_counts: Value,
+) -> Value {
+    let shapes: serde_json::Map<String, Value> = (1..=k.dim())
+        .map(|p| (p.to_string(), json!([k.cell_count(p - 1), k.cell_count(p)])))
+        .collect();
+    json!({
+        "name": name,
+        "h5": h5,
+        "xdmf": xdmf,
+        "dim": k.dim(),
+        "vertices": padded(k),
+        "boundary_shapes": shapes,
+        "times": times,
+        "cell_counts": cell_counts,
+        "hasse_version": env!("CARGO_PKG_VERSION"),
+        "report": {"case": "python"},
+    })
+}
+
+fn prisms() -> Complex {
+    let v = Vertices::from_points(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ])
+    .unwrap();
+    let prism = |a: usize, b: usize, c: usize| {
+        vec![
+            vec![a, b, c],
+            vec![a + 4, b + 4, c + 4],
+            vec![a, b, b + 4, a + 4],
+            vec![b, c, c + 4, b + 4],
+            vec![c, a, a + 4, c + 4],
+        ]
+    };
+    Complex::build(v, TopCells::polyhedra([prism(0, 1, 2), prism(0, 2, 3)])).unwrap()
+}
+
+#[test]
+fn h5py_and_meshio_read_the_output() {
+    let python = match python() {
+        Ok(p) => p,
+        Err(why) => {
+            if std::env::var_os("CI").is_some() {
+                panic!("h5py/meshio environment unavailable under CI: {why}");
+            }
+            eprintln!("\n!!!!!!!! SKIPPED output_python: no h5py/meshio venv ({why}) !!!!!!!!\n");
+            return;
+        }
+    };
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("output_python");
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let quad = rectangle(3, 2, [0.0, 1.5], [0.0, 1.0]).unwrap();
+    let x = uniform_axis(2, 0.0, 1.0).unwrap();
+    let tri = kuhn(&[x.clone(), x]).unwrap();
+    let hex = box3(2, 2, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 0.5]).unwrap();
+    let prisms = prisms();
+    let mut cases = vec![
+        steady_case(&dir, "quad", &quad, json!({"quad": 6}), false),
+        steady_case(&dir, "tri", &tri, json!({"triangle": 8}), false),
+        steady_case(&dir, "hex", &hex, json!({"hexahedron": 4}), false),
+        // Each prism is three tetrahedra (the cone from its lowest vertex).
+        steady_case(&dir, "prisms", &prisms, json!({"tetra": 6}), true),
+    ];
+
+    // Two levels of u(t) = (1 + t)(x + 2y), with an edge cochain that lives in
+    // its own temporal collection and must not confuse the reader.
+    let times = [0.0, 0.75];
+    let steps: Vec<Step> = times
+        .iter()
+        .map(|&t| Step {
+            time: t,
+            cochains: vec![
+                Cochain::new(
+                    "u",
+                    0,
+                    linear(&quad).iter().map(|u| (1.0 + t) * u).collect(),
+                ),
+                Cochain::new("c", 2, per_cell(&quad, 2).iter().map(|c| c + t).collect()),
+                Cochain::new("q", 1, per_cell(&quad, 1)),
+            ],
+        })
+        .collect();
+    let run = RunOutput {
+        complex: &quad,
+        steps,
+        provenance: provenance(),
+    };
+    let files = write_run(&dir.join("series"), &run).unwrap();
+    let mut series = describe(
+        "series",
+        &quad,
+        &files.hdf5,
+        &files.xdmf,
+        &times,
+        json!({"quad": 6}),
+    );
+    let expected: Vec<Value> = times
+        .iter()
+        .map(|&t| {
+            json!({
+                "point_data": {"u": linear(&quad).iter().map(|u| (1.0 + t) * u).collect::<Vec<_>>()},
+                "cell_data": {"c": per_cell(&quad, 2).iter().map(|c| c + t).collect::<Vec<_>>()},
+            })
+        })
+        .collect();
+    series["steps"] = json!(expected);
+    series["datasets"] = json!({ "steps/1/q": per_cell(&quad, 1) });
+    cases.push(series);
+
+    let manifest = dir.join("manifest.json");
+    std::fs::write(&manifest, json!({ "cases": cases }).to_string()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/python/check_output.py");
+    let out = Command::new(&python)
+        .arg(&script)
+        .arg(&manifest)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    println!("{stdout}");
+    assert!(
+        out.status.success(),
+        "check_output.py failed:\n{stdout}\n{stderr}"
+    );
+    assert_eq!(stdout.lines().filter(|l| l.starts_with("ok ")).count(), 5);
+}
