@@ -367,6 +367,9 @@ impl Diffusion {
         // Cell-centred boundary faces whose own row changes weight or value.
         let mut face_weight: Vec<Option<f64>> = vec![None; flux_rows];
         let mut face_value = vec![0.0; flux_rows];
+        // Cell-centred Neumann faces carry no row weight; their flux (along
+        // the face's orientation) is the data's, −s g |F|.
+        let mut neumann_flux = vec![0.0; flux_rows];
 
         // Sources.
         match self.method {
@@ -450,7 +453,9 @@ impl Diffusion {
                         }
                         BoundaryKind::Neumann(g) => {
                             face_weight[f] = Some(0.0);
-                            rhs[cell] += evaluate(g, xf, "Neumann value")? * area;
+                            let outward = evaluate(g, xf, "Neumann value")? * area;
+                            rhs[cell] += outward;
+                            neumann_flux[f] = -sign * outward;
                         }
                         BoundaryKind::Robin { alpha, value } => {
                             let a = robin_alpha(bc, f, alpha, xf)?;
@@ -561,8 +566,8 @@ impl Diffusion {
         // The ghost part of boundary fluxes: Ω(Au − w) on Dirichlet/Robin faces.
         if location == Location::CellCentred {
             let lifted = canonical.metric().apply(&ghost_values);
-            for (q, l) in flux.iter_mut().zip(lifted) {
-                *q -= l;
+            for ((q, l), g) in flux.iter_mut().zip(lifted).zip(&neumann_flux) {
+                *q += g - l;
             }
         }
         Ok(Solution {
