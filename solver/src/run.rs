@@ -208,10 +208,13 @@ fn solve_diffusion(
         Location::Hybrid => {}
     }
     let gradient = diffusion::reconstruct_gradient(complex, &solution);
+    // The reconstruction needs cells that fill their space; on a surface in
+    // R³ it is undefined (NaN) and left out.
+    let gradient_defined = gradient.iter().all(|g| g.iter().all(|v| v.is_finite()));
     for (axis, name) in ["x", "y", "z"]
         .iter()
         .enumerate()
-        .take(complex.embedding_dim())
+        .take(if gradient_defined { complex.embedding_dim() } else { 0 })
     {
         fields.push(Field {
             name: format!("grad_{name}"),
@@ -486,11 +489,11 @@ impl fmt::Display for RunResult {
             writeln!(f)?;
         }
         if let Some(e) = &self.errors {
-            writeln!(
-                f,
-                "error      L2 {:.6e}, max {:.6e}, gradient L2 {:.6e}",
-                e.l2, e.max, e.gradient_l2
-            )?;
+            write!(f, "error      L2 {:.6e}, max {:.6e}", e.l2, e.max)?;
+            if e.gradient_l2.is_finite() {
+                write!(f, ", gradient L2 {:.6e}", e.gradient_l2)?;
+            }
+            writeln!(f)?;
         }
         if let Some(q) = self.flux_error {
             writeln!(f, "flux error L2 {q:.6e}")?;
@@ -512,7 +515,11 @@ impl RunResult {
     /// The report stored with the output (and printed by `-v`), as JSON.
     pub fn report_json(&self, complex: &Complex) -> serde_json::Value {
         let errors = self.errors.map(|e| {
-            serde_json::json!({"l2": e.l2, "max": e.max, "gradient_l2": e.gradient_l2})
+            serde_json::json!({
+                "l2": e.l2,
+                "max": e.max,
+                "gradient_l2": e.gradient_l2.is_finite().then_some(e.gradient_l2),
+            })
         });
         let timings: serde_json::Map<String, serde_json::Value> = self
             .timings
