@@ -708,4 +708,23 @@ fn stems_that_cannot_name_the_files_are_rejected() {
     let files = write_run(&dir.join("run.v2"), &empty).unwrap();
     assert_eq!(files.hdf5, dir.join("run.v2.h5"));
     assert_eq!(files_in(&dir), ["run.v2.h5", "run.v2.xdmf"]);
+
+    // No step at all: the mesh alone, an empty `times`, a grid without attributes.
+    let mesh_only = run(&k, vec![]);
+    let files = write_run(&dir.join("mesh"), &mesh_only).unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    assert_eq!(
+        f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
+        0
+    );
+    assert!(f
+        .attr("times")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap()
+        .is_empty());
+    check_mesh(&f, &k);
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    assert!(!xml.contains("<Attribute"));
 }
