@@ -322,6 +322,11 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
         source,
     })?;
 
+    // Contents reach the disk before the names do, so a crash right after
+    // the rename cannot leave an empty file under the final name.
+    for path in &temps.0 {
+        sync(path)?;
+    }
     // The h5 goes first: an xdmf must never point at a file that is not there.
     rename(&temps.0[0], &final_h5)?;
     temps.0.remove(0);
@@ -331,6 +336,15 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
         hdf5: final_h5,
         xdmf: final_xdmf,
     })
+}
+
+fn sync(path: &Path) -> Result<(), OutputError> {
+    std::fs::File::open(path)
+        .and_then(|f| f.sync_all())
+        .map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
 }
 
 fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
