@@ -657,3 +657,74 @@ fn an_older_output_is_replaced_only_by_a_complete_one() {
     assert!(f.dataset("steps/0/u").is_err());
     assert_eq!(files_in(&dir.join("nested")), ["run.h5", "run.xdmf"]);
 }
+
+#[test]
+fn a_1d_complex_is_one_polyline_grid() {
+    let k = hasse_complex::generate::interval(4, 0.0, 2.0).unwrap();
+    let dir = scratch("interval");
+    let cochains = vec![
+        Cochain::new("u", 0, linear(&k)),
+        Cochain::new("q", 1, index_cochain(&k, 1)),
+    ];
+    let files = write_run(&dir.join("line"), &steady(&k, cochains)).unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    check_mesh(&f, &k);
+    // (N, 3) with y = z = 0 padding and the embedding dimension kept.
+    let vertices = f.dataset("mesh/vertices").unwrap();
+    assert_eq!(
+        vertices
+            .attr("embedding_dim")
+            .unwrap()
+            .read_scalar::<u64>()
+            .unwrap(),
+        1
+    );
+    assert_eq!(read_f64(&f, "mesh/vertices")[6..9], [1.0, 0.0, 0.0]);
+    assert_eq!(read_i64(&f, "xdmf/1/topology"), [0, 1, 1, 2, 2, 3, 3, 4]);
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    assert_eq!(xml.matches("<Grid ").count(), 1);
+    assert!(xml.contains("<Grid Name=\"cells\" GridType=\"Uniform\">"));
+    assert!(xml.contains("TopologyType=\"Polyline\" NumberOfElements=\"4\" NodesPerElement=\"2\""));
+    assert!(xml.contains("Name=\"u\" AttributeType=\"Scalar\" Center=\"Node\""));
+    assert!(xml.contains("Name=\"q\" AttributeType=\"Scalar\" Center=\"Cell\""));
+}
+
+#[test]
+fn stems_that_cannot_name_the_files_are_rejected() {
+    let k = hasse_complex::generate::interval(1, 0.0, 1.0).unwrap();
+    let empty = steady(&k, vec![]);
+    let dir = scratch("stems");
+    assert!(matches!(
+        write_run(&dir.join("a:b"), &empty),
+        Err(OutputError::Stem { .. })
+    ));
+    assert!(matches!(
+        write_run(Path::new("/"), &empty),
+        Err(OutputError::Stem { .. })
+    ));
+    assert!(!dir.exists());
+    // A stem whose name has a dot keeps it: run.v2 → run.v2.h5.
+    let files = write_run(&dir.join("run.v2"), &empty).unwrap();
+    assert_eq!(files.hdf5, dir.join("run.v2.h5"));
+    assert_eq!(files_in(&dir), ["run.v2.h5", "run.v2.xdmf"]);
+
+    // No step at all: the mesh alone, an empty `times`, a grid without attributes.
+    let mesh_only = run(&k, vec![]);
+    let files = write_run(&dir.join("mesh"), &mesh_only).unwrap();
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    assert_eq!(
+        f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
+        0
+    );
+    assert!(f
+        .attr("times")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap()
+        .is_empty());
+    check_mesh(&f, &k);
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    assert!(!xml.contains("<Attribute"));
+}

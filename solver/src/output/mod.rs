@@ -54,6 +54,7 @@ mod xdmf;
 use hasse_complex::Complex;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// One cochain: values on the p-cells of the complex (`values.len() == complex.cell_count(dim)`).
 ///
@@ -166,15 +167,20 @@ impl Provenance {
 /// ```
 #[derive(Clone, Debug)]
 pub struct RunOutput<'a> {
+    /// The complex every cochain lives on.
     pub complex: &'a Complex,
+    /// Time levels in increasing time (may be empty: mesh only).
     pub steps: Vec<Step>,
+    /// Where the run came from.
     pub provenance: Provenance,
 }
 
 /// The two files [`write_run`] wrote.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OutputFiles {
+    /// `<stem>.h5`.
     pub hdf5: PathBuf,
+    /// `<stem>.xdmf`, referring to the h5 file by its bare file name.
     pub xdmf: PathBuf,
 }
 
@@ -182,14 +188,17 @@ pub struct OutputFiles {
 /// file names when any of these is returned.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
+    /// A directory or file could not be created, written or renamed.
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,
         #[source]
         source: std::io::Error,
     },
+    /// The HDF5 library refused an operation on the (temporary) h5 file.
     #[error("{path}: HDF5 error: {message}")]
     Hdf5 { path: PathBuf, message: String },
+    /// A cochain's length is not the number of cells of its degree.
     #[error(
         "cochain '{name}' of degree {dim} has {got} values, the complex has {expected} {dim}-cells"
     )]
@@ -199,12 +208,14 @@ pub enum OutputError {
         expected: usize,
         got: usize,
     },
+    /// A cochain's degree exceeds the dimension of the complex.
     #[error("cochain '{name}' has degree {dim}, the complex has dimension {complex_dim}")]
     Degree {
         name: String,
         dim: usize,
         complex_dim: usize,
     },
+    /// NaN or ±∞ in a cochain; `cell` is the first bad cell id.
     #[error(
         "cochain '{name}' (step {step}) has the non-finite value {value} on {dim}-cell {cell}"
     )]
@@ -215,16 +226,22 @@ pub enum OutputError {
         cell: usize,
         value: f64,
     },
+    /// Two cochains of one step share a name.
     #[error("step {step} has two cochains named '{name}'")]
     DuplicateName { step: usize, name: String },
+    /// A cochain name that cannot be an HDF5 link name or an XDMF reference.
     #[error("cochain name '{name}' cannot be stored: {reason}")]
     InvalidName { name: String, reason: &'static str },
+    /// Times must be finite and strictly increasing.
     #[error("step {step} has time {time}: times must be finite and strictly increasing")]
     Time { step: usize, time: f64 },
-    #[error("output stem '{path}' has no file name")]
-    Stem { path: PathBuf },
+    /// The output stem cannot name the two files.
+    #[error("output stem '{path}': {reason}")]
+    Stem { path: PathBuf, reason: &'static str },
+    /// A provenance or metadata string cannot be stored (e.g. it contains NUL).
     #[error("{field} cannot be stored as an HDF5 string: {reason}")]
     Text { field: String, reason: String },
+    /// The reader-order connectivity of some cell could not be rebuilt.
     #[error("cannot write the XDMF cells: {message}")]
     Topology { message: String },
 }
@@ -255,13 +272,22 @@ pub enum OutputError {
 /// ```
 pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputError> {
     validate(run)?;
+    let stem_error = |reason| OutputError::Stem {
+        path: stem.to_path_buf(),
+        reason,
+    };
     let file_name = stem
         .file_name()
-        .and_then(|s| s.to_str())
-        .ok_or_else(|| OutputError::Stem {
-            path: stem.to_path_buf(),
-        })?
+        .ok_or_else(|| stem_error("it has no file name"))?
+        .to_str()
+        .ok_or_else(|| stem_error("the file name is not UTF-8"))?
         .to_string();
+    if file_name.contains(':') {
+        // XDMF readers split "file.h5:/path" at the first ':'.
+        return Err(stem_error(
+            "':' in the file name breaks XDMF data references",
+        ));
+    }
     let dir = match stem.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -276,10 +302,17 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
     let xdmf_name = format!("{file_name}.xdmf");
     let final_h5 = dir.join(&h5_name);
     let final_xdmf = dir.join(&xdmf_name);
-    let pid = std::process::id();
+    // Unique per process and per call, so concurrent writers of the same
+    // stem never share a temporary.
+    static CALLS: AtomicU64 = AtomicU64::new(0);
+    let tag = format!(
+        "{}-{}",
+        std::process::id(),
+        CALLS.fetch_add(1, Ordering::Relaxed)
+    );
     let mut temps = Temporaries(vec![
-        dir.join(format!(".{h5_name}.tmp-{pid}")),
-        dir.join(format!(".{xdmf_name}.tmp-{pid}")),
+        dir.join(format!(".{h5_name}.tmp-{tag}")),
+        dir.join(format!(".{xdmf_name}.tmp-{tag}")),
     ]);
 
     hdf5_file::write(&temps.0[0], run, &grids, &rfc3339_now())?;
@@ -289,6 +322,11 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
         source,
     })?;
 
+    // Contents reach the disk before the names do, so a crash right after
+    // the rename cannot leave an empty file under the final name.
+    for path in &temps.0 {
+        sync(path)?;
+    }
     // The h5 goes first: an xdmf must never point at a file that is not there.
     rename(&temps.0[0], &final_h5)?;
     temps.0.remove(0);
@@ -298,6 +336,15 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
         hdf5: final_h5,
         xdmf: final_xdmf,
     })
+}
+
+fn sync(path: &Path) -> Result<(), OutputError> {
+    std::fs::File::open(path)
+        .and_then(|f| f.sync_all())
+        .map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
 }
 
 fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
