@@ -297,7 +297,11 @@ fn run_case(
         );
         print!("{result}");
         if let Some(files) = written {
-            println!("output     {}, {}", files.hdf5.display(), files.xdmf.display());
+            println!(
+                "output     {}, {}",
+                files.hdf5.display(),
+                files.xdmf.display()
+            );
         }
     } else {
         for w in &result.warnings {

@@ -214,7 +214,11 @@ fn solve_diffusion(
     for (axis, name) in ["x", "y", "z"]
         .iter()
         .enumerate()
-        .take(if gradient_defined { complex.embedding_dim() } else { 0 })
+        .take(if gradient_defined {
+            complex.embedding_dim()
+        } else {
+            0
+        })
     {
         fields.push(Field {
             name: format!("grad_{name}"),
@@ -244,8 +248,11 @@ fn solve_diffusion(
                 .and_then(|g| diffusion::flux_error(complex, &solution, &problem, g));
             let points = field_points(complex, field_dim);
             let exact_values: Vec<f64> = points.iter().map(|x| u(x)).collect();
-            let mut difference: Vec<f64> =
-                field.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
+            let mut difference: Vec<f64> = field
+                .iter()
+                .zip(&exact_values)
+                .map(|(a, b)| a - b)
+                .collect();
             if solution.pure_neumann {
                 // u is defined up to a constant: compare with the mean removed,
                 // as `errors` does.
@@ -326,9 +333,8 @@ fn read_metric_file(path: &PathBuf, faces: usize) -> Result<Vec<(usize, usize, f
         if line.is_empty() {
             continue;
         }
-        let bad = |what: String| {
-            RunError::Input(format!("{}:{}: {what}", path.display(), number + 1))
-        };
+        let bad =
+            |what: String| RunError::Input(format!("{}:{}: {what}", path.display(), number + 1));
         let parts: Vec<&str> = line.split_whitespace().collect();
         if parts.len() != 3 {
             return Err(bad(format!(

@@ -147,7 +147,12 @@ mod tests {
     #[test]
     fn display_names_file_line_key_and_help() {
         let mut c = Collector::new("x.toml", "\n[problem]\nmethdo = 1\n");
-        c.error(Some(11..17), "problem.methdo", "unknown key", Some("did you mean `method`?".into()));
+        c.error(
+            Some(11..17),
+            "problem.methdo",
+            "unknown key",
+            Some("did you mean `method`?".into()),
+        );
         assert_eq!(
             c.diagnostics[0].to_string(),
             "x.toml:3:1: `problem.methdo`: unknown key\n    help: did you mean `method`?"

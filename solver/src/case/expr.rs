@@ -161,9 +161,7 @@ impl Scope {
             reason: reason.to_string(),
         };
         let mut chars = name.chars();
-        let valid = chars
-            .next()
-            .is_some_and(|c| c.is_alphabetic() || c == '_')
+        let valid = chars.next().is_some_and(|c| c.is_alphabetic() || c == '_')
             && chars.all(|c| c.is_alphanumeric() || c == '_');
         if !valid {
             return Err(reserved(
@@ -202,7 +200,8 @@ impl Scope {
     pub fn add_definition(&mut self, name: &str, text: &str) -> Result<(), ExprError> {
         self.check_new_name(name)?;
         let expression = self.parse(text)?;
-        self.definitions.push((name.to_string(), Arc::new(expression)));
+        self.definitions
+            .push((name.to_string(), Arc::new(expression)));
         Ok(())
     }
 
@@ -269,7 +268,10 @@ mod tests {
     fn coordinates_time_and_constants() {
         let scope = Scope::new();
         let e = scope.parse("2*x + 3*y - z + t").unwrap();
-        assert_eq!(e.eval(&[1.0, 10.0, 100.0], 1000.0), 2.0 + 30.0 - 100.0 + 1000.0);
+        assert_eq!(
+            e.eval(&[1.0, 10.0, 100.0], 1000.0),
+            2.0 + 30.0 - 100.0 + 1000.0
+        );
         // Missing coordinates are zero: a 2D point has z = 0.
         assert_eq!(e.eval(&[1.0, 10.0], 0.0), 32.0);
         assert!(!e.is_constant());

@@ -241,9 +241,13 @@ impl Case {
                 match complex.tag(&b.tag) {
                     None => {
                         let help = match expr::closest(&b.tag, &available) {
-                            Some(s) => format!("did you mean `{s}`? the mesh has: {}", available.join(", ")),
+                            Some(s) => format!(
+                                "did you mean `{s}`? the mesh has: {}",
+                                available.join(", ")
+                            ),
                             None if available.is_empty() => {
-                                "the mesh has no boundary tags (a closed surface has no boundary)".into()
+                                "the mesh has no boundary tags (a closed surface has no boundary)"
+                                    .into()
                             }
                             None => format!("the mesh has: {}", available.join(", ")),
                         };

@@ -48,7 +48,14 @@ const MESH_KEYS: &[&str] = &[
     "minor_radius",
     "cavity",
 ];
-const PROBLEM_KEYS: &[&str] = &["kind", "method", "conductivity", "source", "field", "metric"];
+const PROBLEM_KEYS: &[&str] = &[
+    "kind",
+    "method",
+    "conductivity",
+    "source",
+    "field",
+    "metric",
+];
 const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha"];
 const EXACT_KEYS: &[&str] = &["solution", "gradient"];
 const SOLVER_KEYS: &[&str] = &[
@@ -93,11 +100,15 @@ pub(super) fn apply_overrides(
             .parse()
             .unwrap_or_else(|_| Value::from(raw.trim()));
         let segments: Vec<&str> = path.trim().split('.').collect();
-        if segments.iter().any(|s| s.is_empty()) || !set_path(doc.as_table_mut(), &segments, value) {
+        if segments.iter().any(|s| s.is_empty()) || !set_path(doc.as_table_mut(), &segments, value)
+        {
             collector.error(
                 None,
                 path.trim(),
-                format!("--set {assignment}: `{}` does not name a value in this case file", path.trim()),
+                format!(
+                    "--set {assignment}: `{}` does not name a value in this case file",
+                    path.trim()
+                ),
                 Some("use dotted keys such as problem.method, mesh.n or boundary.0.value".into()),
             );
         }
@@ -213,7 +224,13 @@ impl Reader {
         }
     }
 
-    fn error(&mut self, span: Option<Range<usize>>, key: &str, message: impl Into<String>, help: Option<String>) {
+    fn error(
+        &mut self,
+        span: Option<Range<usize>>,
+        key: &str,
+        message: impl Into<String>,
+        help: Option<String>,
+    ) {
         self.collector.error(span, key, message, help);
     }
 
@@ -242,7 +259,12 @@ impl Reader {
 
     fn type_error(&mut self, entry: &Entry, expected: &str) {
         let found = describe(entry.item);
-        self.error(entry.span(), &entry.name, format!("expected {expected}, found {found}"), None);
+        self.error(
+            entry.span(),
+            &entry.name,
+            format!("expected {expected}, found {found}"),
+            None,
+        );
     }
 
     fn string_at(&mut self, table: &dyn TableLike, prefix: &str, key: &str) -> Option<String> {
@@ -272,14 +294,25 @@ impl Reader {
         self.number(&entry)
     }
 
-    fn expression_of(&mut self, item: &Item, name: &str, span: Option<Range<usize>>, scope: &Scope) -> Option<Expression> {
+    fn expression_of(
+        &mut self,
+        item: &Item,
+        name: &str,
+        span: Option<Range<usize>>,
+        scope: &Scope,
+    ) -> Option<Expression> {
         let text = match item.as_value() {
             Some(Value::String(s)) => s.value().clone(),
             Some(Value::Float(f)) => format_number(*f.value()),
             Some(Value::Integer(i)) => i.value().to_string(),
             _ => {
                 let found = describe(item);
-                self.error(span, name, format!("expected a number or an expression string, found {found}"), None);
+                self.error(
+                    span,
+                    name,
+                    format!("expected a number or an expression string, found {found}"),
+                    None,
+                );
                 return None;
             }
         };
@@ -293,12 +326,23 @@ impl Reader {
         }
     }
 
-    fn expression_at(&mut self, table: &dyn TableLike, prefix: &str, key: &str, scope: &Scope) -> Option<Expression> {
+    fn expression_at(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        key: &str,
+        scope: &Scope,
+    ) -> Option<Expression> {
         let entry = self.entry(table, prefix, key)?;
         self.expression_of(entry.item, &entry.name, entry.span(), scope)
     }
 
-    fn subtable<'a>(&mut self, table: &'a dyn TableLike, prefix: &str, key: &str) -> Option<(&'a dyn TableLike, Entry<'a>)> {
+    fn subtable<'a>(
+        &mut self,
+        table: &'a dyn TableLike,
+        prefix: &str,
+        key: &str,
+    ) -> Option<(&'a dyn TableLike, Entry<'a>)> {
         let entry = self.entry(table, prefix, key)?;
         match entry.item.as_table_like() {
             Some(t) => Some((t, entry)),
@@ -315,7 +359,9 @@ impl Reader {
             return out;
         };
         for (key, _) in table.iter() {
-            let Some(entry) = self.entry(table, "constants", key) else { continue };
+            let Some(entry) = self.entry(table, "constants", key) else {
+                continue;
+            };
             // A constant may be a number or an expression of earlier constants.
             let value = match entry.item.as_value() {
                 Some(Value::String(_)) => self
@@ -324,7 +370,12 @@ impl Reader {
                         if e.is_constant() {
                             Some(e.eval(&[], 0.0))
                         } else {
-                            self.error(entry.span(), &entry.name, "a constant may not depend on x, y, z or t", Some("move it to [definitions]".into()));
+                            self.error(
+                                entry.span(),
+                                &entry.name,
+                                "a constant may not depend on x, y, z or t",
+                                Some("move it to [definitions]".into()),
+                            );
                             None
                         }
                     }),
@@ -347,7 +398,9 @@ impl Reader {
             return;
         };
         for (key, item) in table.iter() {
-            let Some(entry) = self.entry(table, "definitions", key) else { continue };
+            let Some(entry) = self.entry(table, "definitions", key) else {
+                continue;
+            };
             let Some(text) = item.as_str() else {
                 self.type_error(&entry, "an expression string");
                 continue;
@@ -363,7 +416,11 @@ impl Reader {
         }
     }
 
-    fn mesh(&mut self, root: &dyn TableLike, text: &str) -> (Option<MeshSpec>, BTreeMap<String, Range<usize>>) {
+    fn mesh(
+        &mut self,
+        root: &dyn TableLike,
+        text: &str,
+    ) -> (Option<MeshSpec>, BTreeMap<String, Range<usize>>) {
         let mut spans = BTreeMap::new();
         let Some((table, entry)) = self.subtable(root, "", "mesh") else {
             if root.get("mesh").is_none() {
@@ -375,7 +432,10 @@ impl Reader {
         let before = self.collector.diagnostics.len();
         self.check_keys(table, "mesh", MESH_KEYS);
         for (key, item) in table.iter() {
-            if let Some(span) = item.span().or_else(|| table.get_key_value(key).and_then(|(k, _)| k.span())) {
+            if let Some(span) = item
+                .span()
+                .or_else(|| table.get_key_value(key).and_then(|(k, _)| k.span()))
+            {
                 spans.insert(key.to_string(), span);
             }
         }
@@ -397,8 +457,13 @@ impl Reader {
                     Err(e) => {
                         // Find which key the message is about to point at it.
                         let message = e.message().trim().to_string();
-                        let key = MESH_KEYS.iter().find(|k| message.contains(&format!("mesh.{k}")) || message.contains(&format!("`{k}`")));
-                        let span = key.and_then(|k| spans.get(*k).cloned()).or_else(|| entry.span());
+                        let key = MESH_KEYS.iter().find(|k| {
+                            message.contains(&format!("mesh.{k}"))
+                                || message.contains(&format!("`{k}`"))
+                        });
+                        let span = key
+                            .and_then(|k| spans.get(*k).cloned())
+                            .or_else(|| entry.span());
                         let name = key.map_or("mesh".to_string(), |k| format!("mesh.{k}"));
                         self.error(span, &name, message, None);
                     }
@@ -412,17 +477,29 @@ impl Reader {
     fn problem(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<Problem> {
         let Some((table, _)) = self.subtable(root, "", "problem") else {
             if root.get("problem").is_none() {
-                self.error(None, "problem", "no [problem] table", Some("add [problem] with `method = \"fe\"` and `source = ...`".into()));
+                self.error(
+                    None,
+                    "problem",
+                    "no [problem] table",
+                    Some("add [problem] with `method = \"fe\"` and `source = ...`".into()),
+                );
             }
             return None;
         };
         self.check_keys(table, "problem", PROBLEM_KEYS);
-        let kind = self.string_at(table, "problem", "kind").unwrap_or_else(|| "diffusion".into());
+        let kind = self
+            .string_at(table, "problem", "kind")
+            .unwrap_or_else(|| "diffusion".into());
         match kind.as_str() {
             "diffusion" => {
                 for key in ["field", "metric"] {
                     if let Some(e) = self.entry(table, "problem", key) {
-                        self.error(e.key_span.clone(), &e.name, "only used by kind = \"gradient\"", None);
+                        self.error(
+                            e.key_span.clone(),
+                            &e.name,
+                            "only used by kind = \"gradient\"",
+                            None,
+                        );
                     }
                 }
                 let method = self.method(table);
@@ -442,25 +519,48 @@ impl Reader {
             "gradient" => {
                 for key in ["method", "conductivity", "source"] {
                     if let Some(e) = self.entry(table, "problem", key) {
-                        self.error(e.key_span.clone(), &e.name, "not used by kind = \"gradient\"", Some("a gradient problem takes `field` and `metric`".into()));
+                        self.error(
+                            e.key_span.clone(),
+                            &e.name,
+                            "not used by kind = \"gradient\"",
+                            Some("a gradient problem takes `field` and `metric`".into()),
+                        );
                     }
                 }
                 if let Some(e) = self.entry(root, "", "boundary") {
-                    self.error(e.key_span.clone(), "boundary", "a gradient problem has no boundary conditions", None);
+                    self.error(
+                        e.key_span.clone(),
+                        "boundary",
+                        "a gradient problem has no boundary conditions",
+                        None,
+                    );
                 }
                 let field = match self.entry(table, "problem", "field") {
                     Some(_) => self.expression_at(table, "problem", "field", scope),
                     None => {
-                        self.error(None, "problem.field", "missing: the cell field whose gradient is computed", Some("e.g. field = \"sin(pi*x)\"".into()));
+                        self.error(
+                            None,
+                            "problem.field",
+                            "missing: the cell field whose gradient is computed",
+                            Some("e.g. field = \"sin(pi*x)\"".into()),
+                        );
                         None
                     }
                 };
                 let metric = self.gradient_metric(table);
-                Some(Problem::Gradient(GradientSpec { field: field?, metric: metric? }))
+                Some(Problem::Gradient(GradientSpec {
+                    field: field?,
+                    metric: metric?,
+                }))
             }
             other => {
                 let span = self.entry(table, "problem", "kind").and_then(|e| e.span());
-                self.error(span, "problem.kind", format!("unknown problem kind \"{other}\""), Some("use \"diffusion\" (default) or \"gradient\"".into()));
+                self.error(
+                    span,
+                    "problem.kind",
+                    format!("unknown problem kind \"{other}\""),
+                    Some("use \"diffusion\" (default) or \"gradient\"".into()),
+                );
                 None
             }
         }
@@ -468,7 +568,12 @@ impl Reader {
 
     fn method(&mut self, table: &dyn TableLike) -> Option<Method> {
         let Some(entry) = self.entry(table, "problem", "method") else {
-            self.error(None, "problem.method", "missing: which discretisation to use", Some(format!("one of {}", METHODS.join(", "))));
+            self.error(
+                None,
+                "problem.method",
+                "missing: which discretisation to use",
+                Some(format!("one of {}", METHODS.join(", "))),
+            );
             return None;
         };
         let name = entry.item.as_str().map(str::to_string);
@@ -485,7 +590,12 @@ impl Reader {
                     Some(s) => format!("did you mean \"{s}\"? methods: {}", METHODS.join(", ")),
                     None => format!("methods: {}", METHODS.join(", ")),
                 };
-                self.error(entry.span(), &entry.name, format!("unknown method \"{other}\""), Some(help));
+                self.error(
+                    entry.span(),
+                    &entry.name,
+                    format!("unknown method \"{other}\""),
+                    Some(help),
+                );
                 return None;
             }
             None => {
@@ -507,7 +617,12 @@ impl Reader {
         };
         let size = rows.len();
         if !(1..=3).contains(&size) {
-            self.error(entry.span(), &entry.name, format!("a tensor has 1 to 3 rows, found {size}"), None);
+            self.error(
+                entry.span(),
+                &entry.name,
+                format!("a tensor has 1 to 3 rows, found {size}"),
+                None,
+            );
             return None;
         }
         let mut tensor = Vec::with_capacity(size);
@@ -515,12 +630,25 @@ impl Reader {
         for (i, row) in rows.iter().enumerate() {
             let name = format!("{}[{i}]", entry.name);
             let Value::Array(cols) = row else {
-                self.error(row.span(), &name, "expected a row (an array)", Some("write the tensor as [[kxx, kxy], [kxy, kyy]]".into()));
+                self.error(
+                    row.span(),
+                    &name,
+                    "expected a row (an array)",
+                    Some("write the tensor as [[kxx, kxy], [kxy, kyy]]".into()),
+                );
                 ok = false;
                 continue;
             };
             if cols.len() != size {
-                self.error(row.span(), &name, format!("row has {} entries; the tensor is {size}×{size}", cols.len()), None);
+                self.error(
+                    row.span(),
+                    &name,
+                    format!(
+                        "row has {} entries; the tensor is {size}×{size}",
+                        cols.len()
+                    ),
+                    None,
+                );
                 ok = false;
                 continue;
             }
@@ -557,7 +685,14 @@ impl Reader {
             return out;
         };
         let Some(array) = entry.item.as_array_of_tables() else {
-            self.error(entry.span(), "boundary", "expected [[boundary]] tables", Some("write each condition as a [[boundary]] table with tag, type and value".into()));
+            self.error(
+                entry.span(),
+                "boundary",
+                "expected [[boundary]] tables",
+                Some(
+                    "write each condition as a [[boundary]] table with tag, type and value".into(),
+                ),
+            );
             return out;
         };
         for (i, table) in array.iter().enumerate() {
@@ -576,14 +711,24 @@ impl Reader {
             let kind_name = match self.entry(table, &prefix, "type") {
                 Some(_) => self.string_at(table, &prefix, "type"),
                 None => {
-                    self.error(header.clone(), &format!("{prefix}.type"), "missing: dirichlet, neumann or robin", None);
+                    self.error(
+                        header.clone(),
+                        &format!("{prefix}.type"),
+                        "missing: dirichlet, neumann or robin",
+                        None,
+                    );
                     None
                 }
             };
             let value = match self.entry(table, &prefix, "value") {
                 Some(_) => self.expression_at(table, &prefix, "value", scope),
                 None => {
-                    self.error(header.clone(), &format!("{prefix}.value"), "missing: the boundary value (a number or an expression)", None);
+                    self.error(
+                        header.clone(),
+                        &format!("{prefix}.value"),
+                        "missing: the boundary value (a number or an expression)",
+                        None,
+                    );
                     None
                 }
             };
@@ -594,31 +739,56 @@ impl Reader {
                     let alpha = match self.entry(table, &prefix, "alpha") {
                         Some(_) => self.expression_at(table, &prefix, "alpha", scope),
                         None => {
-                            self.error(header.clone(), &format!("{prefix}.alpha"), "missing: a Robin condition K∇u·n + α u = g needs α", None);
+                            self.error(
+                                header.clone(),
+                                &format!("{prefix}.alpha"),
+                                "missing: a Robin condition K∇u·n + α u = g needs α",
+                                None,
+                            );
                             None
                         }
                     };
                     match (alpha, value) {
-                        (Some(alpha), Some(value)) => Some(BoundaryKindSpec::Robin { alpha, value }),
+                        (Some(alpha), Some(value)) => {
+                            Some(BoundaryKindSpec::Robin { alpha, value })
+                        }
                         _ => None,
                     }
                 }
                 Some(other) => {
                     let span = self.entry(table, &prefix, "type").and_then(|e| e.span());
                     let kinds = ["dirichlet".to_string(), "neumann".into(), "robin".into()];
-                    let help = closest(other, &kinds).map_or("use dirichlet, neumann or robin".into(), |s| format!("did you mean \"{s}\"?"));
-                    self.error(span, &format!("{prefix}.type"), format!("unknown boundary type \"{other}\""), Some(help));
+                    let help = closest(other, &kinds)
+                        .map_or("use dirichlet, neumann or robin".into(), |s| {
+                            format!("did you mean \"{s}\"?")
+                        });
+                    self.error(
+                        span,
+                        &format!("{prefix}.type"),
+                        format!("unknown boundary type \"{other}\""),
+                        Some(help),
+                    );
                     None
                 }
                 None => None,
             };
             if kind_name.as_deref() != Some("robin") {
                 if let Some(e) = self.entry(table, &prefix, "alpha") {
-                    self.error(e.key_span.clone(), &e.name, "only a robin condition takes alpha", None);
+                    self.error(
+                        e.key_span.clone(),
+                        &e.name,
+                        "only a robin condition takes alpha",
+                        None,
+                    );
                 }
             }
             if let (Some(tag), Some(kind)) = (tag, kind) {
-                out.push(BoundarySpec { tag, kind, tag_span, key: prefix });
+                out.push(BoundarySpec {
+                    tag,
+                    kind,
+                    tag_span,
+                    key: prefix,
+                });
             }
         }
         out
@@ -627,7 +797,12 @@ impl Reader {
     fn gradient_metric(&mut self, table: &dyn TableLike) -> Option<GradientMetric> {
         let Some((metric, entry)) = self.subtable(table, "problem", "metric") else {
             if table.get("metric").is_none() {
-                self.error(None, "problem.metric", "missing: the face metric Ω", Some("e.g. metric = { type = \"diagonal\", value = 0.2 }".into()));
+                self.error(
+                    None,
+                    "problem.metric",
+                    "missing: the face metric Ω",
+                    Some("e.g. metric = { type = \"diagonal\", value = 0.2 }".into()),
+                );
             }
             return None;
         };
@@ -637,42 +812,78 @@ impl Reader {
             Some("diagonal") => match self.number_at(metric, "problem.metric", "value") {
                 Some(v) if v.is_finite() => Some(GradientMetric::Diagonal(v)),
                 Some(v) => {
-                    self.error(entry.span(), "problem.metric.value", format!("not finite: {v}"), None);
+                    self.error(
+                        entry.span(),
+                        "problem.metric.value",
+                        format!("not finite: {v}"),
+                        None,
+                    );
                     None
                 }
                 None => {
                     if metric.get("value").is_none() {
-                        self.error(entry.span(), "problem.metric.value", "missing: the diagonal value σ of Ω = σ I", None);
+                        self.error(
+                            entry.span(),
+                            "problem.metric.value",
+                            "missing: the diagonal value σ of Ω = σ I",
+                            None,
+                        );
                     }
                     None
                 }
             },
             Some("file") => {
-                let scale = self.number_at(metric, "problem.metric", "scale").unwrap_or(1.0);
+                let scale = self
+                    .number_at(metric, "problem.metric", "scale")
+                    .unwrap_or(1.0);
                 let file = self.string_at(metric, "problem.metric", "file");
                 let Some(file) = file else {
                     if metric.get("file").is_none() {
-                        self.error(entry.span(), "problem.metric.file", "missing: the file of `row column value` lines", None);
+                        self.error(
+                            entry.span(),
+                            "problem.metric.file",
+                            "missing: the file of `row column value` lines",
+                            None,
+                        );
                     }
                     return None;
                 };
                 let path = self.relative(&file);
                 if !path.is_file() {
-                    let span = self.entry(metric, "problem.metric", "file").and_then(|e| e.span());
-                    self.error(span, "problem.metric.file", format!("no such file: {}", path.display()), Some("paths are relative to the case file".into()));
+                    let span = self
+                        .entry(metric, "problem.metric", "file")
+                        .and_then(|e| e.span());
+                    self.error(
+                        span,
+                        "problem.metric.file",
+                        format!("no such file: {}", path.display()),
+                        Some("paths are relative to the case file".into()),
+                    );
                     return None;
                 }
                 Some(GradientMetric::File { path, scale })
             }
             Some("two-point") => Some(GradientMetric::TwoPoint),
             Some(other) => {
-                let span = self.entry(metric, "problem.metric", "type").and_then(|e| e.span());
-                self.error(span, "problem.metric.type", format!("unknown metric type \"{other}\""), Some("use \"diagonal\", \"file\" or \"two-point\"".into()));
+                let span = self
+                    .entry(metric, "problem.metric", "type")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "problem.metric.type",
+                    format!("unknown metric type \"{other}\""),
+                    Some("use \"diagonal\", \"file\" or \"two-point\"".into()),
+                );
                 None
             }
             None => {
                 if metric.get("type").is_none() {
-                    self.error(entry.span(), "problem.metric.type", "missing: \"diagonal\", \"file\" or \"two-point\"", None);
+                    self.error(
+                        entry.span(),
+                        "problem.metric.type",
+                        "missing: \"diagonal\", \"file\" or \"two-point\"",
+                        None,
+                    );
                 }
                 None
             }
@@ -680,7 +891,10 @@ impl Reader {
     }
 
     fn relative(&self, file: &str) -> PathBuf {
-        Path::new(&self.file).parent().unwrap_or(Path::new(".")).join(file)
+        Path::new(&self.file)
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(file)
     }
 
     fn exact(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<ExactSpec> {
@@ -689,7 +903,12 @@ impl Reader {
         let solution = match self.entry(table, "exact", "solution") {
             Some(_) => self.expression_at(table, "exact", "solution", scope),
             None => {
-                self.error(entry.span(), "exact.solution", "missing: the exact solution u(x, y, z)", None);
+                self.error(
+                    entry.span(),
+                    "exact.solution",
+                    "missing: the exact solution u(x, y, z)",
+                    None,
+                );
                 None
             }
         };
@@ -700,7 +919,12 @@ impl Reader {
                     let mut parts = Vec::new();
                     for (i, v) in array.iter().enumerate() {
                         let item = Item::Value(v.clone());
-                        if let Some(e) = self.expression_of(&item, &format!("exact.gradient[{i}]"), v.span(), scope) {
+                        if let Some(e) = self.expression_of(
+                            &item,
+                            &format!("exact.gradient[{i}]"),
+                            v.span(),
+                            scope,
+                        ) {
                             parts.push(e);
                         }
                     }
@@ -712,7 +936,10 @@ impl Reader {
                 }
             },
         };
-        Some(ExactSpec { solution: solution?, gradient })
+        Some(ExactSpec {
+            solution: solution?,
+            gradient,
+        })
     }
 
     fn solver(&mut self, root: &dyn TableLike) -> SolverSpec {
@@ -724,7 +951,12 @@ impl Reader {
         if let Some(kind) = self.string_at(table, "solver", "type") {
             if kind != "direct" {
                 let span = self.entry(table, "solver", "type").and_then(|e| e.span());
-                self.error(span, "solver.type", format!("unknown solver type \"{kind}\""), Some("\"direct\" (sparse Cholesky/LDLᵀ/LU from faer) is available".into()));
+                self.error(
+                    span,
+                    "solver.type",
+                    format!("unknown solver type \"{kind}\""),
+                    Some("\"direct\" (sparse Cholesky/LDLᵀ/LU from faer) is available".into()),
+                );
             }
         }
         if let Some(name) = self.string_at(table, "solver", "factorization") {
@@ -733,19 +965,34 @@ impl Reader {
                 "ldlt" => Some(Factorization::Ldlt),
                 "lu" => Some(Factorization::Lu),
                 other => {
-                    let span = self.entry(table, "solver", "factorization").and_then(|e| e.span());
-                    self.error(span, "solver.factorization", format!("unknown factorisation \"{other}\""), Some("use \"llt\", \"ldlt\" or \"lu\"".into()));
+                    let span = self
+                        .entry(table, "solver", "factorization")
+                        .and_then(|e| e.span());
+                    self.error(
+                        span,
+                        "solver.factorization",
+                        format!("unknown factorisation \"{other}\""),
+                        Some("use \"llt\", \"ldlt\" or \"lu\"".into()),
+                    );
                     None
                 }
             };
         }
-        for (key, slot) in [("residual_warning", &mut spec.residual_warning), ("residual_limit", &mut spec.residual_limit)] {
+        for (key, slot) in [
+            ("residual_warning", &mut spec.residual_warning),
+            ("residual_limit", &mut spec.residual_limit),
+        ] {
             if let Some(v) = self.number_at(table, "solver", key) {
                 if v > 0.0 && v.is_finite() {
                     *slot = v;
                 } else {
                     let span = self.entry(table, "solver", key).and_then(|e| e.span());
-                    self.error(span, &format!("solver.{key}"), format!("must be a positive number, found {v}"), None);
+                    self.error(
+                        span,
+                        &format!("solver.{key}"),
+                        format!("must be a positive number, found {v}"),
+                        None,
+                    );
                 }
             }
         }
@@ -756,7 +1003,11 @@ impl Reader {
         let stem = Path::new(&self.file)
             .file_stem()
             .map_or("hasse".to_string(), |s| s.to_string_lossy().into_owned());
-        let mut spec = OutputSpec { directory: PathBuf::from("."), name: stem, write: true };
+        let mut spec = OutputSpec {
+            directory: PathBuf::from("."),
+            name: stem,
+            write: true,
+        };
         let Some((table, _)) = self.subtable(root, "", "output") else {
             return spec;
         };
@@ -767,7 +1018,12 @@ impl Reader {
         if let Some(n) = self.string_at(table, "output", "name") {
             if n.is_empty() || n.contains(['/', '\\']) {
                 let span = self.entry(table, "output", "name").and_then(|e| e.span());
-                self.error(span, "output.name", "a file stem without directories", Some("put directories in output.directory".into()));
+                self.error(
+                    span,
+                    "output.name",
+                    "a file stem without directories",
+                    Some("put directories in output.directory".into()),
+                );
             } else {
                 spec.name = n;
             }
