@@ -225,7 +225,9 @@ impl Case {
                     .get(&key)
                     .or_else(|| self.mesh_spans.get(""))
                     .cloned();
-                collector.error(span, &format!("mesh.{key}"), message, None);
+                let help = (key == "file")
+                    .then(|| "mesh paths are relative to the case file's directory".to_string());
+                collector.error(span, &format!("mesh.{key}"), message, help);
                 return Err(Diagnostics(collector.diagnostics));
             }
         };

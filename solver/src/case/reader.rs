@@ -475,7 +475,7 @@ impl Reader {
     }
 
     fn problem(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<Problem> {
-        let Some((table, _)) = self.subtable(root, "", "problem") else {
+        let Some((table, problem_entry)) = self.subtable(root, "", "problem") else {
             if root.get("problem").is_none() {
                 self.error(
                     None,
@@ -502,7 +502,7 @@ impl Reader {
                         );
                     }
                 }
-                let method = self.method(table);
+                let method = self.method(table, problem_entry.span());
                 let conductivity = self.conductivity(table, scope);
                 let source = match self.entry(table, "problem", "source") {
                     Some(_) => self.expression_at(table, "problem", "source", scope),
@@ -539,7 +539,7 @@ impl Reader {
                     Some(_) => self.expression_at(table, "problem", "field", scope),
                     None => {
                         self.error(
-                            None,
+                            problem_entry.span(),
                             "problem.field",
                             "missing: the cell field whose gradient is computed",
                             Some("e.g. field = \"sin(pi*x)\"".into()),
@@ -566,10 +566,10 @@ impl Reader {
         }
     }
 
-    fn method(&mut self, table: &dyn TableLike) -> Option<Method> {
+    fn method(&mut self, table: &dyn TableLike, header: Option<Range<usize>>) -> Option<Method> {
         let Some(entry) = self.entry(table, "problem", "method") else {
             self.error(
-                None,
+                header,
                 "problem.method",
                 "missing: which discretisation to use",
                 Some(format!("one of {}", METHODS.join(", "))),
