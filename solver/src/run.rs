@@ -149,6 +149,21 @@ fn solve_diffusion(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     let problem = diffusion_problem(case, spec);
+    let mut warnings = Vec::new();
+    if let (crate::diffusion::Method::Fv, Coefficient::Tensor(rows)) =
+        (spec.method, &spec.conductivity)
+    {
+        let off_diagonal_zero = rows.iter().enumerate().all(|(i, row)| {
+            row.iter()
+                .enumerate()
+                .all(|(j, e)| i == j || (e.is_constant() && e.eval(&[], 0.0) == 0.0))
+        });
+        if !off_diagonal_zero {
+            warnings.push(
+                "the two-point flux (fv) sees only n·K·n: with off-diagonal K it is inconsistent; use fv-mimetic or fe".into(),
+            );
+        }
+    }
     phase("assembling and solving");
     let started = Instant::now();
     let solution = problem.solve(complex).map_err(|e| {
@@ -168,7 +183,6 @@ fn solve_diffusion(
         ),
         ("solve".to_string(), report.solve_seconds),
     ];
-    let mut warnings = Vec::new();
     if solution.pure_neumann {
         warnings.push(format!(
             "pure Neumann problem: solved with zero mean (data imbalance {:.2e} removed)",
