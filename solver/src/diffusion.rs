@@ -512,7 +512,7 @@ impl Diffusion {
                             rhs[cell] += evaluate(g, xf, "Neumann value")? * area;
                         }
                         BoundaryKind::Robin { alpha, value } => {
-                            let a = robin_alpha(bc, f, alpha, xf)?;
+                            let a = robin_alpha(bc, f, alpha, xg)?;
                             face_weight[f] = Some(sigma * a * area / (sigma + a * area));
                             face_value[f] = sign * evaluate(value, xg, "Robin value")? / a;
                         }
