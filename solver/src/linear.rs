@@ -143,8 +143,8 @@ impl LbltFactor {
                     }
                     i += 1;
                 } else {
-                    // |det| / ‖·‖_F bounds the smaller singular value from below
-                    // by at most a factor √2.
+                    // |det| / ‖·‖_F is the block's smaller singular value
+                    // up to a factor √2 (σ_max ≤ ‖·‖_F ≤ √2 σ_max).
                     let (a, b) = (block[(i, i)], block[(i + 1, i + 1)]);
                     let norm = (a * a + b * b + 2.0 * e * e).sqrt();
                     if (a * b - e * e).abs() <= tolerance * norm {
