@@ -598,4 +598,61 @@ mod tests {
             SolveError::Singular { method: "LBLᵀ" }
         );
     }
+
+    /// The five-point Laplacian of an m×m grid shifted by −σ I.
+    fn shifted_laplacian(m: usize, sigma: f64) -> SparseColMat<usize, f64> {
+        let mut e = Vec::new();
+        let id = |i: usize, j: usize| i + m * j;
+        for j in 0..m {
+            for i in 0..m {
+                e.push((id(i, j), id(i, j), 4.0 - sigma));
+                if i + 1 < m {
+                    e.push((id(i, j), id(i + 1, j), -1.0));
+                    e.push((id(i + 1, j), id(i, j), -1.0));
+                }
+                if j + 1 < m {
+                    e.push((id(i, j), id(i, j + 1), -1.0));
+                    e.push((id(i, j + 1), id(i, j), -1.0));
+                }
+            }
+        }
+        matrix(m * m, &e)
+    }
+
+    #[test]
+    fn lblt_solves_an_indefinite_shifted_laplacian_with_many_supernodes() {
+        // Eigenvalues 4 − 2cos(iπ/31) − 2cos(jπ/31) − σ, 1 ≤ i, j ≤ 30: with
+        // σ = 3.3, 317 of the 900 are negative; the nearest to zero is
+        // 0.0092 (i = 5, j = 21) and the largest 4.68, so cond ≈ 510.
+        let m = 30;
+        let a = shifted_laplacian(m, 3.3);
+        let exact: Vec<f64> = (0..m * m)
+            .map(|k| ((k % 7) as f64 - 3.0) * 0.5 + (k as f64).cos())
+            .collect();
+        let rhs = product(&a, &exact);
+        let (x, report) = solve(&a, &rhs, Factorization::Lblt).unwrap();
+        assert!(report.relative_residual < 1e-13, "{report:?}");
+        // Error ≤ cond · residual: well below 1e-10.
+        assert!(
+            relative_error(&x, &exact) < 1e-10,
+            "{:e}",
+            relative_error(&x, &exact)
+        );
+        let solver = DirectSolver::analyse(a.as_ref(), Factorization::Lblt).unwrap();
+        let Analysis::Lblt(analysis) = &solver.analysis else {
+            panic!("an LBLᵀ analysis was asked for");
+        };
+        let SymbolicCholeskyRaw::Supernodal(symbolic) = analysis.raw() else {
+            panic!("the LBLᵀ analysis must be supernodal");
+        };
+        assert!(
+            symbolic.n_supernodes() > 10,
+            "{} supernodes",
+            symbolic.n_supernodes()
+        );
+        assert_eq!(
+            solve(&a, &rhs, Factorization::Llt).unwrap_err(),
+            SolveError::NotPositiveDefinite
+        );
+    }
 }
