@@ -1,7 +1,8 @@
 //! Mesh generators checked against independently derived numbers: closed-form
 //! cell counts, Euler characteristics and Betti numbers of the shapes,
 //! ∂∂ = 0, tag sizes, areas by the shoelace formula, sphere radii, torus
-//! orientation and perturbation invariants.
+//! orientation, perturbation invariants, and for Voronoi meshes convexity,
+//! exact tiling of the rectangle and the nearest-site property.
 
 use hasse_complex::generate::{
     annulus, box3, delaunay, graded_axis, grid, hollow_box, interval, kuhn, perturb, rectangle,
