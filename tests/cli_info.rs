@@ -54,6 +54,8 @@ fn shipped_cases_report_their_topology() {
             "χ = 1",
             "β = (1, 0, 0)",
         ),
+        // 400 sites give 400 polygons filling the unit square (a disk).
+        ("cases/voronoi.toml", "K2 = 400", "χ = 1", "β = (1, 0, 0)"),
     ];
     for (case, cells, euler, betti) in expected {
         let (code, out, err) = info(&repo(case));
@@ -64,6 +66,8 @@ fn shipped_cases_report_their_topology() {
     }
     let (_, out, _) = info(&repo("cases/torus.toml"));
     assert!(out.contains("(closed)"), "{out}");
+    let (_, out, _) = info(&repo("cases/voronoi.toml"));
+    assert!(out.contains("total area 1.000000e0"), "{out}");
     let (_, out, _) = info(&repo("cases/hollow-box.toml"));
     assert!(out.contains("tag        cavity: 24 2-cells"), "{out}");
 }
@@ -102,6 +106,11 @@ fn bad_input_exits_2_naming_file_and_key() {
             "does-not-exist.msh",
         ),
         ("empty.toml", "title = \"no mesh\"\n", "no [mesh] table"),
+        (
+            "no-sites.toml",
+            "[mesh]\ngenerator = \"voronoi\"\nn = [0]\n",
+            "mesh.n",
+        ),
     ];
     for (name, text, needle) in cases {
         let path = dir.join(name);

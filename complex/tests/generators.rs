@@ -1,11 +1,12 @@
 //! Mesh generators checked against independently derived numbers: closed-form
 //! cell counts, Euler characteristics and Betti numbers of the shapes,
 //! ∂∂ = 0, tag sizes, areas by the shoelace formula, sphere radii, torus
-//! orientation and perturbation invariants.
+//! orientation, perturbation invariants, and for Voronoi meshes convexity,
+//! exact tiling of the rectangle and the nearest-site property.
 
 use hasse_complex::generate::{
     annulus, box3, delaunay, graded_axis, grid, hollow_box, interval, kuhn, perturb, rectangle,
-    sphere, torus, uniform_axis,
+    sphere, torus, uniform_axis, voronoi, voronoi_with_sites,
 };
 use hasse_complex::{Complex, ComplexError};
 use rand::{Rng, SeedableRng};
@@ -641,6 +642,160 @@ fn delaunay_rejects_bad_point_sets() {
     assert!(e.contains("points 0 and 2"), "{e}");
 }
 
+// ---------------------------------------------------------------- Voronoi
+
+/// Corners of polygon `c` in boundary order, walked along its oriented
+/// edges (each edge taken with its sign in ∂₂), and the signed shoelace
+/// area of that walk.
+fn polygon_walk(k: &Complex, c: usize) -> (Vec<usize>, f64) {
+    let d2 = k.boundary_csc(2);
+    let mut next = std::collections::HashMap::new();
+    for (e, &s) in d2.outer_view(c).unwrap().iter() {
+        let (t, h) = edge_ends(k, e);
+        let (t, h) = if s > 0 { (t, h) } else { (h, t) };
+        assert!(next.insert(t, h).is_none(), "cell {c}: two edges leave {t}");
+    }
+    let start = *next.keys().min().unwrap();
+    let mut walk = vec![start];
+    let mut v = next[&start];
+    while v != start {
+        walk.push(v);
+        v = next[&v];
+        assert!(
+            walk.len() <= next.len(),
+            "cell {c}: its edges are not one cycle"
+        );
+    }
+    assert_eq!(
+        walk.len(),
+        next.len(),
+        "cell {c}: its edges are not one cycle"
+    );
+    let area = (0..walk.len())
+        .map(|i| {
+            let (p, q) = (point3(k, walk[i]), point3(k, walk[(i + 1) % walk.len()]));
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<f64>()
+        / 2.0;
+    (walk, area)
+}
+
+#[test]
+fn voronoi_cells_are_convex_and_tile_the_rectangle() {
+    let (x, y) = ([-1.0, 2.0], [0.5, 1.5]);
+    let rect = (x[1] - x[0]) * (y[1] - y[0]);
+    for (n, seed, lloyd) in [(1, 0, 0), (2, 1, 0), (37, 5, 0), (200, 6, 3), (500, 7, 10)] {
+        let k = voronoi(n, x, y, seed, lloyd).unwrap();
+        assert_eq!(k.cell_count(2), n);
+        assert_topology(&k, 1, &[1, 0, 0]);
+        let mut total = 0.0;
+        for c in 0..n {
+            let (walk, area) = polygon_walk(&k, c);
+            // Strictly convex: every corner turns the same way as the walk.
+            let m = walk.len();
+            for i in 0..m {
+                let (a, b, d) = (
+                    point3(&k, walk[i]),
+                    point3(&k, walk[(i + 1) % m]),
+                    point3(&k, walk[(i + 2) % m]),
+                );
+                let turn = cross(sub(b, a), sub(d, b))[2];
+                assert!(
+                    turn * area > 0.0,
+                    "n = {n}: cell {c} is not strictly convex at corner {i}"
+                );
+            }
+            assert!(
+                (area.abs() - k.measure(2)[c]).abs() <= 1e-12 * rect,
+                "n = {n}: cell {c} measure {} vs shoelace {area}",
+                k.measure(2)[c]
+            );
+            total += area.abs();
+        }
+        assert!(
+            (total - rect).abs() <= 1e-12 * rect,
+            "n = {n}: areas sum to {total}"
+        );
+        // Boundary edges lie exactly on the sides, and the side tags cover them.
+        let side_length = |name: &str| -> f64 {
+            k.tag(name)
+                .unwrap()
+                .cells
+                .iter()
+                .map(|&e| k.measure(1)[e])
+                .sum()
+        };
+        for (name, length) in [("xmin", 1.0), ("xmax", 1.0), ("ymin", 3.0), ("ymax", 3.0)] {
+            assert!(
+                (side_length(name) - length).abs() < 1e-12,
+                "n = {n}: {name}"
+            );
+        }
+        assert_eq!(
+            tag_len(&k, "boundary"),
+            ["xmin", "xmax", "ymin", "ymax"]
+                .iter()
+                .map(|t| tag_len(&k, t))
+                .sum::<usize>()
+        );
+    }
+}
+
+#[test]
+fn voronoi_cells_are_the_nearest_site_regions() {
+    let (k, sites) = voronoi_with_sites(150, [0.0, 1.0], [0.0, 1.0], 11, 2).unwrap();
+    let d = |p: P3, q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]);
+    for (c, &s) in sites.iter().enumerate() {
+        // Every corner of cell c is at least as near to site c as to any other.
+        for &v in k.cell_vertices(2, c) {
+            let p = point3(&k, v);
+            let own = d(p, s);
+            assert!(
+                sites.iter().all(|&q| own <= d(p, q) + 1e-12),
+                "cell {c}, corner {v}"
+            );
+        }
+        // The site lies inside its cell: on the inner side of every edge.
+        let (walk, area) = polygon_walk(&k, c);
+        for i in 0..walk.len() {
+            let (a, b) = (point3(&k, walk[i]), point3(&k, walk[(i + 1) % walk.len()]));
+            let side = cross(sub(b, a), sub([s[0], s[1], 0.0], a))[2];
+            assert!(side * area > 0.0, "site {c} outside its cell");
+        }
+    }
+}
+
+#[test]
+fn voronoi_is_seeded_and_lloyd_moves_sites_towards_centroids() {
+    let k = voronoi(80, [0.0, 1.0], [0.0, 1.0], 3, 2).unwrap();
+    assert_eq!(k, voronoi(80, [0.0, 1.0], [0.0, 1.0], 3, 2).unwrap());
+    assert_ne!(k, voronoi(80, [0.0, 1.0], [0.0, 1.0], 4, 2).unwrap());
+    // Lloyd's fixed points are centroidal tessellations: the largest
+    // site–centroid distance shrinks with the iterations.
+    let offset = |lloyd: usize| {
+        let (k, sites) = voronoi_with_sites(80, [0.0, 1.0], [0.0, 1.0], 3, lloyd).unwrap();
+        (0..80)
+            .map(|c| {
+                let g = k.centroid_of(2, c);
+                (g[0] - sites[c][0]).hypot(g[1] - sites[c][1])
+            })
+            .fold(0.0, f64::max)
+    };
+    let (none, some, many) = (offset(0), offset(5), offset(40));
+    assert!(some < none && many < some, "{none} {some} {many}");
+}
+
+#[test]
+fn voronoi_rejects_bad_parameters() {
+    let e = message(voronoi(0, [0.0, 1.0], [0.0, 1.0], 0, 0).unwrap_err());
+    assert!(e.contains("at least 1 site"), "{e}");
+    let e = message(voronoi(5, [1.0, 1.0], [0.0, 1.0], 0, 0).unwrap_err());
+    assert!(e.contains("x extent"), "{e}");
+    let e = message(voronoi(5, [0.0, 1.0], [0.0, f64::NAN], 0, 0).unwrap_err());
+    assert!(e.contains("y extent"), "{e}");
+}
+
 // ---------------------------------------------------------------- perturbation
 
 fn on_box_boundary(p: &[f64]) -> bool {
@@ -722,6 +877,7 @@ fn boundary_of_boundary_vanishes_on_every_generator() {
         torus(3.0, 1.0, 8, 5).unwrap(),
         sphere(1.0, 2).unwrap(),
         hollow_box(4, [1, 3]).unwrap(),
+        voronoi(40, [0.0, 1.0], [0.0, 1.0], 2, 1).unwrap(),
     ];
     for k in &complexes {
         assert_dd_zero(k);

@@ -78,6 +78,39 @@ impl Method {
     }
 }
 
+/// Where the cell values of the two-point finite-volume method ([`Method::Fv`])
+/// are located. The two-point flux is consistent only when the line between
+/// two neighbouring cell points is orthogonal to their common face; on
+/// meshes that are orthogonal for other points than the centroids, put the
+/// unknowns there.
+///
+/// ```
+/// use hasse_complex::generate::voronoi_with_sites;
+/// use hasse_solver::diffusion::{CellPoints, Conductivity, Diffusion, Method, BoundaryKind};
+/// use std::sync::Arc;
+/// let (mesh, sites) = voronoi_with_sites(100, [0.0, 1.0], [0.0, 1.0], 1, 0).unwrap();
+/// let u = |x: &[f64]| 1.0 + 2.0 * x[0] - x[1];
+/// let mut problem = Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 0.0))
+///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(u)));
+/// problem.cell_points = CellPoints::Given(sites.iter().flatten().copied().collect());
+/// let solution = problem.solve(&mesh).unwrap();
+/// // Linear solutions are reproduced exactly at the sites.
+/// for (c, s) in sites.iter().enumerate() {
+///     assert!((solution.values[c] - u(s)).abs() < 1e-11);
+/// }
+/// ```
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum CellPoints {
+    /// Cell centroids: consistent on K-orthogonal grids (boxes).
+    #[default]
+    Centroids,
+    /// Circumcentres of simplices: consistent on Delaunay triangulations
+    /// and well-centred simplicial meshes.
+    Circumcentres,
+    /// One point per top cell (stride d), e.g. the sites of a Voronoi mesh.
+    Given(Arc<[f64]>),
+}
+
 /// Where the unknowns of a method live.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Location {
@@ -117,6 +150,8 @@ pub struct Diffusion {
     pub boundary: Vec<BoundaryCondition>,
     /// Direct factorisation (default: LLᵀ, the systems are SPD).
     pub factorization: Factorization,
+    /// Where the cell values of [`Method::Fv`] live (default: centroids).
+    pub cell_points: CellPoints,
     /// Largest relative imbalance Σ b / Σ |b| accepted for pure-Neumann data
     /// (quadrature makes consistent data slightly incompatible).
     pub neumann_tolerance: f64,
@@ -180,6 +215,9 @@ pub struct Solution {
     pub pure_neumann: bool,
     /// Relative imbalance of pure-Neumann data removed before solving.
     pub neumann_imbalance: f64,
+    /// The points whose exact values the cell values approximate (stride d),
+    /// when they are not the centroids (see [`CellPoints`]).
+    pub cell_points: Option<Vec<f64>>,
 }
 
 impl Solution {
@@ -201,7 +239,9 @@ impl Solution {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Errors {
     /// Discrete L² error of the primary field (lumped-mass weights on
-    /// vertices, cell volumes on cells).
+    /// vertices, cell volumes on cells): sqrt(Σ w_i (u_i − u(x_i))²) with
+    /// x_i the vertices, or the cell points (centroids unless
+    /// [`Solution::cell_points`] says otherwise).
     pub l2: f64,
     /// Largest pointwise error of the primary field.
     pub max: f64,
@@ -235,6 +275,7 @@ impl Diffusion {
             source,
             boundary: Vec::new(),
             factorization: Factorization::Llt,
+            cell_points: CellPoints::Centroids,
             neumann_tolerance: 1e-2,
         }
     }
@@ -325,6 +366,7 @@ impl Diffusion {
         let face_area = complex.measure(n - 1);
         let face_centre = complex.centroid(n - 1);
         let x_face = |f: usize| &face_centre[f * d..(f + 1) * d];
+        let cell_points = self.cell_points(complex)?;
 
         let (incidence, metric, unknowns) = match self.method {
             Method::Fe => (
@@ -339,7 +381,10 @@ impl Diffusion {
             ),
             Method::Fv => (
                 complex.boundary(n).clone(),
-                fv::two_point(complex, &tensors)?,
+                match &cell_points {
+                    None => fv::two_point(complex, &tensors)?,
+                    Some(points) => fv::two_point_at(complex, &tensors, points)?,
+                },
                 cells,
             ),
             Method::Fd => (
@@ -447,9 +492,23 @@ impl Diffusion {
                         method: self.method.name(),
                         what: "boundary conditions with a non-diagonal boundary metric",
                     })?;
+                    // The ghost value sits where the two-point flux measures
+                    // the gradient: the foot of the perpendicular from the
+                    // cell point to the face (the centroid's foot is taken
+                    // as the face centroid, as on a box).
+                    let foot: Vec<f64> = match &cell_points {
+                        None => xf.to_vec(),
+                        Some(points) => {
+                            let p = &points[cell * d..(cell + 1) * d];
+                            let normal = &complex.normal()[f * d..(f + 1) * d];
+                            let s = fv::signed_distance(xf, p, normal, sign as i8);
+                            (0..d).map(|a| p[a] + s * sign * normal[a]).collect()
+                        }
+                    };
+                    let xg = foot.as_slice();
                     match &bc.kind {
                         BoundaryKind::Dirichlet(g) => {
-                            face_value[f] = sign * evaluate(g, xf, "Dirichlet value")?
+                            face_value[f] = sign * evaluate(g, xg, "Dirichlet value")?
                         }
                         BoundaryKind::Neumann(g) => {
                             face_weight[f] = Some(0.0);
@@ -458,9 +517,9 @@ impl Diffusion {
                             neumann_flux[f] = -sign * outward;
                         }
                         BoundaryKind::Robin { alpha, value } => {
-                            let a = robin_alpha(bc, f, alpha, xf)?;
+                            let a = robin_alpha(bc, f, alpha, xg)?;
                             face_weight[f] = Some(sigma * a * area / (sigma + a * area));
-                            face_value[f] = sign * evaluate(value, xf, "Robin value")? / a;
+                            face_value[f] = sign * evaluate(value, xg, "Robin value")? / a;
                         }
                     }
                 }
@@ -579,6 +638,38 @@ impl Diffusion {
             assembly_seconds,
             pure_neumann,
             neumann_imbalance,
+            cell_points,
+        })
+    }
+
+    /// The cell points of [`Method::Fv`] when they are not the centroids.
+    fn cell_points(&self, complex: &Complex) -> Result<Option<Vec<f64>>, DiffusionError> {
+        let (n, d) = (complex.dim(), complex.embedding_dim());
+        if self.cell_points != CellPoints::Centroids && self.method != Method::Fv {
+            return Err(DiffusionError::Unsupported {
+                method: self.method.name(),
+                what: "cell points other than centroids (only the two-point method \"fv\" moves its unknowns)",
+            });
+        }
+        Ok(match &self.cell_points {
+            CellPoints::Centroids => None,
+            CellPoints::Circumcentres => {
+                Some(complex.circumcentre(n).map_err(MetricError::from)?.to_vec())
+            }
+            CellPoints::Given(points) => {
+                let cells = complex.cell_count(n);
+                if points.len() != cells * d {
+                    return Err(DiffusionError::Metric(MetricError::UnsupportedMesh {
+                        method: self.method.name(),
+                        needs: "one given cell point per top cell",
+                        detail: format!(
+                            "{} coordinates given for {cells} top cells in R^{d}",
+                            points.len()
+                        ),
+                    }));
+                }
+                Some(points.to_vec())
+            }
         })
     }
 
@@ -719,7 +810,14 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
     let n = complex.dim();
     let d = complex.embedding_dim();
     let cells = complex.cell_count(n);
-    let centre = complex.centroid(n);
+    // Cell values stand for the exact field at their cell points.
+    let centre = match solution.location {
+        Location::CellCentred => solution
+            .cell_points
+            .as_deref()
+            .unwrap_or(complex.centroid(n)),
+        _ => complex.centroid(n),
+    };
     let face_centre = complex.centroid(n - 1);
     let by_cell = complex.boundary_csc(n);
     let top = complex.boundary(n);
@@ -819,7 +917,13 @@ pub fn errors(
             lumped_vertex_volumes(complex),
         ),
         _ => (
-            complex.centroid(n).chunks(d).map(<[f64]>::to_vec).collect(),
+            solution
+                .cell_points
+                .as_deref()
+                .unwrap_or(complex.centroid(n))
+                .chunks(d)
+                .map(<[f64]>::to_vec)
+                .collect(),
             complex.measure(n).to_vec(),
         ),
     };

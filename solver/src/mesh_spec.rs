@@ -3,13 +3,25 @@
 //!
 //! ```toml
 //! [mesh]
-//! generator = "rectangle"   # interval | rectangle | box | annulus | torus | sphere | hollow-box
+//! generator = "rectangle"   # interval | rectangle | box | annulus | torus | sphere | hollow-box | voronoi
 //! n = [32, 32]              # cells per axis
 //! x = [0.0, 1.0]            # extent per axis (default [0, 1])
 //! y = [0.0, 1.0]
 //! cells = "simplex"         # "cuboid" (default) or "simplex" (Kuhn triangles / tetrahedra)
 //! perturb = 0.2             # optional: move interior vertices by up to 0.2 × local h
 //! seed = 7                  # seed of the perturbation (default 0)
+//! ```
+//! or a polygonal mesh, the Voronoi diagram of `n` random sites clipped
+//! to the rectangle `x × y` (seeded, so the same table gives the same
+//! mesh), optionally smoothed by `lloyd` iterations of Lloyd's algorithm:
+//! ```toml
+//! [mesh]
+//! generator = "voronoi"
+//! n = [400]                 # number of sites = number of polygons
+//! x = [0.0, 1.0]
+//! y = [0.0, 1.0]
+//! seed = 3                  # site positions (default 0)
+//! lloyd = 5                 # optional, default 0
 //! ```
 //! or
 //! ```toml
@@ -66,7 +78,10 @@ pub struct MeshSpec {
     /// "cuboid" (default) or "simplex".
     pub cells: Option<String>,
     pub perturb: Option<f64>,
+    /// Seed of the perturbation, or of the Voronoi sites.
     pub seed: Option<u64>,
+    /// Lloyd iterations of the Voronoi generator.
+    pub lloyd: Option<usize>,
     /// Sphere radius.
     pub radius: Option<f64>,
     /// Icosphere subdivision levels.
@@ -278,10 +293,31 @@ impl MeshSpec {
                 })?;
                 generate::hollow_box(n[0], cavity).map_err(Generated::Complex)
             }
+            "voronoi" => {
+                let n = self.counts(1, key).map_err(Generated::Key)?;
+                let extent = |e: Option<[f64; 2]>, k: &'static str| {
+                    let [lo, hi] = e.unwrap_or([0.0, 1.0]);
+                    if lo.is_nan() || hi.is_nan() || lo >= hi {
+                        return Err(Generated::Key(key(
+                            k,
+                            format!("extent [{lo}, {hi}] must be increasing"),
+                        )));
+                    }
+                    Ok([lo, hi])
+                };
+                generate::voronoi(
+                    n[0],
+                    extent(self.x, "x")?,
+                    extent(self.y, "y")?,
+                    self.seed.unwrap_or(0),
+                    self.lloyd.unwrap_or(0),
+                )
+                .map_err(Generated::Complex)
+            }
             other => Err(Generated::Key(key(
                 "generator",
                 format!(
-                    "unknown generator \"{other}\"; known: interval, rectangle, box, annulus, torus, sphere, hollow-box"
+                    "unknown generator \"{other}\"; known: interval, rectangle, box, annulus, torus, sphere, hollow-box, voronoi"
                 ),
             ))),
         }

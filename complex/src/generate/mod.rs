@@ -1,7 +1,7 @@
 //! Mesh generators: structured grids (cuboidal and Kuhn-simplicial),
 //! Delaunay triangulations of point sets, an annulus, a torus and a sphere
-//! surface, a box with a closed cavity, and random interior perturbation of
-//! an existing mesh.
+//! surface, a box with a closed cavity, Voronoi polygon meshes of random
+//! sites, and random interior perturbation of an existing mesh.
 //!
 //! Every generator returns a [`Complex`](crate::Complex) whose boundary
 //! (n−1)-cells are tagged (at least `"boundary"`; grids also name each
@@ -15,6 +15,7 @@
 //! | [`grid`], [`interval`], [`rectangle`], [`box3`] | segments / quads / hexes | `xmin` … `zmax`, `boundary` |
 //! | [`kuhn`] | segments / triangles / tetrahedra | as [`grid`] |
 //! | [`delaunay`] | triangles | `boundary` |
+//! | [`voronoi`] | convex polygons (clipped Voronoi cells of random sites) | `xmin` … `ymax`, `boundary` |
 //! | [`annulus`] | quads | `inner`, `outer`, `boundary` |
 //! | [`torus`], [`sphere`] | closed quad / triangle surfaces in R^3 | none (no boundary) |
 //! | [`hollow_box`] | hexes | `outer`, `cavity`, `boundary` |
@@ -33,11 +34,13 @@ mod delaunay;
 mod grid;
 mod perturb;
 mod surfaces;
+mod voronoi;
 
 pub use delaunay::delaunay;
 pub use grid::{box3, graded_axis, grid, hollow_box, interval, kuhn, rectangle, uniform_axis};
 pub use perturb::perturb;
 pub use surfaces::{annulus, sphere, torus};
+pub use voronoi::{voronoi, voronoi_with_sites};
 
 use crate::error::{ComplexError, Result};
 use crate::Complex;

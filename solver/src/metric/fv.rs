@@ -10,6 +10,9 @@
 //!   two cell centroids is K-orthogonal to their common face, e.g.
 //!   axis-aligned boxes with a diagonal tensor, or a Voronoi mesh with a
 //!   scalar coefficient).
+//! - [`two_point_at`]: the same with the cell unknowns at given points
+//!   (circumcentres of a Delaunay triangulation, sites of a Voronoi mesh),
+//!   where the mesh is orthogonal by construction.
 //! - [`mimetic_hybrid`]: A is the half-face incidence (cell minus face),
 //!   Ω block diagonal with one dense block per cell. Exact for linear
 //!   solutions on any mesh of convex cells with planar faces (distorted
@@ -178,6 +181,123 @@ pub fn two_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, M
         })
         .collect::<Result<Vec<f64>, MetricError>>()?;
     Ok(BlockMetric::diagonal(&sigma))
+}
+
+/// Two-point flux approximation with the cell unknowns at given points
+/// instead of the centroids: `points` holds one point per top cell (stride
+/// d), e.g. the circumcentres of a Delaunay triangulation or the sites of a
+/// Voronoi mesh, for which the line between two neighbouring points is
+/// orthogonal to their common face and the two-point flux is consistent.
+///
+/// With n_{K,F} the normal of F pointing out of K and
+/// s_{K,F} = (x_F − p_K)·n_{K,F} the *signed* distance from K's point to
+/// the plane of F, σ_F = |F| / Σ_K s_{K,F}/κ_K over the one or two top
+/// cells on F (κ_K = n_Fᵀ K_K n_F). A circumcentre may lie outside its
+/// triangle; only the sum over the two sides has to be positive, which is
+/// the Delaunay condition (the two circumcentres lie in the right order
+/// along the edge's perpendicular bisector). On a boundary face the point
+/// must lie strictly on the inner side. A face where this fails
+/// (cocircular neighbours, an obtuse angle opposite a boundary edge) is
+/// reported by number.
+///
+/// The Dirichlet value of a boundary face then belongs at the orthogonal
+/// projection p_K + s_{K,F} n_{K,F} of the cell point onto the face plane
+/// (for a circumcentre: the midpoint of the boundary edge), and the cell
+/// value approximates u(p_K); [`crate::diffusion`] does both when asked
+/// for these cell points.
+///
+/// ```
+/// use hasse_complex::{Complex, TopCells, Vertices};
+/// use hasse_solver::metric::{fv, isotropic};
+/// // Two right triangles on the unit square: both circumcentres are the
+/// // midpoint of the shared diagonal, so that face is singular...
+/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]]).unwrap();
+/// let k = Complex::build(v, TopCells::simplices([[0, 1, 2], [1, 3, 2]])).unwrap();
+/// let c = k.circumcentre(2).unwrap().to_vec();
+/// assert!(fv::two_point_at(&k, &[isotropic(1.0); 2], &c).is_err());
+/// // ...while an equilateral-ish pair is fine: the boundary edges have
+/// // σ = |F| / (distance from circumcentre to edge).
+/// let v = Vertices::from_points(&[[0.0, 0.0], [2.0, 0.0], [1.0, 1.5], [1.0, -1.5]]).unwrap();
+/// let k = Complex::build(v, TopCells::simplices([[0, 1, 2], [0, 3, 1]])).unwrap();
+/// let c = k.circumcentre(2).unwrap().to_vec();
+/// let sigma = fv::two_point_at(&k, &[isotropic(1.0); 2], &c).unwrap().to_dense();
+/// let shared = k.find_cell(1, &[0, 1]).unwrap();
+/// // Circumcentres at (1, ±5/12): σ = 2 / (5/12 + 5/12).
+/// assert!((sigma[shared][shared] - 2.4).abs() < 1e-12);
+/// ```
+pub fn two_point_at(
+    complex: &Complex,
+    tensors: &[Tensor],
+    points: &[f64],
+) -> Result<BlockMetric, MetricError> {
+    const METHOD: &str = "two-point flux (TPFA) at given cell points";
+    let n = check_dimension(complex, METHOD)?;
+    let d = complex.embedding_dim();
+    let cells = complex.cell_count(n);
+    check_tensors(tensors, cells, d)?;
+    if points.len() != cells * d || points.iter().any(|x| !x.is_finite()) {
+        return Err(MetricError::UnsupportedMesh {
+            method: METHOD,
+            needs: "one finite point per top cell",
+            detail: format!(
+                "{} coordinates given for {cells} top cells in R^{d}",
+                points.len()
+            ),
+        });
+    }
+    let boundary = complex.try_boundary(n)?;
+    let _ = (
+        complex.measure(n - 1),
+        complex.normal(),
+        complex.centroid(n - 1),
+    );
+    let sigma = (0..boundary.rows())
+        .into_par_iter()
+        .map(|face| {
+            let row = boundary.outer_view(face).map(|r| r.iter().map(|(c, &s)| (c, s)).collect::<Vec<_>>()).unwrap_or_default();
+            if row.len() > 2 {
+                return Err(MetricError::UnsupportedMesh {
+                    method: METHOD,
+                    needs: "every (n−1)-cell shared by at most two top cells",
+                    detail: format!("(n−1)-cell {face} lies on {} top cells", row.len()),
+                });
+            }
+            if row.is_empty() {
+                return Ok(0.0);
+            }
+            let normal = &complex.normal()[face * d..(face + 1) * d];
+            let x_face = complex.centroid_of(n - 1, face);
+            let mut resistance = 0.0;
+            for &(cell, sign) in &row {
+                let s = signed_distance(x_face, &points[cell * d..(cell + 1) * d], normal, sign);
+                resistance += s / normal_component(&tensors[cell], normal);
+            }
+            if !(resistance > 0.0 && resistance.is_finite()) {
+                return Err(MetricError::UnsupportedMesh {
+                    method: METHOD,
+                    needs: "cell points in order across every face (for circumcentres: a Delaunay mesh without cocircular neighbours and without an obtuse angle opposite a boundary edge)",
+                    detail: format!(
+                        "(n−1)-cell {face}: the signed distances of its cell points sum to {resistance:e}"
+                    ),
+                });
+            }
+            Ok(complex.measure(n - 1)[face] / resistance)
+        })
+        .collect::<Result<Vec<f64>, MetricError>>()?;
+    Ok(BlockMetric::diagonal(&sigma))
+}
+
+/// (x_F − p)·n_{K,F}: the distance from `point` to the face plane, positive
+/// when the point is on the inner side of the face for the cell with
+/// incidence `sign` (n_{K,F} = sign · n_F points out of that cell).
+pub fn signed_distance(x_face: &[f64], point: &[f64], normal: &[f64], sign: i8) -> f64 {
+    f64::from(sign)
+        * x_face
+            .iter()
+            .zip(point)
+            .zip(normal)
+            .map(|((f, p), n)| (f - p) * n)
+            .sum::<f64>()
 }
 
 /// Sizes of the hybrid unknown vector: cell values in columns
