@@ -135,6 +135,9 @@ fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
     if let Some(f) = case.solver.factorization {
         problem.factorization = f;
     }
+    if spec.circumcentres {
+        problem.cell_points = diffusion::CellPoints::Circumcentres;
+    }
     problem
 }
 
@@ -260,7 +263,13 @@ fn solve_diffusion(
             let flux_error = grad
                 .as_ref()
                 .and_then(|g| diffusion::flux_error(complex, &solution, &problem, g));
-            let points = field_points(complex, field_dim);
+            let points = match &solution.cell_points {
+                Some(given) => given
+                    .chunks(complex.embedding_dim())
+                    .map(<[f64]>::to_vec)
+                    .collect(),
+                None => field_points(complex, field_dim),
+            };
             let exact_values: Vec<f64> = points.iter().map(|x| u(x)).collect();
             let mut difference: Vec<f64> = field
                 .iter()

@@ -100,6 +100,8 @@ pub struct DiffusionSpec {
     pub conductivity: Coefficient,
     pub source: Expression,
     pub boundary: Vec<BoundarySpec>,
+    /// Two-point flux with unknowns at circumcentres instead of centroids.
+    pub circumcentres: bool,
 }
 
 /// g = Ω δ f: a cell field's "normal gradient" as a face cochain.

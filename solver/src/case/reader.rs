@@ -47,6 +47,7 @@ const MESH_KEYS: &[&str] = &[
     "major_radius",
     "minor_radius",
     "cavity",
+    "lloyd",
 ];
 const PROBLEM_KEYS: &[&str] = &[
     "kind",
@@ -55,6 +56,7 @@ const PROBLEM_KEYS: &[&str] = &[
     "source",
     "field",
     "metric",
+    "cell_points",
 ];
 const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha"];
 const EXACT_KEYS: &[&str] = &["solution", "gradient"];
@@ -509,15 +511,34 @@ impl Reader {
                     None => scope.parse("0").ok(),
                 };
                 let boundary = self.boundary(root, scope);
+                let circumcentres = match self.string_at(table, "problem", "cell_points").as_deref()
+                {
+                    None | Some("centroids") => false,
+                    Some("circumcentres") => true,
+                    Some(other) => {
+                        let span = self
+                            .entry(table, "problem", "cell_points")
+                            .and_then(|e| e.span());
+                        self.error(span, "problem.cell_points", format!("unknown cell points \"{other}\""), Some("use \"centroids\" (default) or \"circumcentres\" (Delaunay triangulations)".into()));
+                        false
+                    }
+                };
+                if circumcentres && method.is_some_and(|m| m != Method::Fv) {
+                    let span = self
+                        .entry(table, "problem", "cell_points")
+                        .and_then(|e| e.span());
+                    self.error(span, "problem.cell_points", "only the two-point flux (method = \"fv\") places its unknowns at other cell points", None);
+                }
                 Some(Problem::Diffusion(DiffusionSpec {
                     method: method?,
                     conductivity: conductivity?,
                     source: source?,
                     boundary,
+                    circumcentres,
                 }))
             }
             "gradient" => {
-                for key in ["method", "conductivity", "source"] {
+                for key in ["method", "conductivity", "source", "cell_points"] {
                     if let Some(e) = self.entry(table, "problem", key) {
                         self.error(
                             e.key_span.clone(),
@@ -963,6 +984,7 @@ impl Reader {
             spec.factorization = match name.as_str() {
                 "llt" | "cholesky" => Some(Factorization::Llt),
                 "ldlt" => Some(Factorization::Ldlt),
+                "lblt" => Some(Factorization::Lblt),
                 "lu" => Some(Factorization::Lu),
                 other => {
                     let span = self
@@ -972,7 +994,7 @@ impl Reader {
                         span,
                         "solver.factorization",
                         format!("unknown factorisation \"{other}\""),
-                        Some("use \"llt\", \"ldlt\" or \"lu\"".into()),
+                        Some("use \"llt\", \"ldlt\", \"lblt\" or \"lu\"".into()),
                     );
                     None
                 }
