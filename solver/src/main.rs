@@ -29,7 +29,8 @@ enum Command {
     Run {
         /// The case file (.toml).
         case: PathBuf,
-        /// Output stem: writes OUT.h5, OUT.xdmf and OUT.edges/faces.xdmf for edge/face fields (default: [output] of the
+        /// Output stem: writes OUT.h5, OUT.xdmf, and OUT.edges.xdmf /
+        /// OUT.faces.xdmf for edge / face fields (default: [output] of the
         /// case, else the case file's name in the current directory).
         #[arg(short, long, value_name = "OUT")]
         output: Option<PathBuf>,
