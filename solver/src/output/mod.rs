@@ -247,7 +247,7 @@ pub enum OutputError {
     /// Times must be finite and strictly increasing.
     #[error("step {step} has time {time}: times must be finite and strictly increasing")]
     Time { step: usize, time: f64 },
-    /// The output stem cannot name the two files.
+    /// The output stem cannot name the output files.
     #[error("output stem '{path}': {reason}")]
     Stem { path: PathBuf, reason: &'static str },
     /// A provenance or metadata string cannot be stored (e.g. it contains NUL).
