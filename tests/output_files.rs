@@ -1,8 +1,9 @@
 //! `output::write_run` read back with the `hdf5` crate: every array is
 //! compared exactly with the complex it came from or with the analytic
-//! formula the cochain was filled with, the XDMF text is checked for the
-//! grids and topology arrays a reader needs, and failed writes are shown
-//! to leave no file behind and an older output untouched.
+//! formula the cochain was filled with, the XDMF texts (one file per
+//! cochain degree grid) are checked for the grids and topology arrays a
+//! reader needs, and failed writes are shown to leave no file behind and an
+//! older output untouched.
 
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
@@ -207,7 +208,9 @@ fn quad_grid_round_trips_exactly() {
     let c = Cochain::new("cell id", 2, index_cochain(&k, 2));
     let files = write_run(&dir.join("quad"), &steady(&k, vec![u, q, c])).unwrap();
     assert_eq!(files.hdf5, dir.join("quad.h5"));
-    assert_eq!(files_in(&dir), ["quad.h5", "quad.xdmf"]);
+    assert_eq!(files.xdmf, dir.join("quad.xdmf"));
+    assert_eq!(files.extra_xdmf, [dir.join("quad.edges.xdmf")]);
+    assert_eq!(files_in(&dir), ["quad.edges.xdmf", "quad.h5", "quad.xdmf"]);
 
     let f = hdf5::File::open(&files.hdf5).unwrap();
     check_mesh(&f, &k);
@@ -285,17 +288,32 @@ fn quad_grid_round_trips_exactly() {
         assert_eq!(pair, k.cell_vertices(1, e));
     }
 
+    // The main file: the quads alone, as one uniform grid meshio can read.
     let xml = std::fs::read_to_string(&files.xdmf).unwrap();
     assert_well_formed(&xml);
     assert!(xml.contains("<Xdmf Version=\"3.0\">"));
-    assert!(xml.contains("GridType=\"Collection\" CollectionType=\"Spatial\""));
-    assert!(xml.find("<Grid Name=\"cells\"").unwrap() < xml.find("<Grid Name=\"edges\"").unwrap());
+    assert!(!xml.contains("Collection"));
+    assert_eq!(xml.matches("<Grid ").count(), 1);
+    assert!(xml.contains("<Grid Name=\"cells\" GridType=\"Uniform\">"));
     assert!(xml.contains("TopologyType=\"Quadrilateral\" NumberOfElements=\"6\""));
-    assert!(xml.contains("TopologyType=\"Polyline\" NumberOfElements=\"17\" NodesPerElement=\"2\""));
     assert!(xml.contains(">quad.h5:/mesh/vertices<"));
     assert!(xml.contains("<Attribute Name=\"u\" AttributeType=\"Scalar\" Center=\"Node\">"));
     assert!(xml.contains("<Attribute Name=\"cell id\" AttributeType=\"Scalar\" Center=\"Cell\">"));
-    assert!(xml.contains("Dimensions=\"17\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">quad.h5:/steps/0/flux<"));
+    assert!(!xml.contains("flux") && !xml.contains("Polyline"));
+    // The edges file: 17 = 3·3 horizontal + 4·2 vertical edges of the 3×2 grid.
+    let edges = std::fs::read_to_string(&files.extra_xdmf[0]).unwrap();
+    assert_well_formed(&edges);
+    assert!(!edges.contains("Collection"));
+    assert_eq!(edges.matches("<Grid ").count(), 1);
+    assert!(edges.contains("<Grid Name=\"edges\" GridType=\"Uniform\">"));
+    assert!(
+        edges.contains("TopologyType=\"Polyline\" NumberOfElements=\"17\" NodesPerElement=\"2\"")
+    );
+    assert!(edges.contains(">quad.h5:/xdmf/1/topology<"));
+    assert!(edges.contains("Dimensions=\"12 3\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">quad.h5:/mesh/vertices<"));
+    assert!(edges.contains("<Attribute Name=\"flux\" AttributeType=\"Scalar\" Center=\"Cell\">"));
+    assert!(edges.contains("Dimensions=\"17\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">quad.h5:/steps/0/flux<"));
+    assert_eq!(edges.matches("<Attribute ").count(), 1);
 }
 
 #[test]
@@ -322,6 +340,7 @@ fn triangles_and_hexes_get_reader_vertex_order() {
     let xml = std::fs::read_to_string(&files.xdmf).unwrap();
     assert!(xml.contains("TopologyType=\"Triangle\" NumberOfElements=\"18\" NodesPerElement=\"3\""));
     assert!(!xml.contains("Collection"));
+    assert!(files.extra_xdmf.is_empty());
 
     let hex = box3(2, 1, 2, [0.0, 2.0], [0.0, 1.0], [0.0, 4.0]).unwrap();
     let cochains = vec![
@@ -358,14 +377,24 @@ fn triangles_and_hexes_get_reader_vertex_order() {
     assert_eq!(faces.shape(), vec![hex.cell_count(2), 4]);
     let xml = std::fs::read_to_string(&files.xdmf).unwrap();
     assert_well_formed(&xml);
+    assert_eq!(xml.matches("<Grid ").count(), 1);
     assert!(
         xml.contains("TopologyType=\"Hexahedron\" NumberOfElements=\"4\" NodesPerElement=\"8\"")
     );
-    assert!(xml.contains(&format!(
-        "<Grid Name=\"faces\" GridType=\"Uniform\">\n        <Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"{}\"",
-        hex.cell_count(2)
-    )));
-    assert!(!xml.contains("Name=\"edges\""));
+    assert!(!xml.contains("Name=\"face\""));
+    // A face cochain and no edge cochain: hex.faces.xdmf only. The 2×1×2 box
+    // has 3·1·2 x-normal + 2·2·2 y-normal + 2·1·3 z-normal = 20 faces.
+    assert_eq!(files.extra_xdmf, [dir.join("hex.faces.xdmf")]);
+    assert!(!dir.join("hex.edges.xdmf").exists());
+    let faces = std::fs::read_to_string(&files.extra_xdmf[0]).unwrap();
+    assert_well_formed(&faces);
+    assert!(faces.contains(
+        "<Grid Name=\"faces\" GridType=\"Uniform\">\n      <Topology TopologyType=\"Quadrilateral\" NumberOfElements=\"20\" NodesPerElement=\"4\">"
+    ));
+    assert!(faces.contains(
+        "Dimensions=\"20\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">hex.h5:/steps/0/face<"
+    ));
+    assert!(!faces.contains("Name=\"u\"") && !faces.contains("Name=\"id\""));
 }
 
 #[test]
@@ -530,6 +559,83 @@ fn time_series_stores_every_level() {
         assert!(xml.contains(&format!("<Time Value=\"{t}\"/>")));
     }
     assert!(xml.contains("heat.h5:/steps/2/u<"));
+    assert!(files.extra_xdmf.is_empty());
+    assert_eq!(files_in(&dir), ["heat.h5", "heat.xdmf"]);
+}
+
+#[test]
+fn a_3d_time_series_writes_one_temporal_file_per_degree() {
+    // 1×1×1 cube: 8 vertices, 12 edges, 6 faces, 1 hexahedron.
+    let k = box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let times = [0.0, 2.0];
+    let steps: Vec<Step> = times
+        .iter()
+        .map(|&t| Step {
+            time: t,
+            cochains: vec![
+                Cochain::new("u", 0, vec![t; 8]),
+                Cochain::new("q", 1, vec![t; 12]),
+                Cochain::new("f", 2, vec![t; 6]),
+                Cochain::new("c", 3, vec![t]),
+            ],
+        })
+        .collect();
+    let dir = scratch("series-3d");
+    let files = write_run(&dir.join("cube"), &run(&k, steps)).unwrap();
+    assert_eq!(
+        files.extra_xdmf,
+        [dir.join("cube.edges.xdmf"), dir.join("cube.faces.xdmf")]
+    );
+    assert_eq!(
+        files_in(&dir),
+        ["cube.edges.xdmf", "cube.faces.xdmf", "cube.h5", "cube.xdmf"]
+    );
+    let expect = [
+        (&files.xdmf, "cells", "Hexahedron", 1, 8, &["u", "c"][..]),
+        (&files.extra_xdmf[0], "edges", "Polyline", 12, 2, &["q"][..]),
+        (
+            &files.extra_xdmf[1],
+            "faces",
+            "Quadrilateral",
+            6,
+            4,
+            &["f"][..],
+        ),
+    ];
+    for (path, name, kind, count, nodes, fields) in expect {
+        let xml = std::fs::read_to_string(path).unwrap();
+        assert_well_formed(&xml);
+        // One temporal collection holding one uniform grid per level.
+        assert_eq!(
+            xml.matches("CollectionType=\"Temporal\"").count(),
+            1,
+            "{name}"
+        );
+        assert!(xml.contains(&format!(
+            "<Grid Name=\"{name}\" GridType=\"Collection\" CollectionType=\"Temporal\">"
+        )));
+        assert_eq!(
+            xml.matches(&format!("<Grid Name=\"{name}\" GridType=\"Uniform\">"))
+                .count(),
+            2
+        );
+        assert_eq!(xml.matches("<Time Value=\"0.0\"/>").count(), 1);
+        assert_eq!(xml.matches("<Time Value=\"2.0\"/>").count(), 1);
+        assert_eq!(
+            xml.matches(&format!(
+                "TopologyType=\"{kind}\" NumberOfElements=\"{count}\" NodesPerElement=\"{nodes}\""
+            ))
+            .count(),
+            2
+        );
+        assert_eq!(xml.matches("<Attribute ").count(), 2 * fields.len());
+        for field in fields {
+            assert!(
+                xml.contains(&format!("cube.h5:/steps/1/{field}<")),
+                "{name} {field}"
+            );
+        }
+    }
 }
 
 #[test]
@@ -611,16 +717,40 @@ fn an_older_output_is_replaced_only_by_a_complete_one() {
     let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
     let dir = scratch("replace");
     let stem = dir.join("nested").join("run");
-    let first = write_run(&stem, &steady(&k, vec![Cochain::new("u", 0, linear(&k))])).unwrap();
+    let first = write_run(
+        &stem,
+        &steady(
+            &k,
+            vec![
+                Cochain::new("u", 0, linear(&k)),
+                Cochain::new("flux", 1, index_cochain(&k, 1)),
+            ],
+        ),
+    )
+    .unwrap();
+    assert_eq!(
+        first.extra_xdmf,
+        [dir.join("nested").join("run.edges.xdmf")]
+    );
     let old_h5 = std::fs::read(&first.hdf5).unwrap();
     let old_xdmf = std::fs::read(&first.xdmf).unwrap();
+    let old_edges = std::fs::read(&first.extra_xdmf[0]).unwrap();
+    let all_three = ["run.edges.xdmf", "run.h5", "run.xdmf"];
 
     // Fails validation.
     let bad = steady(&k, vec![Cochain::new("u", 2, vec![1.0; 3])]);
     assert!(write_run(&stem, &bad).is_err());
     // Passes validation but the provenance cannot be stored (NUL in an HDF5
-    // string), so the failure happens halfway through the h5 file.
-    let mut late = steady(&k, vec![Cochain::new("v", 0, linear(&k))]);
+    // string), so the failure happens halfway through the h5 file, with the
+    // edges file still to come: none of them may appear, and
+    // no temporary (`.run.*.tmp-*`, which `files_in` would list) is left.
+    let mut late = steady(
+        &k,
+        vec![
+            Cochain::new("v", 0, linear(&k)),
+            Cochain::new("flux", 1, vec![0.5; 7]),
+        ],
+    );
     late.provenance.case_text = Some("a\0b".into());
     assert!(matches!(
         write_run(&stem, &late),
@@ -628,7 +758,8 @@ fn an_older_output_is_replaced_only_by_a_complete_one() {
     ));
     assert_eq!(std::fs::read(&first.hdf5).unwrap(), old_h5);
     assert_eq!(std::fs::read(&first.xdmf).unwrap(), old_xdmf);
-    assert_eq!(files_in(&dir.join("nested")), ["run.h5", "run.xdmf"]);
+    assert_eq!(std::fs::read(&first.extra_xdmf[0]).unwrap(), old_edges);
+    assert_eq!(files_in(&dir.join("nested")), all_three);
 
     let second = write_run(
         &stem,
@@ -647,7 +778,10 @@ fn an_older_output_is_replaced_only_by_a_complete_one() {
         ),
     )
     .unwrap();
-    assert_eq!(second, first);
+    assert_eq!((&second.hdf5, &second.xdmf), (&first.hdf5, &first.xdmf));
+    // The new output has no edge cochain: the old run.edges.xdmf would point
+    // at /steps/0/flux and /xdmf/1, which the new h5 lacks, so it is gone.
+    assert!(second.extra_xdmf.is_empty());
     let f = hdf5::File::open(&second.hdf5).unwrap();
     assert_eq!(
         f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
@@ -727,4 +861,23 @@ fn stems_that_cannot_name_the_files_are_rejected() {
     let xml = std::fs::read_to_string(&files.xdmf).unwrap();
     assert_well_formed(&xml);
     assert!(!xml.contains("<Attribute"));
+    assert!(files.extra_xdmf.is_empty());
+
+    // Only an edge cochain: the top grid is still written, as the bare mesh
+    // (2×1 quads), and the edge field goes to edges-only.edges.xdmf.
+    let quads = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    let files = write_run(
+        &dir.join("edges-only"),
+        &steady(&quads, vec![Cochain::new("q", 1, vec![1.5; 7])]),
+    )
+    .unwrap();
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    assert!(xml.contains("<Grid Name=\"cells\" GridType=\"Uniform\">"));
+    assert!(xml.contains("TopologyType=\"Quadrilateral\" NumberOfElements=\"2\""));
+    assert!(!xml.contains("<Attribute"));
+    assert_eq!(files.extra_xdmf, [dir.join("edges-only.edges.xdmf")]);
+    let edges = std::fs::read_to_string(&files.extra_xdmf[0]).unwrap();
+    assert!(edges.contains("TopologyType=\"Polyline\" NumberOfElements=\"7\""));
+    assert!(edges.contains("edges-only.h5:/steps/0/q<"));
 }

@@ -1,58 +1,23 @@
 //! The output files read by real clients: `tests/python/check_output.py`
-//! opens them with h5py and meshio (`meshio.read` on steady runs,
-//! `meshio.xdmf.TimeSeriesReader` on a time series) and compares with the
-//! values this test computes from analytic formulas.
+//! opens them with h5py and meshio (`meshio.read` on every file of a
+//! steady run, the main `<stem>.xdmf` and the `<stem>.edges.xdmf` of edge
+//! cochains; `meshio.xdmf.TimeSeriesReader` on both files of a time
+//! series) and compares with the values this test computes from analytic
+//! formulas.
 //!
-//! Python runs in a private venv at `<target>/pyenv`, created with
-//! `pip install h5py meshio` when missing. Without network the test fails
-//! under `CI` and is skipped loudly elsewhere.
+//! Python runs in a private venv at `<target>/pyenv` (see
+//! `common/pyenv.rs`). Without network the test fails under `CI` and is
+//! skipped loudly elsewhere.
+
+#[path = "common/pyenv.rs"]
+mod pyenv;
 
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
 use hasse_solver::output::{write_run, Cochain, Provenance, RunOutput, Step};
 use serde_json::{json, Value};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
-
-fn target_dir() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"))
-}
-
-fn imports_work(python: &Path) -> bool {
-    Command::new(python)
-        .args(["-c", "import h5py, meshio"])
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
-/// The venv's python with h5py and meshio, or why it could not be had.
-fn python() -> Result<PathBuf, String> {
-    let venv = target_dir().join("pyenv");
-    let python = venv.join("bin").join("python");
-    if imports_work(&python) {
-        return Ok(python);
-    }
-    let run = |cmd: &mut Command| -> Result<(), String> {
-        let out = cmd.output().map_err(|e| format!("{cmd:?}: {e}"))?;
-        if out.status.success() {
-            Ok(())
-        } else {
-            Err(format!(
-                "{cmd:?} failed:\n{}",
-                String::from_utf8_lossy(&out.stderr)
-            ))
-        }
-    };
-    run(Command::new("python3").args(["-m", "venv"]).arg(&venv))?;
-    run(Command::new(venv.join("bin").join("pip")).args(["install", "--quiet", "h5py", "meshio"]))?;
-    if imports_work(&python) {
-        Ok(python)
-    } else {
-        Err("h5py and meshio installed but do not import".into())
-    }
-}
 
 fn padded(k: &Complex) -> Vec<[f64; 3]> {
     (0..k.cell_count(0))
@@ -79,6 +44,10 @@ fn per_cell(k: &Complex, p: usize) -> Vec<f64> {
         .collect()
 }
 
+fn edge_series(k: &Complex, t: f64) -> Vec<f64> {
+    per_edge(k).iter().map(|q| q + 2.0 * t).collect()
+}
+
 fn provenance() -> Provenance {
     Provenance {
         case_text: Some("[mesh]\n".into()),
@@ -88,25 +57,41 @@ fn provenance() -> Provenance {
     }
 }
 
-/// Write one steady case and describe what a reader must find in it.
+/// Edge values of the cases with an edge cochain: 0.25 (i + 1) on edge i,
+/// so no two edges agree and a reordering would show.
+fn per_edge(k: &Complex) -> Vec<f64> {
+    (0..k.cell_count(1))
+        .map(|i| 0.25 * (i + 1) as f64)
+        .collect()
+}
+
+/// Write one steady case and describe what a reader must find in it; with
+/// `edges = Some(count)` (the edge count worked out by hand), also an edge
+/// cochain `q` that must land in `<name>.edges.xdmf` and leave the main
+/// file readable by `meshio.read`.
 fn steady_case(
     dir: &Path,
     name: &str,
     k: &Complex,
     cell_counts: Value,
     split_cells: bool,
+    edges: Option<usize>,
 ) -> Value {
     let n = k.dim();
     let u = linear(k);
     let c = per_cell(k, n);
+    let mut cochains = vec![
+        Cochain::new("u", 0, u.clone()),
+        Cochain::new("c", n, c.clone()),
+    ];
+    if edges.is_some() {
+        cochains.push(Cochain::new("q", 1, per_edge(k)));
+    }
     let run = RunOutput {
         complex: k,
         steps: vec![Step {
             time: 0.0,
-            cochains: vec![
-                Cochain::new("u", 0, u.clone()),
-                Cochain::new("c", n, c.clone()),
-            ],
+            cochains,
         }],
         provenance: provenance(),
     };
@@ -117,6 +102,16 @@ fn steady_case(
     case["cell_data"] = json!({ "c": c });
     if split_cells {
         case["cells_of"] = json!(n);
+    }
+    if let Some(count) = edges {
+        assert_eq!(files.extra_xdmf, [dir.join(format!("{name}.edges.xdmf"))]);
+        case["edges"] = json!({
+            "xdmf": files.extra_xdmf[0],
+            "count": count,
+            "steps": [{ "q": per_edge(k) }],
+        });
+    } else {
+        assert!(files.extra_xdmf.is_empty());
     }
     case
 }
@@ -172,15 +167,8 @@ fn prisms() -> Complex {
 
 #[test]
 fn h5py_and_meshio_read_the_output() {
-    let python = match python() {
-        Ok(p) => p,
-        Err(why) => {
-            if std::env::var_os("CI").is_some() {
-                panic!("h5py/meshio environment unavailable under CI: {why}");
-            }
-            eprintln!("\n!!!!!!!! SKIPPED output_python: no h5py/meshio venv ({why}) !!!!!!!!\n");
-            return;
-        }
+    let Some(python) = pyenv::python_or_skip("output_python") else {
+        return;
     };
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("output_python");
     let _ = std::fs::remove_dir_all(&dir);
@@ -191,15 +179,34 @@ fn h5py_and_meshio_read_the_output() {
     let hex = box3(2, 2, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 0.5]).unwrap();
     let prisms = prisms();
     let mut cases = vec![
-        steady_case(&dir, "quad", &quad, json!({"quad": 6}), false),
-        steady_case(&dir, "tri", &tri, json!({"triangle": 8}), false),
-        steady_case(&dir, "hex", &hex, json!({"hexahedron": 4}), false),
+        steady_case(&dir, "quad", &quad, json!({"quad": 6}), false, None),
+        steady_case(&dir, "tri", &tri, json!({"triangle": 8}), false, None),
+        steady_case(&dir, "hex", &hex, json!({"hexahedron": 4}), false, None),
         // Each prism is three tetrahedra (the cone from its lowest vertex).
-        steady_case(&dir, "prisms", &prisms, json!({"tetra": 6}), true),
+        steady_case(&dir, "prisms", &prisms, json!({"tetra": 6}), true, None),
+        // The 3×2 quads with an edge cochain: the main file must still be one
+        // uniform grid, the 3·3 + 4·2 = 17 edges in quad-edges.edges.xdmf.
+        steady_case(
+            &dir,
+            "quad-edges",
+            &quad,
+            json!({"quad": 6}),
+            false,
+            Some(17),
+        ),
+        // The 2×2 Kuhn grid: 2·3 + 3·2 axis edges and 4 diagonals.
+        steady_case(
+            &dir,
+            "tri-edges",
+            &tri,
+            json!({"triangle": 8}),
+            false,
+            Some(16),
+        ),
     ];
 
-    // Two levels of u(t) = (1 + t)(x + 2y), with an edge cochain that lives in
-    // its own temporal collection and must not confuse the reader.
+    // Two levels of u(t) = (1 + t)(x + 2y), with an edge cochain
+    // q(t) = 0.25 (i + 1) + 2t that lives in series.edges.xdmf.
     let times = [0.0, 0.75];
     let steps: Vec<Step> = times
         .iter()
@@ -212,7 +219,7 @@ fn h5py_and_meshio_read_the_output() {
                     linear(&quad).iter().map(|u| (1.0 + t) * u).collect(),
                 ),
                 Cochain::new("c", 2, per_cell(&quad, 2).iter().map(|c| c + t).collect()),
-                Cochain::new("q", 1, per_cell(&quad, 1)),
+                Cochain::new("q", 1, edge_series(&quad, t)),
             ],
         })
         .collect();
@@ -240,7 +247,13 @@ fn h5py_and_meshio_read_the_output() {
         })
         .collect();
     series["steps"] = json!(expected);
-    series["datasets"] = json!({ "steps/1/q": per_cell(&quad, 1) });
+    series["datasets"] = json!({ "steps/1/q": edge_series(&quad, 0.75) });
+    assert_eq!(files.extra_xdmf, [dir.join("series.edges.xdmf")]);
+    series["edges"] = json!({
+        "xdmf": files.extra_xdmf[0],
+        "count": 17,
+        "steps": times.iter().map(|&t| json!({ "q": edge_series(&quad, t) })).collect::<Vec<_>>(),
+    });
     cases.push(series);
 
     let manifest = dir.join("manifest.json");
@@ -258,5 +271,9 @@ fn h5py_and_meshio_read_the_output() {
         out.status.success(),
         "check_output.py failed:\n{stdout}\n{stderr}"
     );
-    assert_eq!(stdout.lines().filter(|l| l.starts_with("ok ")).count(), 5);
+    // One line per case (seven) and one per edges file read back (two
+    // steady cases and the series).
+    let ok: Vec<&str> = stdout.lines().filter(|l| l.starts_with("ok ")).collect();
+    assert_eq!(ok.iter().filter(|l| !l.contains("edges file")).count(), 7);
+    assert_eq!(ok.iter().filter(|l| l.contains("edges file")).count(), 3);
 }

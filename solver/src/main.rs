@@ -29,7 +29,8 @@ enum Command {
     Run {
         /// The case file (.toml).
         case: PathBuf,
-        /// Output stem: writes OUT.h5 and OUT.xdmf (default: [output] of the
+        /// Output stem: writes OUT.h5, OUT.xdmf, and OUT.edges.xdmf /
+        /// OUT.faces.xdmf for edge / face fields (default: [output] of the
         /// case, else the case file's name in the current directory).
         #[arg(short, long, value_name = "OUT")]
         output: Option<PathBuf>,
@@ -297,11 +298,10 @@ fn run_case(
         );
         print!("{result}");
         if let Some(files) = written {
-            println!(
-                "output     {}, {}",
-                files.hdf5.display(),
-                files.xdmf.display()
-            );
+            let mut names = vec![files.hdf5.display().to_string()];
+            names.push(files.xdmf.display().to_string());
+            names.extend(files.extra_xdmf.iter().map(|p| p.display().to_string()));
+            println!("output     {}", names.join(", "));
         }
     } else {
         for w in &result.warnings {

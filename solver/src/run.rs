@@ -571,9 +571,10 @@ impl RunResult {
     }
 }
 
-/// Write the run's fields, mesh and provenance to `<stem>.h5` and
-/// `<stem>.xdmf` (atomically: nothing appears under those names unless
-/// both were written completely).
+/// Write the run's fields, mesh and provenance to `<stem>.h5`,
+/// `<stem>.xdmf` and, for edge or face fields, `<stem>.edges.xdmf` /
+/// `<stem>.faces.xdmf` (atomically: nothing appears under those names
+/// unless all were written completely).
 pub fn write_output(
     case: &Case,
     complex: &Complex,

@@ -5,7 +5,12 @@ Usage: check_output.py MANIFEST.json
 The manifest (written by tests/output_python.rs) lists output files and the
 values expected in them, computed in Rust from analytic formulas. Every
 check raises AssertionError with a message; the script prints one line per
-case and exits non-zero on the first failure.
+case (and one per edges file read) and exits non-zero on the first failure.
+
+A case with "edges" also has an edge cochain: its main <stem>.xdmf must
+still be readable by meshio (top cells only), and <stem>.edges.xdmf must be
+readable too, with one line cell per edge, in edge-id order, carrying the
+edge values.
 """
 
 import json
@@ -95,6 +100,45 @@ def check_meshio(case, sets):
         equal(got, values, f"meshio cell_data {name}")
 
 
+def check_edge_cells(points, cells, case, sets):
+    """One 'line' block with the edges in edge-id order: line i joins the two
+    vertices of row i of /mesh/cells/1, so cell data i is the value of edge i."""
+    edges = case["edges"]
+    assert [b.type for b in cells] == ["line"], f"edge blocks {[b.type for b in cells]}"
+    lines = cells[0].data
+    assert len(lines) == edges["count"], f"{len(lines)} lines != {edges['count']} edges"
+    assert len(sets[1]) == edges["count"], f"h5 has {len(sets[1])} edges"
+    for i, line in enumerate(lines):
+        assert frozenset(line) == sets[1][i], f"line {i} {line} is not edge {set(sets[1][i])}"
+        assert np.linalg.norm(points[line[1]] - points[line[0]]) > 0, f"line {i} has length 0"
+
+
+def check_edges_meshio(case, sets):
+    edges = case["edges"]
+    mesh = meshio.read(edges["xdmf"])
+    equal(mesh.points, case["vertices"], "edges file points")
+    check_edge_cells(mesh.points, mesh.cells, case, sets)
+    assert not mesh.point_data, f"edges file point data {list(mesh.point_data)}"
+    assert set(mesh.cell_data) == set(edges["steps"][0]), f"edges cell data {list(mesh.cell_data)}"
+    for name, values in edges["steps"][0].items():
+        equal(np.concatenate(mesh.cell_data[name]), values, f"edges file cell_data {name}")
+
+
+def check_edges_series(case, sets):
+    edges = case["edges"]
+    with meshio.xdmf.TimeSeriesReader(edges["xdmf"]) as reader:
+        points, cells = reader.read_points_cells()
+        equal(points, case["vertices"], "edges series points")
+        check_edge_cells(points, cells, case, sets)
+        assert reader.num_steps == len(case["times"]), f"edge steps {reader.num_steps}"
+        for k, t in enumerate(case["times"]):
+            time, point_data, cell_data = reader.read_data(k)
+            assert time == t, f"edges step {k}: time {time} != {t}"
+            assert not point_data, f"edges step {k}: point data {list(point_data)}"
+            for name, values in edges["steps"][k].items():
+                equal(np.concatenate(cell_data[name]), values, f"edges step {k} cell_data {name}")
+
+
 def check_series(case):
     with meshio.xdmf.TimeSeriesReader(case["xdmf"]) as reader:
         points, cells = reader.read_points_cells()
@@ -119,6 +163,12 @@ def main():
         else:
             check_meshio(case, sets)
         print(f"ok {case['name']} (h5py {h5py.__version__}, meshio {meshio.__version__})")
+        if "edges" in case:
+            if len(case["times"]) > 1:
+                check_edges_series(case, sets)
+            else:
+                check_edges_meshio(case, sets)
+            print(f"ok {case['name']} edges file ({case['edges']['count']} edges)")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 //! Output of a run: one HDF5 file holding the complex, every cochain of
-//! every time level and the provenance, plus an XDMF 3 file beside it so
-//! ParaView, VisIt and meshio open the same data.
+//! every time level and the provenance, plus XDMF 3 files beside it (one
+//! per cochain degree grid) so ParaView, VisIt and meshio open the same data.
 //!
 //! # HDF5 layout (`<stem>.h5`)
 //!
@@ -25,7 +25,7 @@
 //! Strings are variable-length UTF-8, so h5py returns attributes as `str`
 //! (string datasets need `.asstr()[()]`).
 //!
-//! # XDMF (`<stem>.xdmf`)
+//! # XDMF (`<stem>.xdmf`, `<stem>.edges.xdmf`, `<stem>.faces.xdmf`)
 //!
 //! ParaView and VisIt ignore `Center="Edge"`/`"Face"`, so each cochain
 //! degree gets its own grid with ordinary cell data: the top cells
@@ -41,11 +41,15 @@
 //! their lowest vertex (XDMF `Polyhedron` is read by neither meshio nor
 //! reliably by ParaView), with `cell_ids` mapping elements back.
 //!
-//! One time level gives plain uniform grids (a spatial collection holding
-//! them, top grid first, when there are several degrees). Several levels
-//! give one temporal collection per degree grid, the top-cell collection
-//! last, because meshio's `TimeSeriesReader` reads the last collection of
-//! the domain.
+//! Each grid is a document of its own: the top grid is `<stem>.xdmf`
+//! (written even when no cochain lives on it, as the mesh), the edges
+//! `<stem>.edges.xdmf`, the faces `<stem>.faces.xdmf`, all pointing into
+//! the one `<stem>.h5`. `meshio.read` accepts only a domain with a single
+//! uniform grid (a spatial collection fails with "Unknown section
+//! 'Grid'") and `meshio.xdmf.TimeSeriesReader` only one temporal
+//! collection, so one grid per file lets meshio read every file, while
+//! ParaView opens each. One time level gives a plain uniform grid,
+//! several give a temporal collection.
 
 mod hdf5_file;
 mod topology;
@@ -175,17 +179,25 @@ pub struct RunOutput<'a> {
     pub provenance: Provenance,
 }
 
-/// The two files [`write_run`] wrote.
+/// The files [`write_run`] wrote.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OutputFiles {
     /// `<stem>.h5`.
     pub hdf5: PathBuf,
-    /// `<stem>.xdmf`, referring to the h5 file by its bare file name.
+    /// `<stem>.xdmf`: the top-cell grid (0-cochains as point data,
+    /// n-cochains as cell data), referring to the h5 file by its bare name.
     pub xdmf: PathBuf,
+    /// `<stem>.edges.xdmf` and `<stem>.faces.xdmf`, in increasing degree:
+    /// one per lower degree that carries cochains (empty when none does).
+    pub extra_xdmf: Vec<PathBuf>,
 }
 
 /// Why an output could not be written. Nothing is left under the final
-/// file names when any of these is returned.
+/// file names when any of these is returned, except for an [`Io`] error on
+/// removing a stale degree file of an older output, which happens only
+/// after the new output is complete and in place.
+///
+/// [`Io`]: OutputError::Io
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
     /// A directory or file could not be created, written or renamed.
@@ -235,7 +247,7 @@ pub enum OutputError {
     /// Times must be finite and strictly increasing.
     #[error("step {step} has time {time}: times must be finite and strictly increasing")]
     Time { step: usize, time: f64 },
-    /// The output stem cannot name the two files.
+    /// The output stem cannot name the output files.
     #[error("output stem '{path}': {reason}")]
     Stem { path: PathBuf, reason: &'static str },
     /// A provenance or metadata string cannot be stored (e.g. it contains NUL).
@@ -246,13 +258,16 @@ pub enum OutputError {
     Topology { message: String },
 }
 
-/// Writes `<stem>.h5` and `<stem>.xdmf` (stem may include a directory,
-/// created if missing) and returns their paths.
+/// Writes `<stem>.h5`, `<stem>.xdmf` and one `<stem>.<grid>.xdmf` per
+/// lower cochain degree (stem may include a directory, created if missing)
+/// and returns their paths.
 ///
-/// Inputs are checked before anything is written. Both files are first
+/// Inputs are checked before anything is written. All files are first
 /// written under temporary names in the target directory and renamed into
-/// place only when complete, so an error never leaves a truncated file and
-/// never replaces an older output.
+/// place only when all are complete (the h5 first, then the degree files,
+/// `<stem>.xdmf` last), so an error never leaves a truncated file and
+/// never replaces an older output. Once the new output is in place, degree
+/// files of an older output that this run does not have are removed.
 ///
 /// ```
 /// use hasse_solver::output::{write_run, Cochain, Provenance, RunOutput, Step};
@@ -266,6 +281,7 @@ pub enum OutputError {
 /// let dir = std::env::temp_dir().join(format!("hasse-doc-{}", std::process::id()));
 /// let files = write_run(&dir.join("run"), &run).unwrap();
 /// assert!(files.hdf5.ends_with("run.h5") && files.xdmf.exists());
+/// assert!(files.extra_xdmf.is_empty()); // no edge cochain, no run.edges.xdmf
 /// let xdmf = std::fs::read_to_string(&files.xdmf).unwrap();
 /// assert!(xdmf.contains("run.h5:/steps/0/x"));
 /// std::fs::remove_dir_all(&dir).unwrap();
@@ -299,9 +315,28 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
         source,
     })?;
     let h5_name = format!("{file_name}.h5");
-    let xdmf_name = format!("{file_name}.xdmf");
+    let n = run.complex.dim();
     let final_h5 = dir.join(&h5_name);
-    let final_xdmf = dir.join(&xdmf_name);
+    let final_xdmf = dir.join(format!("{file_name}.xdmf"));
+    // One XDMF document per grid: the top grid (first in `grids`) under
+    // `<stem>.xdmf`, each lower degree under `<stem>.<grid>.xdmf`.
+    let mut extra_xdmf = Vec::new();
+    let mut documents = Vec::new();
+    for (i, grid) in grids.iter().enumerate() {
+        let text = xdmf::document(run, grid, &h5_name);
+        if i == 0 {
+            documents.push((final_xdmf.clone(), text));
+        } else {
+            let path = dir.join(format!("{file_name}.{}.xdmf", xdmf::grid_name(grid, n)));
+            extra_xdmf.push(path.clone());
+            documents.push((path, text));
+        }
+    }
+    // Rename order: the h5 first, because no xdmf may point at a file that
+    // is not there; the main xdmf last, because it is the one users open,
+    // so once it appears the whole output is in place.
+    documents.rotate_left(1);
+
     // Unique per process and per call, so concurrent writers of the same
     // stem never share a temporary.
     static CALLS: AtomicU64 = AtomicU64::new(0);
@@ -310,33 +345,54 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
         std::process::id(),
         CALLS.fetch_add(1, Ordering::Relaxed)
     );
-    let mut temps = Temporaries(vec![
-        dir.join(format!(".{h5_name}.tmp-{tag}")),
-        dir.join(format!(".{xdmf_name}.tmp-{tag}")),
-    ]);
+    let temp = |path: &Path| {
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        dir.join(format!(".{name}.tmp-{tag}"))
+    };
+    let mut finals = vec![final_h5.clone()];
+    finals.extend(documents.iter().map(|(path, _)| path.clone()));
+    let mut temps = Temporaries(finals.iter().map(|path| temp(path)).collect());
 
     hdf5_file::write(&temps.0[0], run, &grids, &rfc3339_now())?;
-    let text = xdmf::document(run, &grids, &h5_name);
-    std::fs::write(&temps.0[1], text).map_err(|source| OutputError::Io {
-        path: temps.0[1].clone(),
-        source,
-    })?;
+    for (path, (_, text)) in temps.0[1..].iter().zip(&documents) {
+        std::fs::write(path, text).map_err(|source| OutputError::Io {
+            path: path.clone(),
+            source,
+        })?;
+    }
 
     // Contents reach the disk before the names do, so a crash right after
-    // the rename cannot leave an empty file under the final name.
+    // the renames cannot leave an empty file under a final name.
     for path in &temps.0 {
         sync(path)?;
     }
-    // The h5 goes first: an xdmf must never point at a file that is not there.
-    rename(&temps.0[0], &final_h5)?;
-    temps.0.remove(0);
-    rename(&temps.0[0], &final_xdmf)?;
-    temps.0.clear();
+    for target in &finals {
+        rename(&temps.0[0], target)?;
+        temps.0.remove(0);
+    }
+    // Degree files of an earlier output under this stem that this run does
+    // not have would point at datasets the new h5 may lack: remove them.
+    for grid_name in LOWER_GRID_NAMES {
+        let path = dir.join(format!("{file_name}.{grid_name}.xdmf"));
+        if extra_xdmf.contains(&path) {
+            continue;
+        }
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(OutputError::Io { path, source: e });
+            }
+            _ => {}
+        }
+    }
     Ok(OutputFiles {
         hdf5: final_h5,
         xdmf: final_xdmf,
+        extra_xdmf,
     })
 }
+
+/// Every name a lower-degree grid file can have (see `xdmf::grid_name`).
+const LOWER_GRID_NAMES: [&str; 2] = ["edges", "faces"];
 
 fn sync(path: &Path) -> Result<(), OutputError> {
     std::fs::File::open(path)

@@ -1,11 +1,13 @@
-//! The XDMF 3 text: one grid per cochain degree, pointing into the h5 file.
+//! The XDMF 3 texts: one document per cochain degree grid, each pointing
+//! into the same h5 file.
 
 use super::topology::{grid_topology, GridTopology};
 use super::{Cochain, OutputError, RunOutput};
 use std::fmt::Write;
 
 /// The grids a run needs, top cells first: the top grid always (it also
-/// carries the point data), edges and faces only when cochains live there.
+/// carries the point data), then edges and faces, in increasing degree,
+/// only when cochains live there.
 pub(crate) fn grids(run: &RunOutput) -> Result<Vec<GridTopology>, OutputError> {
     let n = run.complex.dim();
     let used = |p: usize| {
@@ -14,7 +16,7 @@ pub(crate) fn grids(run: &RunOutput) -> Result<Vec<GridTopology>, OutputError> {
             .any(|s| s.cochains.iter().any(|c| c.dim == p))
     };
     let mut grids = vec![grid_topology(run.complex, n)?];
-    for p in (1..n).rev() {
+    for p in 1..n {
         if used(p) {
             grids.push(grid_topology(run.complex, p)?);
         }
@@ -48,7 +50,9 @@ pub(crate) fn attribute_path(grid: &GridTopology, step: usize, c: &Cochain, at: 
     }
 }
 
-fn grid_name(grid: &GridTopology, top_dim: usize) -> &'static str {
+/// Name of the grid in the XDMF text, also the middle part of the file
+/// name `<stem>.<name>.xdmf` of a lower-degree grid.
+pub(crate) fn grid_name(grid: &GridTopology, top_dim: usize) -> &'static str {
     match grid.degree {
         p if p == top_dim => "cells",
         1 => "edges",
@@ -71,40 +75,28 @@ fn escape(text: &str) -> String {
     out
 }
 
-/// The whole XDMF document; `h5_name` is the h5 file name relative to it.
-pub(crate) fn document(run: &RunOutput, grids: &[GridTopology], h5_name: &str) -> String {
+/// The XDMF document of one grid; `h5_name` is the h5 file name relative
+/// to it. One grid per document, because `meshio.read` accepts only a
+/// domain holding a single uniform grid and `TimeSeriesReader` only the
+/// last temporal collection: a plain uniform grid for at most one time
+/// level, a temporal collection for several.
+pub(crate) fn document(run: &RunOutput, grid: &GridTopology, h5_name: &str) -> String {
     let h5 = escape(h5_name);
     let mut out = String::new();
     out.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
     out.push_str("<Xdmf Version=\"3.0\">\n  <Domain>\n");
     if run.steps.len() <= 1 {
-        let spatial = grids.len() > 1;
-        let indent = if spatial { 6 } else { 4 };
-        if spatial {
-            out.push_str(
-                "    <Grid Name=\"hasse\" GridType=\"Collection\" CollectionType=\"Spatial\">\n",
-            );
-        }
-        for grid in grids {
-            uniform_grid(&mut out, run, grid, 0, None, &h5, indent);
-        }
-        if spatial {
-            out.push_str("    </Grid>\n");
-        }
+        uniform_grid(&mut out, run, grid, 0, None, &h5, 4);
     } else {
-        // meshio's TimeSeriesReader takes the last collection of the domain,
-        // so the top-cell collection (points and cells) goes last.
-        for grid in grids.iter().rev() {
-            let name = grid_name(grid, run.complex.dim());
-            let _ = writeln!(
-                out,
-                "    <Grid Name=\"{name}\" GridType=\"Collection\" CollectionType=\"Temporal\">"
-            );
-            for (k, step) in run.steps.iter().enumerate() {
-                uniform_grid(&mut out, run, grid, k, Some(step.time), &h5, 6);
-            }
-            out.push_str("    </Grid>\n");
+        let name = grid_name(grid, run.complex.dim());
+        let _ = writeln!(
+            out,
+            "    <Grid Name=\"{name}\" GridType=\"Collection\" CollectionType=\"Temporal\">"
+        );
+        for (k, step) in run.steps.iter().enumerate() {
+            uniform_grid(&mut out, run, grid, k, Some(step.time), &h5, 6);
         }
+        out.push_str("    </Grid>\n");
     }
     out.push_str("  </Domain>\n</Xdmf>\n");
     out
@@ -196,7 +188,7 @@ mod tests {
     use crate::output::{Provenance, Step};
 
     #[test]
-    fn temporal_collections_put_the_top_grid_last() {
+    fn a_time_series_gives_one_temporal_collection_per_grid_document() {
         let k = hasse_complex::generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
         let step = |t: f64| Step {
             time: t,
@@ -212,51 +204,68 @@ mod tests {
         };
         let grids = grids(&run).unwrap();
         assert_eq!(grids.iter().map(|g| g.degree).collect::<Vec<_>>(), [2, 1]);
-        let text = document(&run, &grids, "a&b.h5");
-        let edges = text
-            .find("<Grid Name=\"edges\" GridType=\"Collection\" CollectionType=\"Temporal\">")
-            .unwrap();
-        let cells = text
-            .find("<Grid Name=\"cells\" GridType=\"Collection\" CollectionType=\"Temporal\">")
-            .unwrap();
-        assert!(edges < cells);
-        assert_eq!(text.matches("<Time Value=\"0.0\"/>").count(), 2);
-        assert_eq!(text.matches("<Time Value=\"0.25\"/>").count(), 2);
+        assert_eq!(grid_name(&grids[1], 2), "edges");
+
+        let cells = document(&run, &grids[0], "a&b.h5");
+        assert_eq!(cells.matches("CollectionType=\"Temporal\"").count(), 1);
+        assert!(cells
+            .contains("<Grid Name=\"cells\" GridType=\"Collection\" CollectionType=\"Temporal\">"));
+        assert_eq!(cells.matches("<Time Value=\"0.0\"/>").count(), 1);
+        assert_eq!(cells.matches("<Time Value=\"0.25\"/>").count(), 1);
         // Point data on the top grid only, edge data on the edge grid only.
         assert_eq!(
-            text.matches("Name=\"u\" AttributeType=\"Scalar\" Center=\"Node\"")
+            cells
+                .matches("Name=\"u\" AttributeType=\"Scalar\" Center=\"Node\"")
                 .count(),
             2
         );
+        assert!(!cells.contains("flux"));
+        assert_eq!(cells.matches("<Grid ").count(), 1 + 2);
+
+        let edges = document(&run, &grids[1], "a&b.h5");
+        assert!(edges
+            .contains("<Grid Name=\"edges\" GridType=\"Collection\" CollectionType=\"Temporal\">"));
         assert_eq!(
-            text.matches("Name=\"flux\" AttributeType=\"Scalar\" Center=\"Cell\"")
+            edges
+                .matches("Name=\"flux\" AttributeType=\"Scalar\" Center=\"Cell\"")
                 .count(),
             2
         );
-        assert!(text.contains("a&amp;b.h5:/steps/1/flux"));
-        assert!(text.contains(
+        assert!(!edges.contains("Name=\"u\""));
+        assert!(edges.contains("a&amp;b.h5:/steps/1/flux"));
+        assert!(edges.contains(
             "<Topology TopologyType=\"Polyline\" NumberOfElements=\"4\" NodesPerElement=\"2\">"
         ));
-        assert_eq!(text.matches("<Grid ").count(), 2 + 4);
-        assert_eq!(text.matches("</Grid>").count(), 2 + 4);
+        assert_eq!(edges.matches("<Grid ").count(), 1 + 2);
+        assert_eq!(edges.matches("</Grid>").count(), 1 + 2);
     }
 
     #[test]
-    fn one_step_with_one_grid_is_a_plain_uniform_grid() {
+    fn one_step_gives_plain_uniform_grids() {
         let k = hasse_complex::generate::rectangle(2, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
         let run = RunOutput {
             complex: &k,
             steps: vec![Step {
                 time: 0.0,
-                cochains: vec![Cochain::new("p", 2, vec![1.0, 2.0])],
+                cochains: vec![
+                    Cochain::new("p", 2, vec![1.0, 2.0]),
+                    Cochain::new("q", 1, vec![0.5; 7]),
+                ],
             }],
             provenance: Provenance::new(serde_json::Value::Null),
         };
         let grids = grids(&run).unwrap();
-        let text = document(&run, &grids, "r.h5");
+        let text = document(&run, &grids[0], "r.h5");
         assert_eq!(text.matches("<Grid ").count(), 1);
         assert!(!text.contains("Collection"));
         assert!(!text.contains("<Time"));
+        assert!(!text.contains("Name=\"q\""));
         assert!(text.contains("<DataItem Dimensions=\"2 4\" DataType=\"Int\" Precision=\"8\" Format=\"HDF\">r.h5:/xdmf/2/topology</DataItem>"));
+        // 2×1 quads have 7 edges: 2 rows of 2 horizontal ones and 3 vertical ones.
+        let edges = document(&run, &grids[1], "r.h5");
+        assert_eq!(edges.matches("<Grid ").count(), 1);
+        assert!(!edges.contains("Collection"));
+        assert!(edges.contains("<DataItem Dimensions=\"7\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">r.h5:/steps/0/q</DataItem>"));
+        assert!(!edges.contains("Name=\"p\""));
     }
 }
