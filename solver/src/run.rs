@@ -315,7 +315,8 @@ fn solve_diffusion(
 }
 
 fn check_residual(case: &Case, residual: f64, warnings: &mut Vec<String>) -> Result<(), RunError> {
-    if !(residual <= case.solver.residual_limit) {
+    // A NaN residual fails too.
+    if residual.is_nan() || residual > case.solver.residual_limit {
         return Err(RunError::Solve(format!(
             "relative residual {residual:.3e} exceeds solver.residual_limit = {:.1e}: the system is (nearly) singular or badly conditioned",
             case.solver.residual_limit

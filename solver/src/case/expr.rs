@@ -70,7 +70,8 @@ enum Slot {
 #[derive(Clone, Debug)]
 pub struct Expression {
     text: String,
-    flat: FlatEx<f64>,
+    /// Boxed: exmex keeps its nodes in large inline arrays (~20 kB).
+    flat: Box<FlatEx<f64>>,
     /// One slot per exmex variable, in exmex's (alphabetical) order.
     slots: Vec<Slot>,
     /// True when the value depends on neither position nor time.
@@ -241,7 +242,7 @@ impl Scope {
         }
         Ok(Expression {
             text: text.to_string(),
-            flat,
+            flat: Box::new(flat),
             slots,
             constant,
             uses_time,

@@ -688,9 +688,9 @@ impl Reader {
         }
         // Symmetry can be checked textually for constant entries here; entries
         // that vary are checked where they are evaluated.
-        for i in 0..size {
-            for j in 0..i {
-                let (a, b) = (&tensor[i][j], &tensor[j][i]);
+        for (i, row) in tensor.iter().enumerate() {
+            for (j, a) in row.iter().enumerate().take(i) {
+                let b = &tensor[j][i];
                 if a.is_constant() && b.is_constant() && a.eval(&[], 0.0) != b.eval(&[], 0.0) {
                     self.error(entry.span(), &entry.name, format!("the tensor is not symmetric: entry [{i}][{j}] = {} but [{j}][{i}] = {}", a.text(), b.text()), Some("a diffusion tensor is symmetric positive definite".into()));
                     return None;
