@@ -125,3 +125,429 @@ fn make_rejects_bad_selections() {
     assert!(matches!(make(&b, 2, 0, &[]), Err(SplitError::BadFacetSelection { .. })));
     assert!(matches!(make(&b, 1, 0, &[1]), Err(SplitError::BadFacetSelection { .. })));
 }
+
+// ---------------------------------------------------------------- SPLIT
+
+use hasse_complex::generate::{box3, delaunay, kuhn, perturb, rectangle, uniform_axis};
+use hasse_complex::split::{
+    classification_step, split, split_cells, vertex_classes, Hyperplane, Refinement,
+    SplitOptions,
+};
+use hasse_complex::{Complex, Lar, SplitError, TopCells, Vertices};
+
+/// Every invariant a SPLIT must keep, checked without trusting the split
+/// code: topology exactly, geometry to 1e-12 relative.
+fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
+    let n = coarse.dim();
+    assert_eq!(fine.dim(), n);
+    for p in 2..=n {
+        assert!(is_zero(&(fine.boundary(p - 1) * fine.boundary(p))), "∂∂ ≠ 0 at p = {p}");
+    }
+    assert_eq!(fine.euler_characteristic(), coarse.euler_characteristic());
+    assert_eq!(fine.betti_numbers(), coarse.betti_numbers());
+    // ∂ζ = ζ∂, exactly.
+    for p in 1..=n {
+        let left = fine.boundary(p) * r.zeta(p);
+        let right = r.zeta(p - 1) * coarse.boundary(p);
+        assert_eq!(dense(&left), dense(&right), "∂ζ ≠ ζ∂ at p = {p}");
+    }
+    // The orientation the split assembled is the one geometry gives.
+    let fresh = Complex::from_lar(fine.lar().clone()).expect("refined LAR is a valid complex");
+    for p in 1..=n {
+        let (a, b) = (dense(fresh.boundary(p)), dense(fine.boundary(p)));
+        for (i, (ra, rb)) in a.iter().zip(&b).enumerate() {
+            assert_eq!(ra, rb, "∂_{p} row {i} differs from from_lar ({:?})", fine.cell_vertices(p - 1, i));
+        }
+        assert_eq!(a.len(), b.len());
+    }
+    assert_eq!(fresh.top_orientation(), fine.top_orientation());
+    // Pieces' measures add up to their parent's.
+    for p in 1..=n {
+        let mut sum = vec![0.0; coarse.cell_count(p)];
+        for i in 0..fine.cell_count(p) {
+            if let Some((j, _)) = r.parent(p, i) {
+                sum[j] += fine.measure(p)[i];
+            }
+        }
+        for (j, (&s, &m)) in sum.iter().zip(coarse.measure(p)).enumerate() {
+            assert!((s - m).abs() <= 1e-12 * m, "p = {p}, cell {j}: pieces {s} vs {m}");
+        }
+        // ζ maps every coarse cell to at least one piece.
+        assert!(r.zeta(p).to_csc().outer_iterator().all(|c| c.nnz() >= 1));
+    }
+    let total: f64 = fine.measure(n).iter().sum();
+    let coarse_total: f64 = coarse.measure(n).iter().sum();
+    assert!((total - coarse_total).abs() <= 1e-12 * coarse_total);
+    check_convex(fine, 1e-9);
+    // Tags: every piece of a tagged cell is tagged, nothing else.
+    for (name, tag) in coarse.tags().iter() {
+        let fine_tag = fine.tag(name).expect("tag kept");
+        let mut expected: Vec<usize> = (0..fine.cell_count(tag.dim))
+            .filter(|&i| r.parent(tag.dim, i).is_some_and(|(j, _)| tag.contains(j)))
+            .collect();
+        expected.sort_unstable();
+        assert_eq!(fine_tag.cells, expected, "tag {name}");
+    }
+}
+
+/// Every vertex of a top cell lies on the inner side of each of its facets
+/// (outward normal = sign in ∂_n × the facet normal).
+fn check_convex(k: &Complex, tol: f64) {
+    let n = k.dim();
+    let d = k.embedding_dim();
+    let csc = k.boundary(n).to_csc();
+    let normals = k.normal();
+    for (c, col) in csc.outer_iterator().enumerate() {
+        let verts = k.cell_vertices(n, c);
+        let scale = k.measure(n)[c].powf(1.0 / n as f64);
+        for (f, &s) in col.iter() {
+            let centre = k.centroid_of(n - 1, f);
+            for &v in verts {
+                let x = k.vertices().point(v);
+                let h: f64 = (0..d)
+                    .map(|a| (x[a] - centre[a]) * normals[f * d + a] * f64::from(s))
+                    .sum();
+                assert!(h <= tol * scale, "cell {c} not convex at facet {f}: vertex {v} is {h} outside");
+            }
+        }
+    }
+}
+
+fn lcg(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn random_delaunay(count: usize, seed: u64) -> Complex {
+    let mut next = lcg(seed);
+    let mut points = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+    for _ in 0..count {
+        points.push([next(), next()]);
+    }
+    delaunay(&points).unwrap()
+}
+
+fn mesh(kind: usize, seed: u64) -> Complex {
+    let axis = |n| uniform_axis(n, 0.0, 1.0).unwrap();
+    match kind {
+        0 => rectangle(3, 2, [0.0, 1.0], [0.0, 1.0]).unwrap(),
+        1 => kuhn(&[axis(3), axis(3)]).unwrap(),
+        2 => random_delaunay(12, seed),
+        3 => perturb(&rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap(), 0.2, seed).unwrap(),
+        4 => box3(2, 2, 2, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap(),
+        _ => kuhn(&[axis(2), axis(2), axis(2)]).unwrap(),
+    }
+}
+
+fn plane_from(d: usize, a: f64, b: f64, offset: f64) -> Hyperplane {
+    // Direction from two angles; the offset moves the plane across [0,1]^d.
+    let normal: Vec<f64> = if d == 2 {
+        vec![a.cos(), a.sin()]
+    } else {
+        vec![a.cos() * b.sin(), a.sin() * b.sin(), b.cos()]
+    };
+    let centre = vec![0.5; d];
+    let point: Vec<f64> = centre
+        .iter()
+        .zip(&normal)
+        .map(|(c, h)| c + (offset - 0.5) * h)
+        .collect();
+    Hyperplane::through(&point, &normal).unwrap()
+}
+
+/// Thesis §4.5, Figs. 4.8–4.9: the classification chains of SPLIT on the
+/// triangle of Examples 5–10 with v1 = (0,0), v2 = (1,1), v3 = (2,0) and the
+/// line x = 1, driven step by step with the make operators.
+#[test]
+fn thesis_classification_chains() {
+    let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 1.0], [2.0, 0.0]]).unwrap();
+    let tri = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+    let h = Hyperplane::axis(2, 0, 1.0).unwrap();
+    let c0 = vertex_classes(&tri, &h, 1e-6).unwrap();
+    assert_eq!(c0, vec![-1, 0, 1]);
+    // Thesis numbering: e1 = v1→v3, e2 = v1→v2, e3 = v2→v3.
+    let d1 = transpose(&from_rows(&[&[-1, 0, 1], &[-1, 1, 0], &[0, -1, 1]]));
+    let d2 = transpose(&from_rows(&[&[-1, 1, 1]]));
+    let (c1, f1) = classification_step(&d1, &c0).unwrap();
+    assert_eq!((c1.clone(), f1.clone()), (vec![0, -1, 1], vec![2, 1, 1]));
+    let cut: Vec<usize> = (0..3).filter(|&i| c1[i].abs() != f1[i]).collect();
+    assert_eq!(cut, vec![0]);
+    // β⁰ on e1: the old index keeps the negative (v1) half; v4 is on the line.
+    let step1 = make(&[d1, d2], 1, 0, &[2]).unwrap();
+    let c0 = vec![-1i8, 0, 1, 0];
+    let (c1, _) = classification_step(&step1.boundaries[0], &c0).unwrap();
+    let c1: Vec<i8> = c1.iter().map(|&x| x.signum() as i8).collect();
+    assert_eq!(c1, vec![-1, -1, 1, 1]);
+    let (c2, f2) = classification_step(&step1.boundaries[1], &c1).unwrap();
+    assert_eq!((c2, f2), (vec![0], vec![4]));
+    // β¹ moves the positive edges e3, e4 to the new face.
+    let step2 = make(&step1.boundaries, 2, 0, &[2, 3]).unwrap();
+    let c1 = vec![-1i8, -1, 1, 1, 0];
+    let (c2, f2) = classification_step(&step2.boundaries[1], &c1).unwrap();
+    let c2: Vec<i8> = c2.iter().map(|&x| x.signum() as i8).collect();
+    assert_eq!((c2, f2), (vec![-1, 1], vec![2, 2]));
+
+    // The geometric SPLIT of the same triangle: same counts, v4 = (1, 0),
+    // two halves of area 1/2.
+    let (fine, r) = split(&tri, &h, None, SplitOptions::default()).unwrap();
+    assert_eq!(fine.cell_counts(), vec![4, 5, 2]);
+    assert_eq!(fine.vertices().point(3), &[1.0, 0.0]);
+    assert_eq!(fine.measure(2), &[0.5, 0.5]);
+    // The negative (left) half keeps index 0.
+    assert!(fine.centroid_of(2, 0)[0] < 1.0);
+    check_split(&tri, &fine, &r);
+}
+
+/// A unit square cut by x = 1/4, everything by hand. Vertices 0 (0,0),
+/// 1 (1,0), 2 (0,1), 3 (1,1); edges {0,1} {0,2} {1,3} {2,3}; the cut adds
+/// v4 = (¼,0) on e0 and v5 = (¼,1) on e3.
+#[test]
+fn square_split_by_hand() {
+    let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    assert_eq!(dense(k.boundary(2)), vec![vec![1], vec![-1], vec![1], vec![-1]]);
+    let h = Hyperplane::axis(2, 0, 0.25).unwrap();
+    let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
+    // Edges: 0 = {0,4} (neg half of e0), 1 = {0,2}, 2 = {1,3}, 3 = {2,5} (neg
+    // half of e3), 4 = {1,4}, 5 = {3,5} (positive halves), 6 = {4,5} (cut).
+    let sets: Vec<Vec<usize>> = (0..7).map(|e| fine.cell_vertices(1, e).to_vec()).collect();
+    assert_eq!(
+        sets,
+        vec![vec![0, 4], vec![0, 2], vec![1, 3], vec![2, 5], vec![1, 4], vec![3, 5], vec![4, 5]]
+    );
+    assert_eq!(
+        dense(fine.boundary(1)),
+        vec![
+            vec![-1, -1, 0, 0, 0, 0, 0],
+            vec![0, 0, -1, 0, -1, 0, 0],
+            vec![0, 1, 0, -1, 0, 0, 0],
+            vec![0, 0, 1, 0, 0, -1, 0],
+            vec![1, 0, 0, 0, 1, 0, -1],
+            vec![0, 0, 0, 1, 0, 1, 1],
+        ]
+    );
+    // Left piece 0→4→5→2→0: e0 + e6 − e3 − e1. Right piece 4→1→3→5→4:
+    // −e4 + e2 + e5 − e6.
+    assert_eq!(
+        dense(fine.boundary(2)),
+        vec![
+            vec![1, 0],
+            vec![-1, 0],
+            vec![0, 1],
+            vec![-1, 0],
+            vec![0, -1],
+            vec![0, 1],
+            vec![1, -1],
+        ]
+    );
+    // ζ_1: e0 ↦ e0 − e4 (the piece {1,4} runs 1 → 4, against 0 → 1),
+    // e3 ↦ e3 − e5; ζ_2: the square ↦ both pieces.
+    assert_eq!(
+        dense(r.zeta(1)),
+        vec![
+            vec![1, 0, 0, 0],
+            vec![0, 1, 0, 0],
+            vec![0, 0, 1, 0],
+            vec![0, 0, 0, 1],
+            vec![-1, 0, 0, 0],
+            vec![0, 0, 0, -1],
+            vec![0, 0, 0, 0],
+        ]
+    );
+    assert_eq!(dense(r.zeta(2)), vec![vec![1], vec![1]]);
+    assert_eq!(fine.measure(2), &[0.25, 0.75]);
+    check_split(&k, &fine, &r);
+}
+
+#[test]
+fn planes_through_vertices_and_along_faces_reuse_them() {
+    // Diagonal through two corners of a square: no new vertex.
+    let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let h = Hyperplane::new(&[1.0, -1.0], 0.0).unwrap();
+    let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
+    assert_eq!(fine.cell_counts(), vec![4, 5, 2]);
+    assert_eq!(fine.measure(2), &[0.5, 0.5]);
+    check_split(&k, &fine, &r);
+    // Along grid lines: nothing changes (2D and 3D).
+    let g = rectangle(3, 3, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let h = Hyperplane::axis(2, 0, 1.0 / 3.0).unwrap();
+    let (same, r) = split(&g, &h, None, SplitOptions::default()).unwrap();
+    assert_eq!(same.cell_counts(), g.cell_counts());
+    assert_eq!(dense(r.zeta(2)), dense(&CsMat::eye(9)));
+    let b = box3(2, 2, 2, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let (same, _) = split(&b, &Hyperplane::axis(3, 2, 0.5).unwrap(), None, SplitOptions::default()).unwrap();
+    assert_eq!(same.cell_counts(), b.cell_counts());
+    // A cube cut through the plane of four of its vertices (a diagonal
+    // plane x = y): two prisms, no new vertex; the top and bottom squares
+    // are halved by diagonals and the cut square is new: 6 + 2 + 1 faces.
+    let c = box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let h = Hyperplane::new(&[1.0, -1.0, 0.0], 0.0).unwrap();
+    let (fine, r) = split(&c, &h, None, SplitOptions::default()).unwrap();
+    assert_eq!(fine.cell_counts(), vec![8, 14, 9, 2]);
+    assert_eq!(fine.measure(3), &[0.5, 0.5]);
+    check_split(&c, &fine, &r);
+    // A tetrahedron cut through one vertex and two edges: a triangle cut face.
+    let unit = uniform_axis(1, 0.0, 1.0).unwrap();
+    let t = kuhn(&[unit.clone(), unit.clone(), unit]).unwrap();
+    let h = Hyperplane::new(&[1.0, 0.0, 0.0], 0.5).unwrap();
+    let (fine, r) = split(&t, &h, None, SplitOptions::default()).unwrap();
+    check_split(&t, &fine, &r);
+}
+
+#[test]
+fn near_vertex_plane_snaps_and_exact_mode_keeps_slivers() {
+    let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    // Through (0,0) and 1e-9 above (1,1): snapped to the diagonal.
+    let h = Hyperplane::new(&[1.0, -1.0], 1e-9).unwrap();
+    let (snapped, _) = split(&k, &h, None, SplitOptions::default()).unwrap();
+    assert_eq!(snapped.cell_counts(), vec![4, 5, 2]);
+    // 1e-9 the other way with exact classification: (0,1) alone is below,
+    // and the two edges at it are cut 1e-9 short of (0,0) and (1,1): a
+    // triangle and a pentagon, with sliver edges of length about 1.4e-9.
+    let h = Hyperplane::new(&[1.0, -1.0], -1e-9).unwrap();
+    let (exact, r) = split(&k, &h, None, SplitOptions { snap: 0.0 }).unwrap();
+    assert_eq!(exact.cell_counts(), vec![6, 7, 2]);
+    let shortest = exact.measure(1).iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(shortest < 2e-9 && shortest > 0.0);
+    check_split(&k, &exact, &r);
+}
+
+#[test]
+fn restricted_split_leaves_neighbours_whole_with_a_hanging_vertex() {
+    let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    // Cut only cell 0 (bottom left) by y = 0.25; its right edge is shared with
+    // cell 1, which becomes a pentagon with a straight angle.
+    let h = Hyperplane::axis(2, 1, 0.25).unwrap();
+    let (fine, r) = split(&k, &h, Some(&[0]), SplitOptions::default()).unwrap();
+    assert_eq!(fine.cell_count(2), 5);
+    assert_eq!(fine.cell_vertices(2, 1).len(), 5);
+    check_split(&k, &fine, &r);
+    // Tags of boundary edges are carried to the pieces.
+    let xmin = fine.tag("xmin").unwrap();
+    assert_eq!(xmin.cells.len(), 3);
+}
+
+#[test]
+fn bad_input_is_reported() {
+    let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let h3 = Hyperplane::axis(3, 0, 0.5).unwrap();
+    assert!(matches!(split(&k, &h3, None, SplitOptions::default()), Err(SplitError::PlaneDimension { .. })));
+    let h = Hyperplane::axis(2, 0, 0.5).unwrap();
+    assert!(matches!(split(&k, &h, Some(&[3]), SplitOptions::default()), Err(SplitError::CellOutOfRange { .. })));
+    assert!(matches!(split(&k, &h, None, SplitOptions { snap: 0.5 }), Err(SplitError::BadTolerance(_))));
+    assert!(matches!(split(&k, &h, None, SplitOptions { snap: f64::NAN }), Err(SplitError::BadTolerance(_))));
+    assert!(matches!(Hyperplane::new(&[f64::NAN, 1.0], 0.0), Err(SplitError::BadNormal(_))));
+    assert!(matches!(Hyperplane::new(&[1.0, 1.0], f64::INFINITY), Err(SplitError::BadOffset(_))));
+    let line = hasse_complex::generate::interval(3, 0.0, 1.0).unwrap();
+    assert!(matches!(
+        split(&line, &Hyperplane::axis(1, 0, 0.5).unwrap(), None, SplitOptions::default()),
+        Err(SplitError::Unsupported { .. })
+    ));
+    let cuts = vec![(0, h.clone()), (0, h)];
+    assert!(split_cells(&k, &cuts, SplitOptions::default()).is_err());
+    let (_, r) = split(&k, &Hyperplane::axis(2, 0, 0.5).unwrap(), None, SplitOptions::default()).unwrap();
+    assert!(matches!(r.intensive(2, &[1.0, 2.0]), Err(SplitError::LengthMismatch { .. })));
+    assert!(matches!(r.nodal(&[1.0]), Err(SplitError::LengthMismatch { .. })));
+    assert!(r.compose(&r).is_err());
+    let _ = Lar::from_vertex_sets; // the LAR type is part of the checked API
+}
+
+#[test]
+fn transfers_conserve_and_interpolate() {
+    let k = kuhn(&[uniform_axis(3, 0.0, 1.0).unwrap(), uniform_axis(2, 0.0, 1.0).unwrap()]).unwrap();
+    let h = Hyperplane::new(&[0.3, 0.9], 0.5).unwrap();
+    let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
+    check_split(&k, &fine, &r);
+    let n = 2;
+    let mut next = lcg(3);
+    for p in 0..=n {
+        let coarse: Vec<f64> = (0..k.cell_count(p)).map(|_| next() - 0.5).collect();
+        let ext = r.extensive(&fine, p, &coarse).unwrap();
+        // ζᵀ (fine) = coarse: the pieces add up to their parent.
+        let mut back = vec![0.0; k.cell_count(p)];
+        for (i, row) in r.zeta(p).outer_iterator().enumerate() {
+            for (j, &s) in row.iter() {
+                back[j] += f64::from(s) * ext[i];
+            }
+        }
+        for (b, c) in back.iter().zip(&coarse) {
+            assert!((b - c).abs() <= 1e-14, "p = {p}: {b} vs {c}");
+        }
+        let int = r.intensive(p, &coarse).unwrap();
+        for (i, v) in int.iter().enumerate() {
+            match r.parent(p, i) {
+                Some((j, s)) => assert_eq!(*v, f64::from(s) * coarse[j]),
+                None => assert_eq!(*v, 0.0),
+            }
+        }
+    }
+    // An affine nodal field is reproduced exactly at every new vertex.
+    let f = |x: &[f64]| 2.0 * x[0] - 3.0 * x[1] + 0.5;
+    let coarse: Vec<f64> = (0..k.cell_count(0)).map(|v| f(k.vertices().point(v))).collect();
+    let fine_u = r.nodal(&coarse).unwrap();
+    for (v, u) in fine_u.iter().enumerate() {
+        assert!((u - f(fine.vertices().point(v))).abs() < 1e-13);
+    }
+}
+
+#[test]
+fn repeated_splits_compose() {
+    let mut k = random_delaunay(20, 11);
+    let coarse = k.clone();
+    let mut total = Refinement::identity(&k);
+    let mut next = lcg(5);
+    for _ in 0..4 {
+        let h = plane_from(2, next() * 6.3, 0.0, 0.2 + 0.6 * next());
+        let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
+        check_split(&k, &fine, &r);
+        total = total.compose(&r).unwrap();
+        k = fine;
+    }
+    check_split(&coarse, &k, &total);
+    // 3D: a hex grid cut three times by oblique planes.
+    let mut k = box3(2, 2, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let coarse = k.clone();
+    let mut total = Refinement::identity(&k);
+    for _ in 0..3 {
+        let h = plane_from(3, next() * 6.3, 0.3 + next(), 0.2 + 0.6 * next());
+        let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
+        check_split(&k, &fine, &r);
+        total = total.compose(&r).unwrap();
+        k = fine;
+    }
+    check_split(&coarse, &k, &total);
+}
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 40, ..ProptestConfig::default() })]
+
+        #[test]
+        fn random_planes_on_random_meshes(
+            kind in 0usize..6,
+            seed in 0u64..1000,
+            a in 0.0f64..6.3,
+            b in 0.2f64..2.9,
+            offset in 0.05f64..0.95,
+            a2 in 0.0f64..6.3,
+            offset2 in 0.05f64..0.95,
+        ) {
+            let k = mesh(kind, seed);
+            let d = k.embedding_dim();
+            let h = plane_from(d, a, b, offset);
+            let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
+            check_split(&k, &fine, &r);
+            // A second plane, restricted to the even top cells.
+            let h2 = plane_from(d, a2, 3.0 - b, offset2);
+            let some: Vec<usize> = (0..fine.cell_count(d)).step_by(2).collect();
+            let (fine2, r2) = split(&fine, &h2, Some(&some), SplitOptions::default()).unwrap();
+            check_split(&fine, &fine2, &r2);
+            check_split(&k, &fine2, &r.compose(&r2).unwrap());
+        }
+    }
+}
