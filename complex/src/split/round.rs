@@ -25,7 +25,9 @@ use crate::error::{ComplexError, SplitError};
 use crate::frame::{self, Frame, Point};
 use crate::lar::{characteristic_matrix, Lar};
 use crate::tags::{CellTag, Tags};
+use rayon::prelude::*;
 use sprs::CsMat;
+use std::ops::Range;
 
 const NONE: u32 = u32::MAX;
 
@@ -102,7 +104,7 @@ impl Level {
 /// shares a vertex sees the same class.
 struct Classifier<'a> {
     planes: &'a [Hyperplane],
-    coords: Vec<f64>,
+    coords: &'a [f64],
     dim: usize,
     /// snap × (shortest edge at the vertex).
     threshold: Vec<f64>,
@@ -113,6 +115,7 @@ struct Classifier<'a> {
 
 impl Classifier<'_> {
     fn distance(&self, v: usize, plane: u32) -> f64 {
+        // Only the first `dim` normal components are non-zero.
         self.planes[plane as usize].distance(&self.coords[v * self.dim..(v + 1) * self.dim])
     }
 
@@ -211,6 +214,7 @@ pub(super) fn round(
     let d = k.embedding_dim();
     let counts = k.cell_counts();
     let k0 = counts[0];
+    let mut clock = Phases::new();
 
     // Local length scale: the shortest edge at each vertex.
     let mut shortest = vec![f64::INFINITY; k0];
@@ -224,7 +228,7 @@ pub(super) fn round(
     }
     let mut cls = Classifier {
         planes,
-        coords: k.vertices().as_slice().to_vec(),
+        coords: k.vertices().as_slice(),
         dim: d,
         threshold: shortest
             .iter()
@@ -238,6 +242,7 @@ pub(super) fn round(
     let mut splits: Vec<Splits> = counts.iter().map(|&c| Splits::new(c)).collect();
     let mut deferred = Vec::new();
     let mut straddled: Vec<(usize, usize)> = Vec::new();
+    let mut stack: Vec<(usize, usize)> = Vec::new();
     let csc: Vec<Option<&CsMat<i8>>> = (0..=n)
         .map(|p| (p >= 1).then(|| k.boundary_csc(p)))
         .collect();
@@ -250,10 +255,11 @@ pub(super) fn round(
             continue;
         }
         straddled.clear();
-        collect_straddled(k, &csc, &cls, n, c, id, &mut straddled);
-        let conflict = straddled
-            .iter()
-            .any(|&(p, i)| splits[p].plane[i] != NONE && splits[p].plane[i] != id);
+        collect_straddled(k, &csc, &cls, n, c, id, &mut stack, &mut straddled);
+        let conflict = straddled.iter().any(|&(p, i)| {
+            let claim = splits[p].plane[i];
+            claim != NONE && claim != id && !compatible(k, &cls, p, i, claim, id)
+        });
         if conflict {
             deferred.push((c, id));
             continue;
@@ -263,6 +269,7 @@ pub(super) fn round(
         }
         splits[n].plane[c] = id;
     }
+    clock.lap("classify and accept");
     // Ranks: the positive piece of the r-th split p-cell is k_p + r.
     let split_count: Vec<usize> = splits
         .iter()
@@ -287,109 +294,91 @@ pub(super) fn round(
         })
         .collect();
 
-    // ---- Level 1: edges; new vertices on cut edges.
+    // ---- Level 1: edges; new vertices on cut edges. Chunks of edges are
+    // processed in parallel; the r-th cut edge creates vertex k0 + r and
+    // positive piece k1 + r, so chunks need no coordination.
+    let edge_chunks: Vec<EdgeChunk> = (0..counts[1].div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|i| cut_edges(k, &cls, &splits[1], i * CHUNK..((i + 1) * CHUNK).min(counts[1])))
+        .collect();
     let mut nodal: Vec<(usize, usize, f64)> = Vec::with_capacity(split_count[1]);
+    let mut coords = Vec::with_capacity((k0 + split_count[1]) * d);
+    coords.extend_from_slice(k.vertices().as_slice());
     let mut levels: Vec<Level> = Vec::with_capacity(n + 1);
     levels.push(Level::default());
     {
         let mut main = Level::with_capacity(new_counts[1], 2 * new_counts[1], 2 * new_counts[1]);
         let mut plus = Level::with_capacity(split_count[1], 2 * split_count[1], 2 * split_count[1]);
-        cls.coords.reserve(split_count[1] * d);
-        let s = &mut splits[1];
-        for e in 0..counts[1] {
-            let ends = k.cell_vertices(1, e);
-            let (a, b) = (ends[0], ends[1]);
-            let id = s.plane[e];
-            if id == NONE {
-                main.push(&[(a, -1), (b, 1)], &[a as u32, b as u32]);
-                continue;
+        coords.reserve_exact(split_count[1] * d);
+        for chunk in edge_chunks {
+            main.append(chunk.main);
+            plus.append(chunk.plus);
+            coords.extend(chunk.coords);
+            for (e, em, ep) in chunk.eps {
+                splits[1].eps_minus[e] = em;
+                splits[1].eps_plus[e] = ep;
             }
-            let (da, db) = (cls.distance(a, id), cls.distance(b, id));
-            let t = da / (da - db);
-            let m = k0 + nodal.len();
-            let (xa, xb) = (cls.point(a), cls.point(b));
-            for axis in 0..d {
-                cls.coords.push(xa[axis] + t * (xb[axis] - xa[axis]));
+            for &(a, b, t, id) in &chunk.nodal {
+                cls.threshold.push(cls.threshold[a].min(cls.threshold[b]));
+                cls.creator.push(id);
+                nodal.push((a, b, t));
             }
-            cls.threshold.push(cls.threshold[a].min(cls.threshold[b]));
-            cls.creator.push(id);
-            nodal.push((a, b, t));
-            // (x, m) is oriented x → m; it agrees with a → b when x = a.
-            let (minus_end, plus_end) = if da < 0.0 { (a, b) } else { (b, a) };
-            let eps = |x: usize| if x == a { 1 } else { -1 };
-            s.eps_minus[e] = eps(minus_end);
-            s.eps_plus[e] = eps(plus_end);
-            main.push(&[(minus_end, -1), (m, 1)], &[minus_end as u32, m as u32]);
-            plus.push(&[(plus_end, -1), (m, 1)], &[plus_end as u32, m as u32]);
         }
         main.append(plus);
         levels.push(main);
     }
-    let vertices = Vertices::new(d, cls.coords.clone())?;
+    let vertices = Vertices::new(d, coords)?;
+    // From here on new vertices are classified too.
+    let cls = Classifier {
+        planes,
+        coords: vertices.as_slice(),
+        dim: d,
+        threshold: std::mem::take(&mut cls.threshold),
+        creator: std::mem::take(&mut cls.creator),
+    };
+    clock.lap("edges");
 
-    // ---- Levels 2..=n.
+    // ---- Levels 2..=n, in parallel chunks of cells.
     let mut top_orientation: Vec<i8> = k.top_orientation().to_vec();
-    top_orientation.reserve(split_count[n]);
-    let mut scratch = Scratch::default();
+    top_orientation.resize(counts[n] + split_count[n], 1);
     for p in 2..=n {
         let old = csc[p].ok_or(SplitError::Invalid("internal: missing ∂".into()))?;
+        let ctx = CellPass {
+            k,
+            vertices: &vertices,
+            cls: &cls,
+            edges: &levels[1],
+            lower: &levels[p - 1],
+            below: &splits[p - 1],
+            here: &splits[p],
+            old,
+            p,
+            n,
+            cut_base: counts[p - 1] + split_count[p - 1],
+            first_plus: counts[p],
+        };
+        let chunks: Vec<CellChunk> = (0..counts[p].div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|i| ctx.run(i * CHUNK..((i + 1) * CHUNK).min(counts[p])))
+            .collect::<Result<_, SplitError>>()?;
         let mut main = Level::with_capacity(new_counts[p], old.nnz() * 2, old.nnz() * 2);
-        let mut plus = Level::default();
-        plus.ptr.push(0);
-        plus.set_ptr.push(0);
-        let mut cut_cells = Level::default();
-        cut_cells.ptr.push(0);
-        cut_cells.set_ptr.push(0);
-        let (lower_splits, upper) = splits.split_at_mut(p);
-        let below = &lower_splits[p - 1];
-        let here = &mut upper[0];
-        let lower = &levels[p - 1];
-        let cut_base = counts[p - 1] + split_count[p - 1];
-        for c in 0..counts[p] {
-            let (facets, signs) = crate::geometry::column(old, c);
-            scratch.column.clear();
-            let mut changed = false;
-            for (&f, &s) in facets.iter().zip(signs) {
-                if below.plane[f] == NONE {
-                    changed |= below.grown[f];
-                    scratch.column.push((f, s));
-                } else {
-                    changed = true;
-                    scratch.column.push((f, s * below.eps_minus[f]));
-                    scratch.column.push((below.plus[f], s * below.eps_plus[f]));
-                }
+        let mut plus = Level::with_capacity(split_count[p], 0, 0);
+        let mut cut_cells = Level::with_capacity(split_count[p], 0, 0);
+        let here = &mut splits[p];
+        for chunk in chunks {
+            main.append(chunk.main);
+            plus.append(chunk.plus);
+            cut_cells.append(chunk.cuts);
+            for c in chunk.grown {
+                here.grown[c] = true;
             }
-            scratch.column.sort_unstable();
-            let id = here.plane[c];
-            if id == NONE {
-                here.grown[c] = changed;
-                if changed {
-                    union_sets(lower, scratch.column.iter().map(|x| x.0), &mut scratch.set);
-                    main.push(&scratch.column, &scratch.set);
-                } else {
-                    let set: Vec<u32> = k.cell_vertices(p, c).iter().map(|&v| v as u32).collect();
-                    main.push(&scratch.column, &set);
+            for (c, em, ep, tm, tp) in chunk.eps {
+                here.eps_minus[c] = em;
+                here.eps_plus[c] = ep;
+                if p == n {
+                    top_orientation[c] = tm;
+                    top_orientation[here.plus[c]] = tp;
                 }
-                continue;
-            }
-            let pieces = cut_cell(k, &vertices, &cls, &levels[1], lower, p, n, c, id, &mut scratch)?;
-            let cut_index = cut_base + cut_cells.len();
-            cut_cells.push(&pieces.cut_column, &pieces.cut_set);
-            let col = |side: &[(usize, i8)], s_n: i8, eps: i8| -> Vec<(usize, i8)> {
-                let mut v: Vec<(usize, i8)> = side.iter().map(|&(f, r)| (f, r * eps)).collect();
-                v.push((cut_index, s_n * eps));
-                v.sort_unstable();
-                v
-            };
-            let minus_col = col(&pieces.minus, pieces.cut_sign, pieces.eps_minus);
-            let plus_col = col(&pieces.plus, -pieces.cut_sign, pieces.eps_plus);
-            main.push(&minus_col, &pieces.minus_set);
-            plus.push(&plus_col, &pieces.plus_set);
-            here.eps_minus[c] = pieces.eps_minus;
-            here.eps_plus[c] = pieces.eps_plus;
-            if p == n {
-                top_orientation[c] = pieces.top_minus;
-                top_orientation.push(pieces.top_plus);
             }
         }
         main.append(plus);
@@ -399,6 +388,7 @@ pub(super) fn round(
         levels[p - 1].append(cut_cells);
     }
 
+    clock.lap("faces and cells");
     // ---- Assemble matrices.
     let mut boundaries = Vec::with_capacity(n);
     let mut characteristic = Vec::with_capacity(n);
@@ -418,6 +408,7 @@ pub(super) fn round(
     }
     let lar = Lar::new(vertices, characteristic)?;
 
+    clock.lap("assemble ∂ and M");
     // ---- ζ and the nodal interpolation.
     let mut zeta = Vec::with_capacity(n + 1);
     zeta.push(identity_rows(new_counts[0], counts[0], &[], &[], &[]));
@@ -433,6 +424,7 @@ pub(super) fn round(
     }
     let nodal = nodal_matrix(counts[0], &nodal);
 
+    clock.lap("ζ and nodal interpolation");
     // ---- Tags: a tagged cell's pieces keep the tag.
     let mut tags = Tags::default();
     for (name, tag) in k.tags().iter() {
@@ -446,6 +438,7 @@ pub(super) fn round(
         tags.insert(name, CellTag::new(tag.dim, cells));
     }
     let complex = Complex::from_parts(lar, boundaries, top_orientation, tags);
+    clock.lap("tags");
     Ok(Round {
         complex,
         refinement: Refinement::from_parts(zeta, nodal),
@@ -453,8 +446,203 @@ pub(super) fn round(
     })
 }
 
+/// Can a lower cell claimed by plane `a` also serve a cell cut by plane `b`?
+/// Yes when both planes see its vertices on the same sides (up to the
+/// orientation of the normals) and, for an edge, `a`'s cut point lies on `b`
+/// within the snap tolerance — so `b` will classify that new vertex as on
+/// its plane. Planes that differ in the last bits (centroids of a column of
+/// cells computed from different vertices) thus share their cuts.
+fn compatible(k: &Complex, cls: &Classifier, p: usize, i: usize, a: u32, b: u32) -> bool {
+    let (na, nb) = (&cls.planes[a as usize].normal, &cls.planes[b as usize].normal);
+    let sigma = if frame::dot(na, nb) >= 0.0 { 1 } else { -1 };
+    let verts = k.cell_vertices(p, i);
+    if verts.iter().any(|&v| cls.class(v, b) != sigma * cls.class(v, a)) {
+        return false;
+    }
+    if p != 1 {
+        return true;
+    }
+    let (u, w) = (verts[0], verts[1]);
+    let (du, dw) = (cls.distance(u, a), cls.distance(w, a));
+    let t = du / (du - dw);
+    let (xu, xw) = (cls.point(u), cls.point(w));
+    let mut m = [0.0; 3];
+    for axis in 0..cls.dim {
+        m[axis] = xu[axis] + t * (xw[axis] - xu[axis]);
+    }
+    let threshold = cls.threshold[u].min(cls.threshold[w]);
+    cls.planes[b as usize].distance(&m[..cls.dim]).abs() <= threshold
+}
+
+const CHUNK: usize = 16384;
+
+struct EdgeChunk {
+    main: Level,
+    plus: Level,
+    coords: Vec<f64>,
+    /// (edge, ε⁻, ε⁺) of the cut edges.
+    eps: Vec<(usize, i8, i8)>,
+    /// (a, b, t, plane) of each new vertex, in order.
+    nodal: Vec<(usize, usize, f64, u32)>,
+}
+
+/// Cut the claimed edges of `range`: the new vertex m = a + t (b − a) at
+/// the plane's crossing; the piece (x, m) is oriented x → m (m is the
+/// largest index), which agrees with the parent a → b exactly when x = a.
+fn cut_edges(k: &Complex, cls: &Classifier, s: &Splits, range: Range<usize>) -> EdgeChunk {
+    let len = range.len();
+    let mut out = EdgeChunk {
+        main: Level::with_capacity(len, 2 * len, 2 * len),
+        plus: Level::with_capacity(0, 0, 0),
+        coords: Vec::new(),
+        eps: Vec::new(),
+        nodal: Vec::new(),
+    };
+    let k0 = k.cell_count(0);
+    let k1 = k.cell_count(1);
+    for e in range {
+        let ends = k.cell_vertices(1, e);
+        let (a, b) = (ends[0], ends[1]);
+        let id = s.plane[e];
+        if id == NONE {
+            out.main.push(&[(a, -1), (b, 1)], &[a as u32, b as u32]);
+            continue;
+        }
+        let (da, db) = (cls.distance(a, id), cls.distance(b, id));
+        let t = da / (da - db);
+        let m = k0 + (s.plus[e] - k1);
+        let (xa, xb) = (cls.point(a), cls.point(b));
+        for axis in 0..cls.dim {
+            out.coords.push(xa[axis] + t * (xb[axis] - xa[axis]));
+        }
+        out.nodal.push((a, b, t, id));
+        let (minus_end, plus_end) = if da < 0.0 { (a, b) } else { (b, a) };
+        let eps = |x: usize| if x == a { 1 } else { -1 };
+        out.eps.push((e, eps(minus_end), eps(plus_end)));
+        out.main
+            .push(&[(minus_end, -1), (m, 1)], &[minus_end as u32, m as u32]);
+        out.plus
+            .push(&[(plus_end, -1), (m, 1)], &[plus_end as u32, m as u32]);
+    }
+    out
+}
+
+struct CellChunk {
+    main: Level,
+    plus: Level,
+    cuts: Level,
+    grown: Vec<usize>,
+    /// (cell, ε⁻, ε⁺, top flag⁻, top flag⁺) of the cut cells.
+    eps: Vec<(usize, i8, i8, i8, i8)>,
+}
+
+/// Everything one pass over the p-cells reads.
+struct CellPass<'a> {
+    k: &'a Complex,
+    vertices: &'a Vertices,
+    cls: &'a Classifier<'a>,
+    edges: &'a Level,
+    lower: &'a Level,
+    below: &'a Splits,
+    here: &'a Splits,
+    old: &'a CsMat<i8>,
+    p: usize,
+    n: usize,
+    cut_base: usize,
+    first_plus: usize,
+}
+
+impl CellPass<'_> {
+    /// New columns and vertex sets of the p-cells in `range`: ζ(∂c) for an
+    /// uncut cell, the two pieces and the cut cell for a cut one.
+    fn run(&self, range: Range<usize>) -> Result<CellChunk, SplitError> {
+        let len = range.len();
+        let mut out = CellChunk {
+            main: Level::with_capacity(len, 6 * len, 6 * len),
+            plus: Level::with_capacity(0, 0, 0),
+            cuts: Level::with_capacity(0, 0, 0),
+            grown: Vec::new(),
+            eps: Vec::new(),
+        };
+        let mut scratch = Scratch::default();
+        let mut pieces = Pieces::default();
+        let mut side = Vec::new();
+        for c in range {
+            let (facets, signs) = crate::geometry::column(self.old, c);
+            scratch.column.clear();
+            let mut changed = false;
+            for (&f, &s) in facets.iter().zip(signs) {
+                if self.below.plane[f] == NONE {
+                    changed |= self.below.grown[f];
+                    scratch.column.push((f, s));
+                } else {
+                    changed = true;
+                    scratch.column.push((f, s * self.below.eps_minus[f]));
+                    scratch
+                        .column
+                        .push((self.below.plus[f], s * self.below.eps_plus[f]));
+                }
+            }
+            scratch.column.sort_unstable();
+            let id = self.here.plane[c];
+            if id == NONE {
+                if changed {
+                    out.grown.push(c);
+                    union_sets(self.lower, scratch.column.iter().map(|x| x.0), &mut scratch.set);
+                    out.main.push(&scratch.column, &scratch.set);
+                } else {
+                    scratch.set.clear();
+                    scratch
+                        .set
+                        .extend(self.k.cell_vertices(self.p, c).iter().map(|&v| v as u32));
+                    out.main.push(&scratch.column, &scratch.set);
+                }
+                continue;
+            }
+            cut_cell(
+                self.k,
+                self.vertices,
+                self.cls,
+                self.edges,
+                self.lower,
+                self.p,
+                self.n,
+                c,
+                id,
+                &mut scratch,
+                &mut pieces,
+            )?;
+            let cut_index = self.cut_base + (self.here.plus[c] - self.first_plus);
+            out.cuts.push(&pieces.cut_column, &pieces.cut_set);
+            for (part, cut_sign, eps, level, set) in [
+                (&pieces.minus, pieces.cut_sign, pieces.eps_minus, 0, &pieces.minus_set),
+                (&pieces.plus, -pieces.cut_sign, pieces.eps_plus, 1, &pieces.plus_set),
+            ] {
+                side.clear();
+                side.extend(part.iter().map(|&(f, r)| (f, r * eps)));
+                side.push((cut_index, cut_sign * eps));
+                side.sort_unstable();
+                if level == 0 {
+                    out.main.push(&side, set);
+                } else {
+                    out.plus.push(&side, set);
+                }
+            }
+            out.eps.push((
+                c,
+                pieces.eps_minus,
+                pieces.eps_plus,
+                pieces.top_minus,
+                pieces.top_plus,
+            ));
+        }
+        Ok(out)
+    }
+}
+
 /// Every lower cell of top cell `c` that straddles plane `id` (vertices
 /// strictly on both sides).
+#[allow(clippy::too_many_arguments)]
 fn collect_straddled(
     k: &Complex,
     csc: &[Option<&CsMat<i8>>],
@@ -462,9 +650,11 @@ fn collect_straddled(
     n: usize,
     c: usize,
     id: u32,
+    stack: &mut Vec<(usize, usize)>,
     out: &mut Vec<(usize, usize)>,
 ) {
-    let mut stack = vec![(n, c)];
+    stack.clear();
+    stack.push((n, c));
     while let Some((p, cell)) = stack.pop() {
         let Some(m) = csc[p] else { continue };
         for &f in crate::geometry::column(m, cell).0 {
@@ -489,7 +679,10 @@ struct Scratch {
     tally: Vec<(usize, i8, u8)>,
 }
 
+#[derive(Default)]
 struct Pieces {
+    ids: Vec<usize>,
+    cut: Vec<usize>,
     minus: Vec<(usize, i8)>,
     plus: Vec<(usize, i8)>,
     minus_set: Vec<u32>,
@@ -526,10 +719,22 @@ fn cut_cell(
     c: usize,
     id: u32,
     scratch: &mut Scratch,
-) -> Result<Pieces, SplitError> {
+    out: &mut Pieces,
+) -> Result<(), SplitError> {
     let ambiguous = || SplitError::AmbiguousCut { dim: p, cell: c };
-    let mut minus = Vec::new();
-    let mut plus = Vec::new();
+    let Pieces {
+        ids,
+        cut,
+        minus,
+        plus,
+        minus_set,
+        plus_set,
+        cut_column,
+        cut_set,
+        ..
+    } = out;
+    minus.clear();
+    plus.clear();
     // Facets with a vertex strictly below go to the negative piece, the rest
     // (positive or lying in the plane) to the positive one.
     scratch.tally.clear();
@@ -555,30 +760,26 @@ fn cut_cell(
     if minus.is_empty() || plus.is_empty() {
         return Err(ambiguous());
     }
-    let mut cut: Vec<usize> = scratch
-        .tally
-        .iter()
-        .filter(|t| t.2 == 3)
-        .map(|t| t.0)
-        .collect();
+    cut.clear();
+    cut.extend(scratch.tally.iter().filter(|t| t.2 == 3).map(|t| t.0));
     cut.sort_unstable();
     // The new (p−1)-cell N and its boundary in its own orientation.
-    let (cut_column, cut_set): (Vec<(usize, i8)>, Vec<u32>) = if p == 2 {
+    if p == 2 {
         if cut.len() != 2 {
             return Err(ambiguous());
         }
-        (
-            vec![(cut[0], -1), (cut[1], 1)],
-            vec![cut[0] as u32, cut[1] as u32],
-        )
+        cut_column.clear();
+        cut_column.extend([(cut[0], -1), (cut[1], 1)]);
+        cut_set.clear();
+        cut_set.extend([cut[0] as u32, cut[1] as u32]);
     } else {
-        cut_polygon(vertices, edges, &cut, p, c)?
-    };
+        (*cut_column, *cut_set) = cut_polygon(vertices, edges, cut, p, c)?;
+    }
     // ∂∂ = 0 on the negative piece fixes the sign of N: the coefficient of
     // the first face g of N in ∂(minus part) must cancel with ∂N.
     let (g, ng) = cut_column[0];
     let mut coef: i32 = 0;
-    for &(f, r) in &minus {
+    for &(f, r) in minus.iter() {
         let (rows, signs) = lower.column(f);
         if let Ok(pos) = rows.binary_search(&g) {
             coef += i32::from(r) * i32::from(signs[pos]);
@@ -588,10 +789,8 @@ fn cut_cell(
         return Err(ambiguous());
     }
     let cut_sign = -(coef as i8) * ng;
-    let mut minus_set = Vec::new();
-    union_sets(lower, minus.iter().map(|x| x.0), &mut minus_set);
-    let mut plus_set = Vec::new();
-    union_sets(lower, plus.iter().map(|x| x.0), &mut plus_set);
+    union_sets(lower, minus.iter().map(|x| x.0), minus_set);
+    union_sets(lower, plus.iter().map(|x| x.0), plus_set);
     let degenerate = |set: &[u32]| {
         SplitError::Complex(ComplexError::DegenerateCell {
             dim: p,
@@ -599,12 +798,13 @@ fn cut_cell(
             vertices: set.iter().map(|&v| v as usize).collect(),
         })
     };
-    let frame_of = |set: &[u32]| {
-        let ids: Vec<usize> = set.iter().map(|&v| v as usize).collect();
-        frame::frame(vertices, &ids, p).ok_or_else(|| degenerate(set))
+    let mut frame_of = |set: &[u32]| {
+        ids.clear();
+        ids.extend(set.iter().map(|&v| v as usize));
+        frame::frame(vertices, ids, p).ok_or_else(|| degenerate(set))
     };
-    let fm = frame_of(&minus_set)?;
-    let fp = frame_of(&plus_set)?;
+    let fm = frame_of(minus_set)?;
+    let fp = frame_of(plus_set)?;
     let (eps_minus, eps_plus, top_minus, top_plus) = if p == n {
         // Top cells are stored positively oriented: the pieces keep the
         // parent's orientation; only the flag relative to the sorted frame is new.
@@ -616,7 +816,7 @@ fn cut_cell(
         )
     } else {
         let parent = frame::frame(vertices, k.cell_vertices(p, c), p)
-            .ok_or_else(|| degenerate(&minus_set))?;
+            .ok_or_else(|| degenerate(minus_set))?;
         (
             relative_orientation(&fm, &parent),
             relative_orientation(&fp, &parent),
@@ -624,19 +824,12 @@ fn cut_cell(
             1,
         )
     };
-    Ok(Pieces {
-        minus,
-        plus,
-        minus_set,
-        plus_set,
-        cut_column,
-        cut_set,
-        cut_sign,
-        eps_minus,
-        eps_plus,
-        top_minus,
-        top_plus,
-    })
+    out.cut_sign = cut_sign;
+    out.eps_minus = eps_minus;
+    out.eps_plus = eps_plus;
+    out.top_minus = top_minus;
+    out.top_plus = top_plus;
+    Ok(())
 }
 
 /// The cut polygon of a polyhedron: its edges `cut` form one cycle; walk it
@@ -719,27 +912,26 @@ fn identity_rows(
     eps_minus: &[i8],
     eps_plus: &[i8],
 ) -> CsMat<i8> {
-    // Row of every new cell: its parent, if it is a positive piece.
-    let mut parent = vec![(usize::MAX, 0i8); rows];
-    for i in 0..cols {
-        parent[i] = (i, eps_minus.get(i).copied().unwrap_or(1));
-        if let Some(&q) = plus.get(i) {
-            if q != usize::MAX {
-                parent[q] = (i, eps_plus[i]);
-            }
-        }
-    }
+    // Rows in order: old cells (their negative piece or themselves), the
+    // positive pieces in the order of their parents, then empty rows for the
+    // new cut cells.
     let mut indptr = Vec::with_capacity(rows + 1);
     let mut indices = Vec::with_capacity(rows);
     let mut data = Vec::with_capacity(rows);
     indptr.push(0);
-    for &(j, s) in &parent {
-        if j != usize::MAX {
-            indices.push(j);
-            data.push(s);
-        }
+    for i in 0..cols {
+        indices.push(i);
+        data.push(eps_minus.get(i).copied().unwrap_or(1));
         indptr.push(indices.len());
     }
+    for (i, &q) in plus.iter().enumerate() {
+        if q != usize::MAX {
+            indices.push(i);
+            data.push(eps_plus[i]);
+            indptr.push(indices.len());
+        }
+    }
+    indptr.resize(rows + 1, indices.len());
     CsMat::new((rows, cols), indptr, indices, data)
 }
 
@@ -763,4 +955,26 @@ fn nodal_matrix(old: usize, new: &[(usize, usize, f64)]) -> CsMat<f64> {
         indptr.push(indices.len());
     }
     CsMat::new((rows, old), indptr, indices, data)
+}
+
+/// Phase timings printed on stderr when `HASSE_SPLIT_PROFILE` is set (used
+/// by the `split_timing` example to attribute the cost of a SPLIT).
+struct Phases {
+    last: Option<std::time::Instant>,
+}
+
+impl Phases {
+    fn new() -> Self {
+        Self {
+            last: std::env::var_os("HASSE_SPLIT_PROFILE").map(|_| std::time::Instant::now()),
+        }
+    }
+
+    fn lap(&mut self, what: &str) {
+        if let Some(last) = self.last {
+            let now = std::time::Instant::now();
+            eprintln!("  split: {what:<28} {:8.3} s", (now - last).as_secs_f64());
+            self.last = Some(now);
+        }
+    }
 }
