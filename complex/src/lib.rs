@@ -25,6 +25,7 @@ pub mod gmsh;
 pub mod homology;
 pub mod json;
 pub mod lar;
+pub mod refine;
 pub mod split;
 pub mod tags;
 

@@ -66,7 +66,10 @@ fn thesis_triangle_beta0_then_beta1() {
         vec![0, 0, 1, -1],
     ];
     assert_eq!(dense(&transpose(&step1.boundaries[0])), delta0_1);
-    assert_eq!(dense(&transpose(&step1.boundaries[1])), vec![vec![-1, 1, 1, -1]]);
+    assert_eq!(
+        dense(&transpose(&step1.boundaries[1])),
+        vec![vec![-1, 1, 1, -1]]
+    );
     // C = [I | e1] of the thesis is ζ_1ᵀ.
     assert_eq!(
         dense(&transpose(&step1.zeta[1])),
@@ -101,7 +104,10 @@ fn thesis_triangle_beta0_then_beta1() {
     }
     // ∂ζ = ζ∂ for both steps.
     for (before, after) in [
-        (vec![transpose(&from_rows(delta0)), transpose(&from_rows(delta1))], &step1),
+        (
+            vec![transpose(&from_rows(delta0)), transpose(&from_rows(delta1))],
+            &step1,
+        ),
         (step1.boundaries.clone(), &step2),
     ] {
         for p in 1..=2 {
@@ -118,20 +124,34 @@ fn make_rejects_bad_selections() {
     let d1 = transpose(&from_rows(&[&[-1, 0, 1], &[-1, 1, 0], &[0, -1, 1]]));
     let d2 = transpose(&from_rows(&[&[-1, 1, 1]]));
     let b = [d1, d2];
-    assert!(matches!(make(&b, 3, 0, &[0]), Err(SplitError::DimensionOutOfRange { .. })));
-    assert!(matches!(make(&b, 2, 1, &[0]), Err(SplitError::CellOutOfRange { .. })));
+    assert!(matches!(
+        make(&b, 3, 0, &[0]),
+        Err(SplitError::DimensionOutOfRange { .. })
+    ));
+    assert!(matches!(
+        make(&b, 2, 1, &[0]),
+        Err(SplitError::CellOutOfRange { .. })
+    ));
     // Every facet, no facet, or a vertex that is not on the edge.
-    assert!(matches!(make(&b, 2, 0, &[0, 1, 2]), Err(SplitError::BadFacetSelection { .. })));
-    assert!(matches!(make(&b, 2, 0, &[]), Err(SplitError::BadFacetSelection { .. })));
-    assert!(matches!(make(&b, 1, 0, &[1]), Err(SplitError::BadFacetSelection { .. })));
+    assert!(matches!(
+        make(&b, 2, 0, &[0, 1, 2]),
+        Err(SplitError::BadFacetSelection { .. })
+    ));
+    assert!(matches!(
+        make(&b, 2, 0, &[]),
+        Err(SplitError::BadFacetSelection { .. })
+    ));
+    assert!(matches!(
+        make(&b, 1, 0, &[1]),
+        Err(SplitError::BadFacetSelection { .. })
+    ));
 }
 
 // ---------------------------------------------------------------- SPLIT
 
 use hasse_complex::generate::{box3, delaunay, kuhn, perturb, rectangle, uniform_axis};
 use hasse_complex::split::{
-    classification_step, split, split_cells, vertex_classes, Hyperplane, Refinement,
-    SplitOptions,
+    classification_step, split, split_cells, vertex_classes, Hyperplane, Refinement, SplitOptions,
 };
 use hasse_complex::{Complex, Lar, SplitError, TopCells, Vertices};
 
@@ -141,7 +161,10 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
     let n = coarse.dim();
     assert_eq!(fine.dim(), n);
     for p in 2..=n {
-        assert!(is_zero(&(fine.boundary(p - 1) * fine.boundary(p))), "∂∂ ≠ 0 at p = {p}");
+        assert!(
+            is_zero(&(fine.boundary(p - 1) * fine.boundary(p))),
+            "∂∂ ≠ 0 at p = {p}"
+        );
     }
     assert_eq!(fine.euler_characteristic(), coarse.euler_characteristic());
     assert_eq!(fine.betti_numbers(), coarse.betti_numbers());
@@ -156,7 +179,12 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
     for p in 1..=n {
         let (a, b) = (dense(fresh.boundary(p)), dense(fine.boundary(p)));
         for (i, (ra, rb)) in a.iter().zip(&b).enumerate() {
-            assert_eq!(ra, rb, "∂_{p} row {i} differs from from_lar ({:?})", fine.cell_vertices(p - 1, i));
+            assert_eq!(
+                ra,
+                rb,
+                "∂_{p} row {i} differs from from_lar ({:?})",
+                fine.cell_vertices(p - 1, i)
+            );
         }
         assert_eq!(a.len(), b.len());
     }
@@ -170,7 +198,10 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
             }
         }
         for (j, (&s, &m)) in sum.iter().zip(coarse.measure(p)).enumerate() {
-            assert!((s - m).abs() <= 1e-12 * m, "p = {p}, cell {j}: pieces {s} vs {m}");
+            assert!(
+                (s - m).abs() <= 1e-12 * m,
+                "p = {p}, cell {j}: pieces {s} vs {m}"
+            );
         }
         // ζ maps every coarse cell to at least one piece.
         assert!(r.zeta(p).to_csc().outer_iterator().all(|c| c.nnz() >= 1));
@@ -207,16 +238,23 @@ fn check_convex(k: &Complex, tol: f64) {
                 let h: f64 = (0..d)
                     .map(|a| (x[a] - centre[a]) * normals[f * d + a] * f64::from(s))
                     .sum();
-                assert!(h <= tol * scale, "cell {c} not convex at facet {f}: vertex {v} is {h} outside");
+                assert!(
+                    h <= tol * scale,
+                    "cell {c} not convex at facet {f}: vertex {v} is {h} outside"
+                );
             }
         }
     }
 }
 
 fn lcg(seed: u64) -> impl FnMut() -> f64 {
-    let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut state = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     }
 }
@@ -307,7 +345,10 @@ fn thesis_classification_chains() {
 #[test]
 fn square_split_by_hand() {
     let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
-    assert_eq!(dense(k.boundary(2)), vec![vec![1], vec![-1], vec![1], vec![-1]]);
+    assert_eq!(
+        dense(k.boundary(2)),
+        vec![vec![1], vec![-1], vec![1], vec![-1]]
+    );
     let h = Hyperplane::axis(2, 0, 0.25).unwrap();
     let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
     // Edges: 0 = {0,4} (neg half of e0), 1 = {0,2}, 2 = {1,3}, 3 = {2,5} (neg
@@ -315,7 +356,15 @@ fn square_split_by_hand() {
     let sets: Vec<Vec<usize>> = (0..7).map(|e| fine.cell_vertices(1, e).to_vec()).collect();
     assert_eq!(
         sets,
-        vec![vec![0, 4], vec![0, 2], vec![1, 3], vec![2, 5], vec![1, 4], vec![3, 5], vec![4, 5]]
+        vec![
+            vec![0, 4],
+            vec![0, 2],
+            vec![1, 3],
+            vec![2, 5],
+            vec![1, 4],
+            vec![3, 5],
+            vec![4, 5]
+        ]
     );
     assert_eq!(
         dense(fine.boundary(1)),
@@ -377,7 +426,13 @@ fn planes_through_vertices_and_along_faces_reuse_them() {
     assert_eq!(same.cell_counts(), g.cell_counts());
     assert_eq!(dense(r.zeta(2)), dense(&CsMat::eye(9)));
     let b = box3(2, 2, 2, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
-    let (same, _) = split(&b, &Hyperplane::axis(3, 2, 0.5).unwrap(), None, SplitOptions::default()).unwrap();
+    let (same, _) = split(
+        &b,
+        &Hyperplane::axis(3, 2, 0.5).unwrap(),
+        None,
+        SplitOptions::default(),
+    )
+    .unwrap();
     assert_eq!(same.cell_counts(), b.cell_counts());
     // A cube cut through the plane of four of its vertices (a diagonal
     // plane x = y): two prisms, no new vertex; the top and bottom squares
@@ -409,7 +464,11 @@ fn near_vertex_plane_snaps_and_exact_mode_keeps_slivers() {
     let h = Hyperplane::new(&[1.0, -1.0], -1e-9).unwrap();
     let (exact, r) = split(&k, &h, None, SplitOptions { snap: 0.0 }).unwrap();
     assert_eq!(exact.cell_counts(), vec![6, 7, 2]);
-    let shortest = exact.measure(1).iter().copied().fold(f64::INFINITY, f64::min);
+    let shortest = exact
+        .measure(1)
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min);
     assert!(shortest < 2e-9 && shortest > 0.0);
     check_split(&k, &exact, &r);
 }
@@ -433,30 +492,69 @@ fn restricted_split_leaves_neighbours_whole_with_a_hanging_vertex() {
 fn bad_input_is_reported() {
     let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
     let h3 = Hyperplane::axis(3, 0, 0.5).unwrap();
-    assert!(matches!(split(&k, &h3, None, SplitOptions::default()), Err(SplitError::PlaneDimension { .. })));
+    assert!(matches!(
+        split(&k, &h3, None, SplitOptions::default()),
+        Err(SplitError::PlaneDimension { .. })
+    ));
     let h = Hyperplane::axis(2, 0, 0.5).unwrap();
-    assert!(matches!(split(&k, &h, Some(&[3]), SplitOptions::default()), Err(SplitError::CellOutOfRange { .. })));
-    assert!(matches!(split(&k, &h, None, SplitOptions { snap: 0.5 }), Err(SplitError::BadTolerance(_))));
-    assert!(matches!(split(&k, &h, None, SplitOptions { snap: f64::NAN }), Err(SplitError::BadTolerance(_))));
-    assert!(matches!(Hyperplane::new(&[f64::NAN, 1.0], 0.0), Err(SplitError::BadNormal(_))));
-    assert!(matches!(Hyperplane::new(&[1.0, 1.0], f64::INFINITY), Err(SplitError::BadOffset(_))));
+    assert!(matches!(
+        split(&k, &h, Some(&[3]), SplitOptions::default()),
+        Err(SplitError::CellOutOfRange { .. })
+    ));
+    assert!(matches!(
+        split(&k, &h, None, SplitOptions { snap: 0.5 }),
+        Err(SplitError::BadTolerance(_))
+    ));
+    assert!(matches!(
+        split(&k, &h, None, SplitOptions { snap: f64::NAN }),
+        Err(SplitError::BadTolerance(_))
+    ));
+    assert!(matches!(
+        Hyperplane::new(&[f64::NAN, 1.0], 0.0),
+        Err(SplitError::BadNormal(_))
+    ));
+    assert!(matches!(
+        Hyperplane::new(&[1.0, 1.0], f64::INFINITY),
+        Err(SplitError::BadOffset(_))
+    ));
     let line = hasse_complex::generate::interval(3, 0.0, 1.0).unwrap();
     assert!(matches!(
-        split(&line, &Hyperplane::axis(1, 0, 0.5).unwrap(), None, SplitOptions::default()),
+        split(
+            &line,
+            &Hyperplane::axis(1, 0, 0.5).unwrap(),
+            None,
+            SplitOptions::default()
+        ),
         Err(SplitError::Unsupported { .. })
     ));
     let cuts = vec![(0, h.clone()), (0, h)];
     assert!(split_cells(&k, &cuts, SplitOptions::default()).is_err());
-    let (_, r) = split(&k, &Hyperplane::axis(2, 0, 0.5).unwrap(), None, SplitOptions::default()).unwrap();
-    assert!(matches!(r.intensive(2, &[1.0, 2.0]), Err(SplitError::LengthMismatch { .. })));
-    assert!(matches!(r.nodal(&[1.0]), Err(SplitError::LengthMismatch { .. })));
+    let (_, r) = split(
+        &k,
+        &Hyperplane::axis(2, 0, 0.5).unwrap(),
+        None,
+        SplitOptions::default(),
+    )
+    .unwrap();
+    assert!(matches!(
+        r.intensive(2, &[1.0, 2.0]),
+        Err(SplitError::LengthMismatch { .. })
+    ));
+    assert!(matches!(
+        r.nodal(&[1.0]),
+        Err(SplitError::LengthMismatch { .. })
+    ));
     assert!(r.compose(&r).is_err());
     let _ = Lar::from_vertex_sets; // the LAR type is part of the checked API
 }
 
 #[test]
 fn transfers_conserve_and_interpolate() {
-    let k = kuhn(&[uniform_axis(3, 0.0, 1.0).unwrap(), uniform_axis(2, 0.0, 1.0).unwrap()]).unwrap();
+    let k = kuhn(&[
+        uniform_axis(3, 0.0, 1.0).unwrap(),
+        uniform_axis(2, 0.0, 1.0).unwrap(),
+    ])
+    .unwrap();
     let h = Hyperplane::new(&[0.3, 0.9], 0.5).unwrap();
     let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
     check_split(&k, &fine, &r);
@@ -485,7 +583,9 @@ fn transfers_conserve_and_interpolate() {
     }
     // An affine nodal field is reproduced exactly at every new vertex.
     let f = |x: &[f64]| 2.0 * x[0] - 3.0 * x[1] + 0.5;
-    let coarse: Vec<f64> = (0..k.cell_count(0)).map(|v| f(k.vertices().point(v))).collect();
+    let coarse: Vec<f64> = (0..k.cell_count(0))
+        .map(|v| f(k.vertices().point(v)))
+        .collect();
     let fine_u = r.nodal(&coarse).unwrap();
     for (v, u) in fine_u.iter().enumerate() {
         assert!((u - f(fine.vertices().point(v))).abs() < 1e-13);
@@ -550,4 +650,161 @@ mod properties {
             check_split(&k, &fine2, &r.compose(&r2).unwrap());
         }
     }
+}
+
+// ------------------------------------------------------------ strategies
+
+use hasse_complex::refine::{
+    bisect_longest_edge, divide_longest_axis, divide_shortest_wall, dorfler_mark, refine_marked,
+    section_measure, uniform,
+};
+
+#[test]
+fn uniform_refinement_of_grids_and_simplices() {
+    // Quads: every child a quarter of its parent.
+    let k = rectangle(3, 2, [0.0, 3.0], [0.0, 1.0]).unwrap();
+    let (fine, r) = uniform(&k).unwrap();
+    assert_eq!(fine.cell_counts(), vec![7 * 5, 6 * 5 + 7 * 4, 24]);
+    assert!(fine.measure(2).iter().all(|&a| (a - 0.125).abs() < 1e-15));
+    check_split(&k, &fine, &r);
+    // Hexes: eight children of volume 1/8 each.
+    let b = box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let (fine, r) = uniform(&b).unwrap();
+    assert_eq!(fine.cell_counts(), vec![27, 54, 36, 8]);
+    assert!(fine.measure(3).iter().all(|&v| (v - 0.125).abs() < 1e-15));
+    check_split(&b, &fine, &r);
+    // Kuhn triangles and tetrahedra: convex polygons/polyhedra, conserved measure.
+    for k in [mesh(1, 0), mesh(5, 0), mesh(2, 7)] {
+        let (fine, r) = uniform(&k).unwrap();
+        check_split(&k, &fine, &r);
+        // Each parent got split along every axis its centroid planes cross.
+        assert!(fine.cell_count(k.dim()) > 2 * k.cell_count(k.dim()));
+    }
+    // A second uniform pass refines the result again.
+    let (once, r1) = uniform(&mesh(1, 0)).unwrap();
+    let (twice, r2) = uniform(&once).unwrap();
+    check_split(&mesh(1, 0), &twice, &r1.compose(&r2).unwrap());
+}
+
+#[test]
+fn per_cell_planes_that_conflict_are_split_in_later_passes() {
+    // Vertical centroid lines of the two Kuhn triangles of a square cut the
+    // shared diagonal at different points: the second cell waits for a
+    // second pass, and the result is still one consistent complex.
+    let x = uniform_axis(1, 0.0, 1.0).unwrap();
+    let k = kuhn(&[x.clone(), x]).unwrap();
+    let cuts: Vec<(usize, Hyperplane)> = (0..2)
+        .map(|c| {
+            (
+                c,
+                Hyperplane::through(k.centroid_of(2, c), &[1.0, 0.0]).unwrap(),
+            )
+        })
+        .collect();
+    let (fine, r) = split_cells(&k, &cuts, SplitOptions::default()).unwrap();
+    assert_eq!(fine.cell_count(2), 4);
+    // Two vertices on the diagonal, one on each horizontal side.
+    assert_eq!(fine.cell_count(0), 4 + 4);
+    check_split(&k, &fine, &r);
+}
+
+#[test]
+fn local_refinement_and_bisection() {
+    let k = rectangle(3, 3, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let (fine, r) = refine_marked(&k, &[4, 4, 0]).unwrap();
+    assert_eq!(fine.cell_count(2), 9 + 3 + 3);
+    check_split(&k, &fine, &r);
+    assert!(matches!(
+        refine_marked(&k, &[9]),
+        Err(SplitError::CellOutOfRange { .. })
+    ));
+    // Longest-edge bisection of every Kuhn triangle: the two triangles of
+    // each square bisect their shared diagonal at its midpoint, giving four
+    // right triangles of a quarter square each.
+    let x = uniform_axis(2, 0.0, 1.0).unwrap();
+    let t = kuhn(&[x.clone(), x]).unwrap();
+    let all: Vec<usize> = (0..t.cell_count(2)).collect();
+    let (fine, r) = bisect_longest_edge(&t, &all).unwrap();
+    assert_eq!(fine.cell_count(2), 16);
+    assert!((0..16).all(|c| fine.cell_vertices(2, c).len() == 3));
+    assert!(fine
+        .measure(2)
+        .iter()
+        .all(|&a| (a - 1.0 / 16.0).abs() < 1e-15));
+    check_split(&t, &fine, &r);
+    // Tetrahedra bisect into tetrahedra (neighbours may gain a vertex).
+    let t3 = mesh(5, 0);
+    let (fine, r) = bisect_longest_edge(&t3, &[0, 7, 20]).unwrap();
+    check_split(&t3, &fine, &r);
+}
+
+#[test]
+fn dorfler_marking_by_hand() {
+    // η² = 9, 1, 4, 0, 4: total 18.
+    let eta = [3.0, 1.0, 2.0, 0.0, 2.0];
+    assert_eq!(dorfler_mark(&eta, 0.5).unwrap(), vec![0]); // 9 ≥ 9
+    assert_eq!(dorfler_mark(&eta, 0.6).unwrap(), vec![0, 2]); // 13 ≥ 10.8 (tie 2 vs 4 by id)
+    assert_eq!(dorfler_mark(&eta, 0.95).unwrap(), vec![0, 2, 4, 1]); // 18 ≥ 17.1
+    assert_eq!(dorfler_mark(&eta, 1.0).unwrap(), vec![0, 2, 4, 1]);
+    assert_eq!(dorfler_mark(&[0.0, 0.0], 1.0).unwrap(), Vec::<usize>::new());
+    assert!(dorfler_mark(&eta, 1.5).is_err());
+    assert!(dorfler_mark(&[1.0, -1.0], 0.5).is_err());
+    assert!(dorfler_mark(&[f64::NAN], 0.5).is_err());
+}
+
+#[test]
+fn division_rules() {
+    // A 2 × 1 rectangle divides across its long axis into two unit squares.
+    let k = rectangle(1, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    for (fine, r) in [
+        divide_longest_axis(&k, &[0]).unwrap(),
+        divide_shortest_wall(&k, &[0], 12).unwrap(),
+    ] {
+        assert_eq!(fine.measure(2), &[1.0, 1.0]);
+        check_split(&k, &fine, &r);
+    }
+    // An oblique parallelogram (0,0) (4,1) (5,3) (1,2): deviations from the
+    // mean (2.5, 1.5) give the scatter matrix [[17, 6], [6, 5]], whose top
+    // eigenpair is λ = 11 + √72 with eigenvector ∝ (6, λ − 17). The wall is
+    // normal to it, and the halves have equal area (the centroid is a
+    // centre of symmetry).
+    let v = Vertices::from_points(&[[0.0, 0.0], [4.0, 1.0], [5.0, 3.0], [1.0, 2.0]]).unwrap();
+    let p = Complex::build(v, TopCells::polygons([[0, 1, 2, 3]])).unwrap();
+    let (fine, r) = divide_longest_axis(&p, &[0]).unwrap();
+    assert!((fine.measure(2)[0] - fine.measure(2)[1]).abs() < 1e-12);
+    let lambda = 11.0 + 72f64.sqrt();
+    let axis = [6.0, lambda - 17.0];
+    let wall = fine.cell_vertices(1, fine.cell_count(1) - 1);
+    let (a, b) = (
+        fine.vertices().point(wall[0]),
+        fine.vertices().point(wall[1]),
+    );
+    let along = (b[0] - a[0]) * axis[0] + (b[1] - a[1]) * axis[1];
+    assert!(
+        along.abs() < 1e-12,
+        "wall not normal to the long axis: {along}"
+    );
+    check_split(&p, &fine, &r);
+    // Shortest wall: no sampled direction gives a shorter section than the
+    // chosen cut.
+    let (fine, r) = divide_shortest_wall(&p, &[0], 90).unwrap();
+    check_split(&p, &fine, &r);
+    let wall = fine.measure(1)[fine.cell_count(1) - 1];
+    let centre = [2.5, 1.5, 0.0];
+    for k in 0..90 {
+        let a = std::f64::consts::PI * k as f64 / 90.0;
+        let s = section_measure(&p, 0, &centre, &[a.cos(), a.sin(), 0.0]);
+        assert!(wall <= s + 1e-12, "direction {k}: wall {wall} > {s}");
+    }
+    // 3D: a 1 × 1 × 3 box divides normal to z (both rules).
+    let b = box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 3.0]).unwrap();
+    for (fine, r) in [
+        divide_longest_axis(&b, &[0]).unwrap(),
+        divide_shortest_wall(&b, &[0], 200).unwrap(),
+    ] {
+        assert_eq!(fine.cell_count(3), 2);
+        assert!((fine.measure(3)[0] - 1.5).abs() < 1e-12);
+        check_split(&b, &fine, &r);
+    }
+    assert!(divide_shortest_wall(&b, &[0], 0).is_err());
 }

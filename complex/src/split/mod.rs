@@ -290,12 +290,7 @@ pub fn split_cells(
     }
     let mut current = round::round(complex, &pending, &planes, options.snap)?;
     while !current.deferred.is_empty() {
-        let next = round::round(
-            &current.complex,
-            &current.deferred,
-            &planes,
-            options.snap,
-        )?;
+        let next = round::round(&current.complex, &current.deferred, &planes, options.snap)?;
         current = round::Round {
             refinement: current.refinement.then(&next.refinement)?,
             complex: next.complex,
@@ -371,8 +366,16 @@ pub fn vertex_classes(
     if complex.dim() >= 1 {
         for e in 0..complex.cell_count(1) {
             let ends = complex.cell_vertices(1, e);
-            let (a, b) = (complex.vertices().point(ends[0]), complex.vertices().point(ends[1]));
-            let len = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+            let (a, b) = (
+                complex.vertices().point(ends[0]),
+                complex.vertices().point(ends[1]),
+            );
+            let len = a
+                .iter()
+                .zip(b)
+                .map(|(x, y)| (x - y) * (x - y))
+                .sum::<f64>()
+                .sqrt();
             shortest[ends[0]] = shortest[ends[0]].min(len);
             shortest[ends[1]] = shortest[ends[1]].min(len);
         }
@@ -380,7 +383,11 @@ pub fn vertex_classes(
     Ok((0..k0)
         .map(|v| {
             let dist = plane.distance(complex.vertices().point(v));
-            let eps = if shortest[v].is_finite() { snap * shortest[v] } else { 0.0 };
+            let eps = if shortest[v].is_finite() {
+                snap * shortest[v]
+            } else {
+                0.0
+            };
             if dist.abs() <= eps {
                 0
             } else if dist > 0.0 {

@@ -31,6 +31,9 @@ use std::ops::Range;
 
 const NONE: u32 = u32::MAX;
 
+/// A signed list of cells (a chain), sorted by cell id.
+type Chain = Vec<(usize, i8)>;
+
 pub(super) struct Round {
     pub complex: Complex,
     pub refinement: Refinement,
@@ -94,7 +97,8 @@ impl Level {
         self.rows.extend(other.rows);
         self.signs.extend(other.signs);
         let base = self.set.len();
-        self.set_ptr.extend(other.set_ptr[1..].iter().map(|&o| o + base));
+        self.set_ptr
+            .extend(other.set_ptr[1..].iter().map(|&o| o + base));
         self.set.extend(other.set);
     }
 }
@@ -221,7 +225,10 @@ pub(super) fn round(
     for e in 0..counts[1] {
         let ends = k.cell_vertices(1, e);
         let (a, b) = (ends[0], ends[1]);
-        let r = frame::sub(&frame::point(k.vertices(), a), &frame::point(k.vertices(), b));
+        let r = frame::sub(
+            &frame::point(k.vertices(), a),
+            &frame::point(k.vertices(), b),
+        );
         let len = frame::norm(&r);
         shortest[a] = shortest[a].min(len);
         shortest[b] = shortest[b].min(len);
@@ -290,7 +297,9 @@ pub(super) fn round(
     // New cell counts: k_p + (split p-cells) + (split (p+1)-cells, each cut by a new p-cell).
     let new_counts: Vec<usize> = (0..=n)
         .map(|p| {
-            counts[p] + if p >= 1 { split_count[p] } else { 0 } + split_count.get(p + 1).copied().unwrap_or(0)
+            counts[p]
+                + if p >= 1 { split_count[p] } else { 0 }
+                + split_count.get(p + 1).copied().unwrap_or(0)
         })
         .collect();
 
@@ -299,7 +308,14 @@ pub(super) fn round(
     // positive piece k1 + r, so chunks need no coordination.
     let edge_chunks: Vec<EdgeChunk> = (0..counts[1].div_ceil(CHUNK))
         .into_par_iter()
-        .map(|i| cut_edges(k, &cls, &splits[1], i * CHUNK..((i + 1) * CHUNK).min(counts[1])))
+        .map(|i| {
+            cut_edges(
+                k,
+                &cls,
+                &splits[1],
+                i * CHUNK..((i + 1) * CHUNK).min(counts[1]),
+            )
+        })
         .collect();
     let mut nodal: Vec<(usize, usize, f64)> = Vec::with_capacity(split_count[1]);
     let mut coords = Vec::with_capacity((k0 + split_count[1]) * d);
@@ -453,10 +469,16 @@ pub(super) fn round(
 /// its plane. Planes that differ in the last bits (centroids of a column of
 /// cells computed from different vertices) thus share their cuts.
 fn compatible(k: &Complex, cls: &Classifier, p: usize, i: usize, a: u32, b: u32) -> bool {
-    let (na, nb) = (&cls.planes[a as usize].normal, &cls.planes[b as usize].normal);
+    let (na, nb) = (
+        &cls.planes[a as usize].normal,
+        &cls.planes[b as usize].normal,
+    );
     let sigma = if frame::dot(na, nb) >= 0.0 { 1 } else { -1 };
     let verts = k.cell_vertices(p, i);
-    if verts.iter().any(|&v| cls.class(v, b) != sigma * cls.class(v, a)) {
+    if verts
+        .iter()
+        .any(|&v| cls.class(v, b) != sigma * cls.class(v, a))
+    {
         return false;
     }
     if p != 1 {
@@ -588,7 +610,11 @@ impl CellPass<'_> {
             if id == NONE {
                 if changed {
                     out.grown.push(c);
-                    union_sets(self.lower, scratch.column.iter().map(|x| x.0), &mut scratch.set);
+                    union_sets(
+                        self.lower,
+                        scratch.column.iter().map(|x| x.0),
+                        &mut scratch.set,
+                    );
                     out.main.push(&scratch.column, &scratch.set);
                 } else {
                     scratch.set.clear();
@@ -615,8 +641,20 @@ impl CellPass<'_> {
             let cut_index = self.cut_base + (self.here.plus[c] - self.first_plus);
             out.cuts.push(&pieces.cut_column, &pieces.cut_set);
             for (part, cut_sign, eps, level, set) in [
-                (&pieces.minus, pieces.cut_sign, pieces.eps_minus, 0, &pieces.minus_set),
-                (&pieces.plus, -pieces.cut_sign, pieces.eps_plus, 1, &pieces.plus_set),
+                (
+                    &pieces.minus,
+                    pieces.cut_sign,
+                    pieces.eps_minus,
+                    0,
+                    &pieces.minus_set,
+                ),
+                (
+                    &pieces.plus,
+                    -pieces.cut_sign,
+                    pieces.eps_plus,
+                    1,
+                    &pieces.plus_set,
+                ),
             ] {
                 side.clear();
                 side.extend(part.iter().map(|&(f, r)| (f, r * eps)));
@@ -664,7 +702,7 @@ fn collect_straddled(
             let (neg, pos) = cls.sides(k.cell_vertices(p - 1, f).iter().copied(), id);
             if neg && pos {
                 out.push((p - 1, f));
-                if p - 1 >= 2 {
+                if p > 2 {
                     stack.push((p - 1, f));
                 }
             }
@@ -840,7 +878,7 @@ fn cut_polygon(
     cut: &[usize],
     p: usize,
     c: usize,
-) -> Result<(Vec<(usize, i8)>, Vec<u32>), SplitError> {
+) -> Result<(Chain, Vec<u32>), SplitError> {
     let ambiguous = || SplitError::AmbiguousCut { dim: p, cell: c };
     let ends: Vec<[usize; 2]> = cut
         .iter()
