@@ -112,16 +112,19 @@ pub fn hasse_matrix(boundaries: &[CsMat<i8>]) -> CsMat<i8> {
 /// ```
 /// use hasse_complex::euler::make;
 /// use sprs::CsMat;
-/// // A square e0 + e1 − e2 − e3 over the path v0→v1→v2→v3→v0 ...
-/// let d1 = CsMat::new_csc((4, 4), vec![0, 2, 4, 6, 8], vec![0, 1, 1, 2, 3, 2, 0, 3],
-///                         vec![-1i8, 1, -1, 1, -1, 1, -1, 1]).to_csr();
-/// let d2 = CsMat::new_csc((4, 1), vec![0, 4], vec![0, 1, 2, 3], vec![1i8, 1, -1, -1]).to_csr();
-/// // ... split along the diagonal v0 v2: e2, e3 move to the new face.
+/// // A square ∂ = e0 + e1 + e2 + e3 around v0 → v1 → v2 → v3 → v0 ...
+/// let d1 = CsMat::new_csc((4, 4), vec![0, 2, 4, 6, 8], vec![0, 1, 1, 2, 2, 3, 0, 3],
+///                         vec![-1i8, 1, -1, 1, -1, 1, 1, -1]).to_csr();
+/// let d2 = CsMat::new_csc((4, 1), vec![0, 4], vec![0, 1, 2, 3], vec![1i8; 4]).to_csr();
+/// // ... split along the diagonal: e2, e3 move to the new face, whose
+/// // boundary runs v2 → v0, so the new edge is ∂(e2 + e3) = v0 − v2.
 /// let out = make(&[d1, d2], 2, 0, &[2, 3]).unwrap();
 /// let d1 = &out.boundaries[0];
 /// let d2 = &out.boundaries[1];
 /// assert_eq!(d2.shape(), (5, 2));
 /// assert!((d1 * d2).data().iter().all(|&x| x == 0));
+/// let e4: Vec<i8> = (0..4).map(|v| *d1.get(v, 4).unwrap_or(&0)).collect();
+/// assert_eq!(e4, vec![1, 0, -1, 0]);
 /// ```
 pub fn make(
     boundaries: &[CsMat<i8>],

@@ -132,16 +132,32 @@ impl Hyperplane {
     }
 
     /// Dimension of the space the plane lives in.
+    ///
+    /// ```
+    /// use hasse_complex::split::Hyperplane;
+    /// assert_eq!(Hyperplane::new(&[0.0, 0.0, 1.0], 2.0).unwrap().dim(), 3);
+    /// ```
     pub fn dim(&self) -> usize {
         self.dim
     }
 
-    /// Unit normal.
+    /// Unit normal (h / |h|).
+    ///
+    /// ```
+    /// use hasse_complex::split::Hyperplane;
+    /// assert_eq!(Hyperplane::new(&[3.0, 4.0], 1.0).unwrap().normal(), &[0.6, 0.8]);
+    /// ```
     pub fn normal(&self) -> &[f64] {
         &self.normal[..self.dim]
     }
 
     /// Signed distance (h·x − b)/|h| of a point (positive on the h side).
+    ///
+    /// ```
+    /// use hasse_complex::split::Hyperplane;
+    /// let h = Hyperplane::new(&[3.0, 4.0], 5.0).unwrap();
+    /// assert_eq!(h.distance(&[0.0, 0.0]), -1.0);
+    /// ```
     pub fn distance(&self, x: &[f64]) -> f64 {
         let mut s = -self.offset;
         for (h, x) in self.normal.iter().zip(x) {

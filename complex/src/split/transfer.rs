@@ -77,11 +77,29 @@ impl Refinement {
     }
 
     /// Top dimension n.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// assert_eq!(r.dim(), 2);
+    /// ```
     pub fn dim(&self) -> usize {
         self.zeta.len() - 1
     }
 
     /// ζ_p (refined p-cells × coarse p-cells, CSR).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// // The square maps to both halves, the bottom edge to itself.
+    /// assert_eq!(r.zeta(2).to_dense().as_slice().unwrap(), &[1, 1]);
+    /// assert_eq!(r.zeta(1).shape(), (fine.cell_count(1), 4));
+    /// ```
     ///
     /// # Panics
     /// When p > n.
@@ -90,11 +108,29 @@ impl Refinement {
     }
 
     /// The nodal interpolation matrix (refined vertices × coarse vertices).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// // Each new vertex is the midpoint of a vertical side: weights ½, ½.
+    /// let row = r.nodal_matrix().outer_view(4).unwrap();
+    /// assert_eq!(row.data(), &[0.5, 0.5]);
+    /// ```
     pub fn nodal_matrix(&self) -> &CsMat<f64> {
         &self.nodal
     }
 
     /// (coarse cell counts, refined cell counts).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// assert_eq!(r.counts(), (vec![4, 4, 1], fine.cell_counts()));
+    /// ```
     pub fn counts(&self) -> (Vec<usize>, Vec<usize>) {
         (
             self.zeta.iter().map(|z| z.cols()).collect(),
@@ -137,6 +173,16 @@ impl Refinement {
     }
 
     /// Alias of [`Refinement::compose`], reading left to right.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// let same = Refinement::identity(&k).then(&r).unwrap();
+    /// assert_eq!(same, r);
+    /// # use hasse_complex::split::Refinement;
+    /// ```
     pub fn then(&self, later: &Refinement) -> Result<Refinement, SplitError> {
         self.compose(later)
     }
@@ -176,6 +222,14 @@ impl Refinement {
 
     /// Intensive values (averages, densities) on coarse p-cells → refined
     /// p-cells: each piece gets ε × its parent's value; new cut cells get 0.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// assert_eq!(r.intensive(2, &[7.0]).unwrap(), vec![7.0, 7.0]);
+    /// ```
     pub fn intensive(&self, p: usize, coarse: &[f64]) -> Result<Vec<f64>, SplitError> {
         self.check(p, coarse, "intensive field")?;
         let z = &self.zeta[p];
@@ -192,6 +246,22 @@ impl Refinement {
     /// p-cells → refined p-cells: ε × value × |piece| / Σ|pieces|, so the
     /// pieces sum (with the signs of ζ) to the parent; new cut cells get 0.
     /// `fine` must be the refined complex (its measures are used).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// // A flux of 2 through the left side (edge 1, v0 → v2) splits 1 + 1
+    /// // between its halves; the upper half {2, 4} runs against its parent,
+    /// // so it stores −1, and ζᵀ adds the pieces back to 2.
+    /// let left = r.extensive(&fine, 1, &[0.0, 2.0, 0.0, 0.0]).unwrap();
+    /// let back: f64 = (0..fine.cell_count(1))
+    ///     .filter_map(|i| r.parent(1, i).map(|(_, s)| f64::from(s) * left[i]))
+    ///     .sum();
+    /// assert_eq!(back, 2.0);
+    /// assert_eq!(left.iter().filter(|&&x| x != 0.0).count(), 2);
+    /// ```
     pub fn extensive(
         &self,
         fine: &Complex,
@@ -227,6 +297,15 @@ impl Refinement {
 
     /// Nodal values → refined vertices by linear interpolation along the
     /// cut edges.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_complex::split::{split, Hyperplane};
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
+    /// // u = y: the midpoints of the vertical sides get ½.
+    /// assert_eq!(r.nodal(&[0.0, 0.0, 1.0, 1.0]).unwrap(), vec![0.0, 0.0, 1.0, 1.0, 0.5, 0.5]);
+    /// ```
     pub fn nodal(&self, coarse: &[f64]) -> Result<Vec<f64>, SplitError> {
         if coarse.len() != self.nodal.cols() {
             return Err(SplitError::LengthMismatch {
