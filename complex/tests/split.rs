@@ -649,6 +649,79 @@ mod properties {
             check_split(&fine, &fine2, &r2);
             check_split(&k, &fine2, &r.compose(&r2).unwrap());
         }
+
+        /// Planes through an existing vertex (and, in 2D, often along edges:
+        /// grid and Kuhn meshes have axis-aligned and diagonal edges).
+        #[test]
+        fn planes_through_vertices(
+            kind in 0usize..6,
+            seed in 0u64..1000,
+            vertex in 0usize..1000,
+            direction in 0usize..8,
+            a in 0.0f64..6.3,
+            b in 0.2f64..2.9,
+        ) {
+            let k = mesh(kind, seed);
+            let d = k.embedding_dim();
+            let v = vertex % k.cell_count(0);
+            // Half the cases use a grid-aligned or diagonal normal.
+            let normal: Vec<f64> = if direction < 4 {
+                let dirs: [[f64; 3]; 4] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 1.0]];
+                dirs[direction][..d].to_vec()
+            } else {
+                plane_from(d, a, b, 0.5).normal().to_vec()
+            };
+            let h = Hyperplane::through(k.vertices().point(v), &normal).unwrap();
+            let (fine, r) = split(&k, &h, None, SplitOptions::default()).unwrap();
+            check_split(&k, &fine, &r);
+            // The vertex itself is reused, never duplicated nearby.
+            let x = k.vertices().point(v);
+            for w in k.cell_count(0)..fine.cell_count(0) {
+                let y = fine.vertices().point(w);
+                let dist: f64 = x.iter().zip(y).map(|(p, q)| (p - q) * (p - q)).sum::<f64>().sqrt();
+                prop_assert!(dist > 1e-9);
+            }
+        }
+
+        /// A coarse snap tolerance in 2D: no new vertex closer to the plane's
+        /// crossing of an edge end than 10% of the shortest edge there.
+        #[test]
+        fn coarse_snap_avoids_slivers_in_2d(
+            kind in 0usize..4,
+            seed in 0u64..1000,
+            a in 0.0f64..6.3,
+            offset in 0.05f64..0.95,
+        ) {
+            let k = mesh(kind, seed);
+            let h = plane_from(2, a, 0.0, offset);
+            let snap = 0.1;
+            let (fine, r) = split(&k, &h, None, SplitOptions { snap }).unwrap();
+            check_split(&k, &fine, &r);
+            // Sliver bound: a new vertex is farther than snap × ℓ from both
+            // ends of its edge (ℓ = shortest coarse edge at that end).
+            let mut shortest = vec![f64::INFINITY; k.cell_count(0)];
+            for (e, len) in k.measure(1).iter().enumerate() {
+                for &v in k.cell_vertices(1, e) {
+                    shortest[v] = shortest[v].min(*len);
+                }
+            }
+            for (w, row) in r.nodal_matrix().outer_iterator().enumerate().skip(k.cell_count(0)) {
+                let y = fine.vertices().point(w);
+                for (v, _) in row.iter() {
+                    let x = k.vertices().point(v);
+                    let dist = ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2)).sqrt();
+                    prop_assert!(dist > snap * shortest[v], "sliver: {dist} at vertex {v}");
+                }
+            }
+            // Every old vertex within snap × (shortest edge) of the plane was
+            // reused: no new vertex sits on an edge at one of those.
+            let classes = vertex_classes(&k, &h, snap).unwrap();
+            for (w, row) in r.nodal_matrix().outer_iterator().enumerate().skip(k.cell_count(0)) {
+                for (v, _) in row.iter() {
+                    prop_assert!(classes[v] != 0, "new vertex {w} on an edge at snapped vertex {v}");
+                }
+            }
+        }
     }
 }
 
