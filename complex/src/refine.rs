@@ -138,6 +138,12 @@ pub fn bisect_longest_edge(
 ) -> Result<(Complex, Refinement), SplitError> {
     let n = complex.dim();
     let d = complex.embedding_dim();
+    if n != d || !(2..=3).contains(&n) {
+        return Err(SplitError::Unsupported {
+            dim: n,
+            embedding: d,
+        });
+    }
     check_cells(complex, cells)?;
     let point = |v: usize| padded(complex.vertices().point(v));
     let mut cuts = Vec::with_capacity(cells.len());
@@ -339,7 +345,7 @@ pub fn divide_shortest_wall(
         let centroid = padded(complex.centroid_of(n, c));
         let mut best = (f64::INFINITY, normals[0]);
         for normal in &normals {
-            let wall = section_measure(complex, c, &centroid, normal);
+            let wall = section_measure(complex, c, &centroid, normal)?;
             if wall < best.0 {
                 best = (wall, *normal);
             }
@@ -350,17 +356,29 @@ pub fn divide_shortest_wall(
 }
 
 /// Length (2D) or area (3D) of the section of convex top cell `c` by the
-/// plane through `point` with unit normal `normal`.
+/// plane through `point` with unit normal `normal` (coordinates padded to
+/// three components). Errors when `c` is not a top cell.
 ///
 /// ```
 /// use hasse_complex::generate::rectangle;
 /// use hasse_complex::refine::section_measure;
 /// let k = rectangle(1, 1, [0.0, 3.0], [0.0, 1.0]).unwrap();
-/// let across = section_measure(&k, 0, &[1.5, 0.5, 0.0], &[1.0, 0.0, 0.0]);
-/// let along = section_measure(&k, 0, &[1.5, 0.5, 0.0], &[0.0, 1.0, 0.0]);
+/// let across = section_measure(&k, 0, &[1.5, 0.5, 0.0], &[1.0, 0.0, 0.0]).unwrap();
+/// let along = section_measure(&k, 0, &[1.5, 0.5, 0.0], &[0.0, 1.0, 0.0]).unwrap();
+/// assert!(section_measure(&k, 1, &[0.0; 3], &[1.0, 0.0, 0.0]).is_err());
 /// assert!((across - 1.0).abs() < 1e-15 && (along - 3.0).abs() < 1e-15);
 /// ```
-pub fn section_measure(complex: &Complex, c: usize, point: &[f64; 3], normal: &[f64; 3]) -> f64 {
+pub fn section_measure(
+    complex: &Complex,
+    c: usize,
+    point: &[f64; 3],
+    normal: &[f64; 3],
+) -> Result<f64, SplitError> {
+    check_cells(complex, &[c])?;
+    Ok(section(complex, c, point, normal))
+}
+
+fn section(complex: &Complex, c: usize, point: &[f64; 3], normal: &[f64; 3]) -> f64 {
     let n = complex.dim();
     // Crossing points of the plane with the cell's edges.
     let mut points: Vec<[f64; 3]> = Vec::new();

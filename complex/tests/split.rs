@@ -866,7 +866,7 @@ fn division_rules() {
     let centre = [2.5, 1.5, 0.0];
     for k in 0..90 {
         let a = std::f64::consts::PI * k as f64 / 90.0;
-        let s = section_measure(&p, 0, &centre, &[a.cos(), a.sin(), 0.0]);
+        let s = section_measure(&p, 0, &centre, &[a.cos(), a.sin(), 0.0]).unwrap();
         assert!(wall <= s + 1e-12, "direction {k}: wall {wall} > {s}");
     }
     // 3D: a 1 × 1 × 3 box divides normal to z (both rules).
@@ -880,4 +880,13 @@ fn division_rules() {
         check_split(&b, &fine, &r);
     }
     assert!(divide_shortest_wall(&b, &[0], 0).is_err());
+    // Strategies refuse what SPLIT cannot do, without panicking.
+    let line = hasse_complex::generate::interval(2, 0.0, 1.0).unwrap();
+    assert!(matches!(
+        bisect_longest_edge(&line, &[0]),
+        Err(SplitError::Unsupported { .. })
+    ));
+    assert!(divide_longest_axis(&line, &[0]).is_err());
+    assert!(uniform(&line).is_err());
+    assert!(divide_longest_axis(&b, &[1]).is_err());
 }

@@ -277,6 +277,14 @@ pub(super) fn round(
         splits[n].plane[c] = id;
     }
     clock.lap("classify and accept");
+    if splits[n].plane.iter().all(|&x| x == NONE) {
+        // Nothing is crossed: the complex is its own refinement.
+        return Ok(Round {
+            complex: k.clone(),
+            refinement: Refinement::identity(k),
+            deferred,
+        });
+    }
     // Ranks: the positive piece of the r-th split p-cell is k_p + r.
     let split_count: Vec<usize> = splits
         .iter()
