@@ -3,8 +3,11 @@
 //! one plane per grid column (x = (i + ½)/n), then with one plane per cell
 //! built from its computed centroid. Run in release:
 //!
+//! A second argument m (default 50) adds the same experiment on an m × m × m
+//! hexahedral grid.
+//!
 //! ```text
-//! cargo run --release -p hasse-complex --example split_timing -- 1000
+//! cargo run --release -p hasse-complex --example split_timing -- 1000 50
 //! HASSE_SPLIT_PROFILE=1 cargo run --release -p hasse-complex --example split_timing
 //! ```
 //!
@@ -15,7 +18,7 @@
 //! number to compare, and with `RAYON_NUM_THREADS=1` it is the
 //! single-core cost.
 
-use hasse_complex::generate::rectangle;
+use hasse_complex::generate::{box3, rectangle};
 use hasse_complex::split::{split_cells, Hyperplane, SplitOptions};
 use std::time::Instant;
 
@@ -80,6 +83,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!(
         "SPLIT by one plane per cell (through its centroid): {:?} cells in {elapsed:.3} s wall, {}",
         fine.cell_counts(),
+        cpu_since(cpu)
+    );
+    drop(fine);
+
+    let m: usize = match std::env::args().nth(2) {
+        Some(arg) => arg.parse()?,
+        None => 50,
+    };
+    let start = Instant::now();
+    let cube = box3(m, m, m, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0])?;
+    println!(
+        "box {m}³: {:?} cells built in {:.3} s",
+        cube.cell_counts(),
+        start.elapsed().as_secs_f64()
+    );
+    let columns: Vec<Hyperplane> = (0..m)
+        .map(|i| Hyperplane::axis(3, 0, (i as f64 + 0.5) / m as f64))
+        .collect::<Result<_, _>>()?;
+    let cuts: Vec<(usize, Hyperplane)> = (0..cube.cell_count(3))
+        .map(|c| (c, columns[c % m].clone()))
+        .collect();
+    let start = Instant::now();
+    let cpu = cpu_seconds();
+    let (fine, _) = split_cells(&cube, &cuts, SplitOptions::default())?;
+    println!(
+        "SPLIT of every hex by its column plane: {:?} cells in {:.3} s wall, {}",
+        fine.cell_counts(),
+        start.elapsed().as_secs_f64(),
         cpu_since(cpu)
     );
     Ok(())
