@@ -782,6 +782,29 @@ fn per_cell_planes_that_conflict_are_split_in_later_passes() {
 }
 
 #[test]
+fn nearly_equal_planes_share_their_cuts() {
+    // Each cell of a column gets its own plane, off by a few ulps from its
+    // neighbours': shared horizontal edges are cut once, at one vertex.
+    let n = 4;
+    let k = rectangle(n, n, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let cuts: Vec<(usize, Hyperplane)> = (0..n * n)
+        .map(|c| {
+            let x = (c % n) as f64 / n as f64 + 0.5 / n as f64 + (c / n) as f64 * 1e-16;
+            (c, Hyperplane::axis(2, 0, x).unwrap())
+        })
+        .collect();
+    let (fine, r) = split_cells(&k, &cuts, SplitOptions::default()).unwrap();
+    assert_eq!(fine.cell_counts(), vec![25 + 20, 40 + 20 + 16, 32]);
+    check_split(&k, &fine, &r);
+    // With exact classification the planes are different planes: the same
+    // edges are cut, but only through later passes and no vertex is shared
+    // unless it lies exactly on both.
+    let (exact, r) = split_cells(&k, &cuts, SplitOptions { snap: 0.0 }).unwrap();
+    check_split(&k, &exact, &r);
+    assert_eq!(exact.cell_count(2), 32);
+}
+
+#[test]
 fn local_refinement_and_bisection() {
     let k = rectangle(3, 3, [0.0, 1.0], [0.0, 1.0]).unwrap();
     let (fine, r) = refine_marked(&k, &[4, 4, 0]).unwrap();

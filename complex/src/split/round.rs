@@ -271,8 +271,12 @@ pub(super) fn round(
             deferred.push((c, id));
             continue;
         }
+        // A compatible claim stays with the first plane: its cut point is the
+        // one the compatibility test measured against.
         for &(p, i) in &straddled {
-            splits[p].plane[i] = id;
+            if splits[p].plane[i] == NONE {
+                splits[p].plane[i] = id;
+            }
         }
         splits[n].plane[c] = id;
     }
