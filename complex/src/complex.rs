@@ -124,6 +124,26 @@ impl Complex {
         })
     }
 
+    /// A complex from parts that are already consistent (used by SPLIT,
+    /// which assembles ∂_p and the orientation flags cell by cell instead of
+    /// recomputing them from geometry).
+    pub(crate) fn from_parts(
+        lar: Lar,
+        boundaries: Vec<CsMat<i8>>,
+        top_orientation: Vec<i8>,
+        tags: Tags,
+    ) -> Self {
+        Self {
+            stars: (0..=lar.dim()).map(|_| OnceLock::new()).collect(),
+            lar,
+            boundaries,
+            top_orientation,
+            tags,
+            geometry: Default::default(),
+            dual: Default::default(),
+        }
+    }
+
     /// The same cells on moved vertices (e.g. a perturbed grid): orientation
     /// and geometry are recomputed, tags are kept.
     pub fn with_vertices(&self, vertices: Vertices) -> Result<Self> {

@@ -73,3 +73,47 @@ pub enum ComplexError {
 
 /// Shorthand used throughout the crate.
 pub type Result<T, E = ComplexError> = std::result::Result<T, E>;
+
+/// Why an Euler make operator, a SPLIT or a field transfer was refused.
+/// Each variant names the offending cell, plane or array.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SplitError {
+    #[error("cell dimension {p} is out of range for this operation: expected 1..={dim}")]
+    DimensionOutOfRange { p: usize, dim: usize },
+    #[error("{p}-cell {cell} does not exist (there are {count})")]
+    CellOutOfRange { p: usize, cell: usize, count: usize },
+    #[error("{p}-cell {cell}: {reason}")]
+    BadFacetSelection {
+        p: usize,
+        cell: usize,
+        reason: String,
+    },
+    #[error("the hyperplane normal {0:?} is zero or not finite")]
+    BadNormal(Vec<f64>),
+    #[error("the hyperplane offset {0} is not finite")]
+    BadOffset(f64),
+    #[error("the hyperplane has {found} normal components but the complex lives in R^{expected}")]
+    PlaneDimension { expected: usize, found: usize },
+    #[error("the snap tolerance {0} must be finite and in [0, 0.25)")]
+    BadTolerance(f64),
+    #[error("SPLIT needs a complex that fills its space (n = d = 2 or 3); this one has n = {dim} in R^{embedding}")]
+    Unsupported { dim: usize, embedding: usize },
+    #[error("{dim}-cell {cell} is cut ambiguously by the plane (its vertices on one side are not contiguous within the snap tolerance); use a smaller tolerance or move the plane")]
+    AmbiguousCut { dim: usize, cell: usize },
+    #[error("{what} has {found} values but there are {expected} {p}-cells")]
+    LengthMismatch {
+        what: &'static str,
+        p: usize,
+        expected: usize,
+        found: usize,
+    },
+    #[error("chain maps cannot be composed: the first refines to {first:?} cells, the second starts from {second:?}")]
+    Incompatible {
+        first: Vec<usize>,
+        second: Vec<usize>,
+    },
+    #[error("{0}")]
+    Invalid(String),
+    #[error(transparent)]
+    Complex(#[from] ComplexError),
+}

@@ -1,0 +1,505 @@
+//! Refinement strategies built on [`split_cells`]: uniform and local
+//! refinement, longest-edge bisection, Dörfler marking, and the division
+//! rules used for growing tissues (a cell divides through its centroid,
+//! normal to its longest axis, or along its shortest wall).
+//!
+//! Every strategy returns the refined complex and the composed
+//! [`Refinement`] (ζ for every dimension and the nodal interpolation), so
+//! fields move to the new complex with the transfers documented in
+//! [`crate::split`].
+//!
+//! ```
+//! use hasse_complex::generate::rectangle;
+//! use hasse_complex::refine::{dorfler_mark, refine_marked};
+//! let k = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+//! // Refine where an indicator is large.
+//! let eta: Vec<f64> = (0..16).map(|c| if c == 5 { 1.0 } else { 0.1 }).collect();
+//! let marked = dorfler_mark(&eta, 0.5).unwrap();
+//! assert_eq!(marked, vec![5]);
+//! let (fine, _) = refine_marked(&k, &marked).unwrap();
+//! assert_eq!(fine.cell_count(2), 16 + 3);
+//! ```
+
+use crate::complex::Complex;
+use crate::error::SplitError;
+use crate::split::{split_cells, Hyperplane, Refinement, SplitOptions};
+use nalgebra::{Matrix2, Matrix3, SymmetricEigen};
+
+/// Split each listed top cell by the d axis-aligned hyperplanes through its
+/// centroid (quads → 4 quads, hexes → 8 hexes, simplices → convex
+/// polygons/polyhedra). Each piece is cut by its *parent's* centroid
+/// planes, one axis after the other.
+fn centroid_planes(
+    complex: &Complex,
+    cells: &[usize],
+) -> Result<(Complex, Refinement), SplitError> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    check_cells(complex, cells)?;
+    let centroids: Vec<Vec<f64>> = cells
+        .iter()
+        .map(|&c| complex.centroid_of(n, c).to_vec())
+        .collect();
+    let mut current = complex.clone();
+    let mut total = Refinement::identity(complex);
+    // Pieces of cell c after each pass: the fine cells whose parent is c.
+    let mut owner: Vec<Option<usize>> = vec![None; complex.cell_count(n)];
+    for (k, &c) in cells.iter().enumerate() {
+        owner[c] = Some(k);
+    }
+    // One pass per axis: a piece created by the x cut is cut again by its
+    // parent's y plane in the next pass.
+    #[allow(clippy::needless_range_loop)]
+    for axis in 0..d {
+        let mut cuts = Vec::new();
+        for (j, o) in owner.iter().enumerate() {
+            if let Some(k) = *o {
+                cuts.push((j, Hyperplane::axis(d, axis, centroids[k][axis])?));
+            }
+        }
+        let (fine, r) = split_cells(&current, &cuts, SplitOptions::default())?;
+        owner = (0..fine.cell_count(n))
+            .map(|i| r.parent(n, i).and_then(|(j, _)| owner[j]))
+            .collect();
+        total = total.compose(&r)?;
+        current = fine;
+    }
+    Ok((current, total))
+}
+
+fn check_cells(complex: &Complex, cells: &[usize]) -> Result<(), SplitError> {
+    let n = complex.dim();
+    let count = complex.cell_count(n);
+    match cells.iter().find(|&&c| c >= count) {
+        Some(&cell) => Err(SplitError::CellOutOfRange { p: n, cell, count }),
+        None => Ok(()),
+    }
+}
+
+/// Uniform refinement: every top cell split by the axis-aligned hyperplanes
+/// through its centroid. Quads and hexes of an axis-aligned grid become 4
+/// or 8 equal children; simplices become convex polygons or polyhedra.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_complex::refine::uniform;
+/// let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let (fine, r) = uniform(&k).unwrap();
+/// assert_eq!(fine.cell_counts(), vec![25, 40, 16]);
+/// assert_eq!(r.zeta(2).nnz(), 16);
+/// ```
+pub fn uniform(complex: &Complex) -> Result<(Complex, Refinement), SplitError> {
+    let all: Vec<usize> = (0..complex.cell_count(complex.dim())).collect();
+    centroid_planes(complex, &all)
+}
+
+/// Local refinement: only the marked top cells are split (as in
+/// [`uniform`]); their neighbours keep their index and receive the new
+/// vertices on shared faces (hanging nodes are legal here: cells are
+/// convex polytopes, not fixed shapes).
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_complex::refine::refine_marked;
+/// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// let (fine, _) = refine_marked(&k, &[0]).unwrap();
+/// assert_eq!(fine.cell_count(2), 5);
+/// // The right square now has a vertex in the middle of its left side.
+/// assert_eq!(fine.cell_vertices(2, 1).len(), 5);
+/// ```
+pub fn refine_marked(
+    complex: &Complex,
+    marked: &[usize],
+) -> Result<(Complex, Refinement), SplitError> {
+    let mut cells = marked.to_vec();
+    cells.sort_unstable();
+    cells.dedup();
+    centroid_planes(complex, &cells)
+}
+
+/// Longest-edge bisection of the listed top cells: a simplex is cut through
+/// the midpoint of its longest edge and its vertices off that edge (so a
+/// triangle gives two triangles, a tetrahedron two tetrahedra); any other
+/// cell by the plane through that midpoint normal to the edge. Neighbours
+/// that share the bisected edge and bisect it too share the midpoint.
+///
+/// ```
+/// use hasse_complex::generate::{kuhn, uniform_axis};
+/// use hasse_complex::refine::bisect_longest_edge;
+/// let x = uniform_axis(1, 0.0, 1.0).unwrap();
+/// let k = kuhn(&[x.clone(), x]).unwrap(); // two triangles sharing the diagonal
+/// let (fine, _) = bisect_longest_edge(&k, &[0, 1]).unwrap();
+/// assert_eq!(fine.cell_counts(), vec![5, 8, 4]);
+/// assert!((0..4).all(|c| fine.cell_vertices(2, c).len() == 3));
+/// ```
+pub fn bisect_longest_edge(
+    complex: &Complex,
+    cells: &[usize],
+) -> Result<(Complex, Refinement), SplitError> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    if n != d || !(2..=3).contains(&n) {
+        return Err(SplitError::Unsupported {
+            dim: n,
+            embedding: d,
+        });
+    }
+    check_cells(complex, cells)?;
+    let point = |v: usize| padded(complex.vertices().point(v));
+    let mut cuts = Vec::with_capacity(cells.len());
+    for &c in cells {
+        let verts = complex.cell_vertices(n, c);
+        let (mut best, mut best_len) = ((verts[0], verts[0]), -1.0);
+        for (i, &a) in verts.iter().enumerate() {
+            for &b in &verts[i + 1..] {
+                let len = norm(&sub(&point(b), &point(a)));
+                if len > best_len && is_edge(complex, a, b) {
+                    (best, best_len) = ((a, b), len);
+                }
+            }
+        }
+        let (a, b) = best;
+        let mid: Vec<f64> = (0..d).map(|k| 0.5 * (point(a)[k] + point(b)[k])).collect();
+        let others: Vec<usize> = verts
+            .iter()
+            .copied()
+            .filter(|&v| v != a && v != b)
+            .collect();
+        let normal = if verts.len() == n + 1 {
+            // The plane spanned by the midpoint and the opposite vertices.
+            let m = padded(&mid);
+            match n {
+                2 => {
+                    let t = sub(&point(others[0]), &m);
+                    vec![-t[1], t[0]]
+                }
+                _ => {
+                    let u = sub(&point(others[0]), &m);
+                    let w = sub(&point(others[1]), &m);
+                    cross(&u, &w).to_vec()
+                }
+            }
+        } else {
+            sub(&point(b), &point(a))[..d].to_vec()
+        };
+        cuts.push((c, Hyperplane::through(&mid, &normal)?));
+    }
+    split_cells(complex, &cuts, SplitOptions::default())
+}
+
+fn is_edge(complex: &Complex, a: usize, b: usize) -> bool {
+    complex.find_cell(1, &[a, b]).is_some()
+}
+
+/// Dörfler (bulk) marking: the smallest set M of cells, taken in order of
+/// decreasing indicator, with Σ_{M} η² ≥ θ Σ η². Returns cell ids sorted by
+/// decreasing indicator (ties by id). `theta` must lie in (0, 1] and every
+/// indicator must be finite and non-negative.
+///
+/// ```
+/// use hasse_complex::refine::dorfler_mark;
+/// // η² = 9, 1, 4, 0 (total 14): half of it needs the first cell only.
+/// assert_eq!(dorfler_mark(&[3.0, 1.0, 2.0, 0.0], 0.5).unwrap(), vec![0]);
+/// assert_eq!(dorfler_mark(&[3.0, 1.0, 2.0, 0.0], 0.7).unwrap(), vec![0, 2]);
+/// assert!(dorfler_mark(&[1.0], 0.0).is_err());
+/// ```
+pub fn dorfler_mark(indicators: &[f64], theta: f64) -> Result<Vec<usize>, SplitError> {
+    if !(theta > 0.0 && theta <= 1.0) {
+        return Err(SplitError::Invalid(format!(
+            "Dörfler fraction θ = {theta} must lie in (0, 1]"
+        )));
+    }
+    if let Some(i) = indicators
+        .iter()
+        .position(|&e| !(e.is_finite() && e >= 0.0))
+    {
+        return Err(SplitError::Invalid(format!(
+            "indicator of cell {i} is {}, expected a finite value ≥ 0",
+            indicators[i]
+        )));
+    }
+    let mut order: Vec<usize> = (0..indicators.len()).collect();
+    order.sort_by(|&a, &b| indicators[b].total_cmp(&indicators[a]).then(a.cmp(&b)));
+    // Summed in the marking order, so that θ = 1 is reached exactly at the
+    // last non-zero indicator.
+    let total: f64 = order.iter().map(|&i| indicators[i] * indicators[i]).sum();
+    let goal = theta * total;
+    let mut acc = 0.0;
+    let mut marked = Vec::new();
+    for i in order {
+        if acc >= goal {
+            break;
+        }
+        acc += indicators[i] * indicators[i];
+        marked.push(i);
+    }
+    Ok(marked)
+}
+
+/// Division rule (a): each listed cell divides by the plane through its
+/// centroid normal to its longest axis — the principal axis of largest
+/// variance of its vertex cloud.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_complex::refine::divide_longest_axis;
+/// let k = rectangle(1, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// let (fine, _) = divide_longest_axis(&k, &[0]).unwrap();
+/// assert_eq!(fine.measure(2), &[1.0, 1.0]); // cut by x = 1
+/// ```
+pub fn divide_longest_axis(
+    complex: &Complex,
+    cells: &[usize],
+) -> Result<(Complex, Refinement), SplitError> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    check_cells(complex, cells)?;
+    let mut cuts = Vec::with_capacity(cells.len());
+    for &c in cells {
+        let verts = complex.cell_vertices(n, c);
+        let centroid = complex.centroid_of(n, c).to_vec();
+        let mut mean = [0.0; 3];
+        for &v in verts {
+            for (k, x) in complex.vertices().point(v).iter().enumerate() {
+                mean[k] += x / verts.len() as f64;
+            }
+        }
+        let mut cov = [[0.0; 3]; 3];
+        for &v in verts {
+            let x = complex.vertices().point(v);
+            for i in 0..d {
+                for j in 0..d {
+                    cov[i][j] += (x[i] - mean[i]) * (x[j] - mean[j]);
+                }
+            }
+        }
+        let axis = principal_axis(d, &cov);
+        cuts.push((c, Hyperplane::through(&centroid, &axis)?));
+    }
+    split_cells(complex, &cuts, SplitOptions::default())
+}
+
+/// Eigenvector of the largest eigenvalue of the leading d × d block.
+fn principal_axis(d: usize, cov: &[[f64; 3]; 3]) -> Vec<f64> {
+    if d == 2 {
+        let m = Matrix2::new(cov[0][0], cov[0][1], cov[1][0], cov[1][1]);
+        let e = SymmetricEigen::new(m);
+        let k = e.eigenvalues.imax();
+        e.eigenvectors.column(k).iter().copied().collect()
+    } else {
+        let m = Matrix3::from_fn(|i, j| cov[i][j]);
+        let e = SymmetricEigen::new(m);
+        let k = e.eigenvalues.imax();
+        e.eigenvectors.column(k).iter().copied().collect()
+    }
+}
+
+/// Division rule (b): each listed cell divides by the plane through its
+/// centroid whose wall (the section of the cell) is smallest, searched over
+/// `directions` normals: equally spaced angles in [0, π) in 2D, a
+/// Fibonacci half-sphere in 3D. Returns an error when `directions` is 0.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_complex::refine::divide_shortest_wall;
+/// let k = rectangle(1, 1, [0.0, 3.0], [0.0, 1.0]).unwrap();
+/// let (fine, _) = divide_shortest_wall(&k, &[0], 36).unwrap();
+/// // The shortest wall through the centre is the vertical one, length 1.
+/// assert_eq!(fine.measure(2), &[1.5, 1.5]);
+/// ```
+pub fn divide_shortest_wall(
+    complex: &Complex,
+    cells: &[usize],
+    directions: usize,
+) -> Result<(Complex, Refinement), SplitError> {
+    if directions == 0 {
+        return Err(SplitError::Invalid(
+            "the shortest-wall search needs at least one direction".into(),
+        ));
+    }
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    if n != d || !(2..=3).contains(&n) {
+        return Err(SplitError::Unsupported {
+            dim: n,
+            embedding: d,
+        });
+    }
+    check_cells(complex, cells)?;
+    let normals: Vec<[f64; 3]> = (0..directions)
+        .map(|k| {
+            if d == 2 {
+                let a = std::f64::consts::PI * k as f64 / directions as f64;
+                [a.cos(), a.sin(), 0.0]
+            } else {
+                // Fibonacci points on the upper half-sphere (z ≥ 0).
+                let z = 1.0 - (k as f64 + 0.5) / directions as f64;
+                let r = (1.0 - z * z).sqrt();
+                let phi = k as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+                [r * phi.cos(), r * phi.sin(), z]
+            }
+        })
+        .collect();
+    let mut cuts = Vec::with_capacity(cells.len());
+    for &c in cells {
+        let centroid = padded(complex.centroid_of(n, c));
+        let mut best = (f64::INFINITY, normals[0]);
+        for normal in &normals {
+            let wall = section_measure(complex, c, &centroid, normal)?;
+            if wall < best.0 {
+                best = (wall, *normal);
+            }
+        }
+        cuts.push((c, Hyperplane::through(&centroid[..d], &best.1[..d])?));
+    }
+    split_cells(complex, &cuts, SplitOptions::default())
+}
+
+/// Length (2D) or area (3D) of the section of convex top cell `c` by the
+/// plane through `point` with unit normal `normal` (coordinates padded to
+/// three components). Errors when `c` is not a top cell.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_complex::refine::section_measure;
+/// let k = rectangle(1, 1, [0.0, 3.0], [0.0, 1.0]).unwrap();
+/// let across = section_measure(&k, 0, &[1.5, 0.5, 0.0], &[1.0, 0.0, 0.0]).unwrap();
+/// let along = section_measure(&k, 0, &[1.5, 0.5, 0.0], &[0.0, 1.0, 0.0]).unwrap();
+/// assert!(section_measure(&k, 1, &[0.0; 3], &[1.0, 0.0, 0.0]).is_err());
+/// assert!((across - 1.0).abs() < 1e-15 && (along - 3.0).abs() < 1e-15);
+/// ```
+pub fn section_measure(
+    complex: &Complex,
+    c: usize,
+    point: &[f64; 3],
+    normal: &[f64; 3],
+) -> Result<f64, SplitError> {
+    check_cells(complex, &[c])?;
+    Ok(section(complex, c, point, normal))
+}
+
+fn section(complex: &Complex, c: usize, point: &[f64; 3], normal: &[f64; 3]) -> f64 {
+    let n = complex.dim();
+    // Crossing points of the plane with the cell's edges.
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    let dist = |x: &[f64; 3]| dot(&sub(x, point), normal);
+    let edges = cell_edges(complex, c);
+    for (a, b) in edges {
+        let (xa, xb) = (
+            padded(complex.vertices().point(a)),
+            padded(complex.vertices().point(b)),
+        );
+        let (da, db) = (dist(&xa), dist(&xb));
+        if (da <= 0.0 && db >= 0.0) || (da >= 0.0 && db <= 0.0) {
+            let t = if da == db { 0.0 } else { da / (da - db) };
+            points.push([
+                xa[0] + t * (xb[0] - xa[0]),
+                xa[1] + t * (xb[1] - xa[1]),
+                xa[2] + t * (xb[2] - xa[2]),
+            ]);
+        }
+    }
+    if points.len() < 2 {
+        return 0.0;
+    }
+    if n == 2 {
+        let mut longest: f64 = 0.0;
+        for (i, a) in points.iter().enumerate() {
+            for b in &points[i + 1..] {
+                longest = longest.max(norm(&sub(b, a)));
+            }
+        }
+        return longest;
+    }
+    // 3D: the section is a convex polygon; order its points by angle about
+    // their mean in the plane and sum the fan.
+    let mut mean = [0.0; 3];
+    for x in &points {
+        for k in 0..3 {
+            mean[k] += x[k] / points.len() as f64;
+        }
+    }
+    let helper = if normal[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let u = unit(&cross(normal, &helper));
+    let w = cross(normal, &u);
+    let mut angled: Vec<(f64, [f64; 3])> = points
+        .iter()
+        .map(|x| {
+            let r = sub(x, &mean);
+            (dot(&r, &w).atan2(dot(&r, &u)), *x)
+        })
+        .collect();
+    angled.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut area = 0.0;
+    for i in 0..angled.len() {
+        let a = sub(&angled[i].1, &mean);
+        let b = sub(&angled[(i + 1) % angled.len()].1, &mean);
+        area += 0.5 * dot(&cross(&a, &b), normal);
+    }
+    area.abs()
+}
+
+/// The edges (as vertex pairs) of top cell `c`, read from the boundary
+/// matrices.
+fn cell_edges(complex: &Complex, c: usize) -> Vec<(usize, usize)> {
+    let n = complex.dim();
+    let mut cells = vec![c];
+    for p in (2..=n).rev() {
+        let csc = complex.boundary_csc(p);
+        let mut next: Vec<usize> = cells
+            .iter()
+            .flat_map(|&j| {
+                csc.outer_view(j)
+                    .map(|v| v.indices().to_vec())
+                    .unwrap_or_default()
+            })
+            .collect();
+        next.sort_unstable();
+        next.dedup();
+        cells = next;
+    }
+    cells
+        .into_iter()
+        .map(|e| {
+            let v = complex.cell_vertices(1, e);
+            (v[0], v[1])
+        })
+        .collect()
+}
+
+fn padded(x: &[f64]) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (o, v) in out.iter_mut().zip(x) {
+        *o = *v;
+    }
+    out
+}
+
+fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn norm(a: &[f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+
+fn unit(a: &[f64; 3]) -> [f64; 3] {
+    let l = norm(a);
+    [a[0] / l, a[1] / l, a[2] / l]
+}
+
+fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
