@@ -468,3 +468,20 @@ fn voronoi_virtual_elements() {
     let (stdout, _) = run_case("cases/voronoi.toml", &[], "voronoi");
     assert!(reported(&stdout, "error", "L2") < 3e-3, "{stdout}");
 }
+
+#[test]
+fn refinement_cases_run_as_shipped() {
+    // l-shape-adaptive: 8 Dörfler steps, the last with 2136 cells and
+    // gradient error 3.9e-3 (tests/refinement.rs compares with uniform).
+    let (stdout, _) = run_case("cases/l-shape-adaptive.toml", &[], "l-shape-adaptive");
+    let rows: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.starts_with("           "))
+        .collect();
+    assert_eq!(rows.len(), 9, "{stdout}");
+    assert!(reported(&stdout, "error", "gradient L2") < 5e-3, "{stdout}");
+    // tissue-growth: 50 cells dividing six times.
+    let (stdout, stem) = run_case("cases/tissue-growth.toml", &[], "tissue");
+    assert!(stdout.contains("[6402, 9601, 3200]"), "{stdout}");
+    assert_eq!(read(&stem, "u").len(), 3200);
+}

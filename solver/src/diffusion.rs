@@ -23,6 +23,7 @@
 //! = 0 up to quadrature error), and the solution with zero mean is returned.
 
 use crate::canonical::{BlockMetric, Canonical, CanonicalError};
+use crate::iterative::{conjugate_gradient, CgError, CgOptions, CgReport};
 use crate::linear::{self, Factorization, SolveError, SolveReport};
 use crate::metric::{self, dec, fd, fe, fv, MetricError, Tensor};
 use faer::sparse::{SparseColMat, Triplet};
@@ -155,6 +156,18 @@ pub struct Diffusion {
     /// Largest relative imbalance Σ b / Σ |b| accepted for pure-Neumann data
     /// (quadrature makes consistent data slightly incompatible).
     pub neumann_tolerance: f64,
+    /// Solve by Jacobi-preconditioned conjugate gradients instead of a
+    /// factorisation (SPD systems), optionally from an initial guess.
+    pub iterative: Option<Iterative>,
+}
+
+/// Settings of an iterative solve.
+#[derive(Clone, Debug, Default)]
+pub struct Iterative {
+    pub options: CgOptions,
+    /// A guess for every unknown (fixed ones are ignored), e.g. a coarse
+    /// solution transferred to a refined mesh.
+    pub initial: Option<Vec<f64>>,
 }
 
 /// Why a problem could not be solved.
@@ -197,6 +210,8 @@ pub enum DiffusionError {
     Canonical(#[from] CanonicalError),
     #[error(transparent)]
     Solve(#[from] SolveError),
+    #[error(transparent)]
+    Iterative(#[from] CgError),
 }
 
 /// The discrete solution and how it was obtained.
@@ -218,6 +233,8 @@ pub struct Solution {
     /// The points whose exact values the cell values approximate (stride d),
     /// when they are not the centroids (see [`CellPoints`]).
     pub cell_points: Option<Vec<f64>>,
+    /// Iterations and residuals when solved iteratively.
+    pub iterations: Option<CgReport>,
 }
 
 impl Solution {
@@ -277,6 +294,7 @@ impl Diffusion {
             factorization: Factorization::Llt,
             cell_points: CellPoints::Centroids,
             neumann_tolerance: 1e-2,
+            iterative: None,
         }
     }
 
@@ -611,7 +629,13 @@ impl Diffusion {
             fixed[0] = Some(0.0);
         }
 
-        let (mut values, report) = solve_with_fixed(&matrix, &rhs, &fixed, self.factorization)?;
+        let (mut values, report, iterations) = solve_with_fixed(
+            &matrix,
+            &rhs,
+            &fixed,
+            self.factorization,
+            self.iterative.as_ref(),
+        )?;
         if pure_neumann {
             let weights = self.mean_weights(complex, location, unknowns);
             let wsum: f64 = weights.iter().sum();
@@ -635,6 +659,7 @@ impl Diffusion {
             values,
             flux,
             report,
+            iterations,
             assembly_seconds,
             pure_neumann,
             neumann_imbalance,
@@ -746,14 +771,18 @@ pub fn lumped_vertex_volumes(complex: &Complex) -> Vec<f64> {
     w
 }
 
-/// Solve M u = b with some unknowns fixed, by symmetric elimination:
-/// M_FF u_F = b_F − M_FD u_D.
+/// Solve M u = b with the unknowns in `fixed` held at their values: the
+/// fixed columns move to the right-hand side and the fixed rows are
+/// dropped, so the reduced system stays symmetric (positive definite when
+/// M is). Directly by `factorization`, or by conjugate gradients when
+/// `iterative` is given (its initial guess restricted to the free unknowns).
 pub fn solve_with_fixed(
     matrix: &SparseColMat<usize, f64>,
     rhs: &[f64],
     fixed: &[Option<f64>],
     factorization: Factorization,
-) -> Result<(Vec<f64>, SolveReport), DiffusionError> {
+    iterative: Option<&Iterative>,
+) -> Result<(Vec<f64>, SolveReport, Option<CgReport>), DiffusionError> {
     let n = rhs.len();
     let mut free_index = vec![usize::MAX; n];
     let mut free = Vec::new();
@@ -790,15 +819,39 @@ pub fn solve_with_fixed(
             solve_seconds: 0.0,
             relative_residual: 0.0,
         };
-        return Ok((values, report));
+        return Ok((values, report, None));
     }
     let reduced = SparseColMat::try_new_from_triplets(free.len(), free.len(), &triplets)
         .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
-    let (x, report) = linear::solve(&reduced, &reduced_rhs, factorization)?;
+    let (x, report, iterations) = match iterative {
+        None => {
+            let (x, report) = linear::solve(&reduced, &reduced_rhs, factorization)?;
+            (x, report, None)
+        }
+        Some(settings) => {
+            let guess: Option<Vec<f64>> = settings.initial.as_ref().map(|all| {
+                free.iter()
+                    .map(|&i| all.get(i).copied().unwrap_or(0.0))
+                    .collect()
+            });
+            let (x, cg) =
+                conjugate_gradient(&reduced, &reduced_rhs, guess.as_deref(), &settings.options)?;
+            let report = SolveReport {
+                factorization,
+                unknowns: free.len(),
+                nonzeros: reduced.compute_nnz(),
+                symbolic_seconds: 0.0,
+                numeric_seconds: 0.0,
+                solve_seconds: cg.seconds,
+                relative_residual: cg.relative_residual,
+            };
+            (x, report, Some(cg))
+        }
+    };
     for (k, &i) in free.iter().enumerate() {
         values[i] = x[k];
     }
-    Ok((values, report))
+    Ok((values, report, iterations))
 }
 
 /// Cell-wise gradient of a discrete field, by least squares over the

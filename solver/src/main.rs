@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use hasse_solver::case::{Case, CaseError};
-use hasse_solver::{info, mesh_spec, run};
+use hasse_solver::{info, mesh_spec, refinement, run};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -35,6 +35,42 @@ enum Command {
         #[arg(short, long, value_name = "OUT")]
         output: Option<PathBuf>,
         /// Override a case key, e.g. --set problem.method=fv (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Print only errors.
+        #[arg(short, long, conflicts_with = "verbose")]
+        quiet: bool,
+        /// Print each phase as it starts.
+        #[arg(short, long)]
+        verbose: bool,
+    },
+    /// Solve a case, refine its mesh by SPLIT and solve again, step by step.
+    ///
+    /// Each step refines (uniform: every cell by axis-aligned planes through
+    /// its centroid; adaptive: the cells holding the fraction θ of the error
+    /// indicator; divide-longest-axis / divide-shortest-wall: tissue
+    /// division rules), moves the solution to the refined mesh through the
+    /// chain map, and re-solves by conjugate gradients from zero and from
+    /// the transferred solution (the table shows both iteration counts).
+    /// Options override the case's [refine] table. Output: the final mesh.
+    ///
+    /// Example: hasse refine cases/l-shape-adaptive.toml --steps 4
+    Refine {
+        /// The case file (.toml).
+        case: PathBuf,
+        /// Number of refinement steps.
+        #[arg(long)]
+        steps: Option<usize>,
+        /// uniform | adaptive | divide-longest-axis | divide-shortest-wall.
+        #[arg(long)]
+        strategy: Option<String>,
+        /// Dörfler fraction for the adaptive strategy (0 < θ ≤ 1).
+        #[arg(long)]
+        theta: Option<f64>,
+        /// Output stem (as for `run`).
+        #[arg(short, long, value_name = "OUT")]
+        output: Option<PathBuf>,
+        /// Override a case key, as for `run`.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
         /// Print only errors.
@@ -115,6 +151,40 @@ fn main() -> ExitCode {
             verbose,
         } => run_case(&case, output.as_deref(), &set, quiet, verbose),
         Command::Check { case, set } => check_case(&case, &set),
+        Command::Refine {
+            case,
+            steps,
+            strategy,
+            theta,
+            output,
+            mut set,
+            quiet,
+            verbose,
+        } => {
+            // The options are overrides of the [refine] table, checked with it.
+            if let Some(n) = steps {
+                set.push(format!("refine.steps={n}"));
+            }
+            if let Some(s) = strategy {
+                set.push(format!("refine.strategy=\"{s}\""));
+            }
+            if let Some(t) = theta {
+                set.push(format!("refine.theta={t:?}"));
+            }
+            let case_path = case;
+            let case = match read_case(&case_path, &set) {
+                Ok(case) => case,
+                Err(code) => return code,
+            };
+            if case.refine.is_none() {
+                eprintln!(
+                    "error: {}: no [refine] table: add one (strategy, steps) or pass --steps N",
+                    case_path.display()
+                );
+                return ExitCode::from(EXIT_BAD_INPUT);
+            }
+            run_case(&case_path, output.as_deref(), &set, quiet, verbose)
+        }
         Command::Info {
             mesh,
             betti,
@@ -253,7 +323,22 @@ fn run_case(
         }
     };
     let mesh_seconds = mesh_started.elapsed().as_secs_f64();
-    let result = run::solve(&case, &complex, &mut |name| progress.phase(name));
+    // With a [refine] table the case is solved, refined and re-solved; the
+    // output holds the final mesh and its solution.
+    let (complex, study, result) = match &case.refine {
+        None => {
+            let result = run::solve(&case, &complex, &mut |name| progress.phase(name));
+            (complex, None, result)
+        }
+        Some(spec) => {
+            match refinement::refine_and_solve(&case, &complex, spec, &mut |name| {
+                progress.phase(name)
+            }) {
+                Ok(study) => (study.complex, Some(study.steps), Ok(study.result)),
+                Err(e) => (complex, None, Err(e)),
+            }
+        }
+    };
     let mut result = match result {
         Ok(result) => result,
         Err(e) => {
@@ -296,6 +381,12 @@ fn run_case(
             complex_kind(&complex),
             complex.cell_counts()
         );
+        if let Some(steps) = &study {
+            println!("refinement {}", refinement::TABLE_HEADER);
+            for step in steps {
+                println!("           {step}");
+            }
+        }
         print!("{result}");
         if let Some(files) = written {
             let mut names = vec![files.hdf5.display().to_string()];

@@ -85,7 +85,7 @@ impl RunError {
     }
 }
 
-fn scalar_fn(e: &crate::case::expr::Expression) -> ScalarFn {
+pub(crate) fn scalar_fn(e: &crate::case::expr::Expression) -> ScalarFn {
     let e = e.clone();
     Arc::new(move |x: &[f64]| e.eval(x, 0.0))
 }
@@ -103,7 +103,19 @@ pub fn solve(
     }
 }
 
-fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
+/// ∇u from one expression per coordinate.
+pub(crate) fn vector_fn(components: &[crate::case::expr::Expression]) -> VectorFn {
+    let g = components.to_vec();
+    Arc::new(move |x: &[f64]| {
+        let mut v = [0.0; 3];
+        for (slot, e) in v.iter_mut().zip(&g) {
+            *slot = e.eval(x, 0.0);
+        }
+        v
+    })
+}
+
+pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
     let conductivity = match &spec.conductivity {
         Coefficient::Scalar(e) => Conductivity::Scalar(scalar_fn(e)),
         Coefficient::Tensor(rows) => {
@@ -142,7 +154,10 @@ fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
 }
 
 fn is_input_error(e: &DiffusionError) -> bool {
-    !matches!(e, DiffusionError::Solve(_) | DiffusionError::Canonical(_))
+    !matches!(
+        e,
+        DiffusionError::Solve(_) | DiffusionError::Canonical(_) | DiffusionError::Iterative(_)
+    )
 }
 
 fn solve_diffusion(
@@ -248,17 +263,7 @@ fn solve_diffusion(
         None => (None, None),
         Some(exact) => {
             let u = scalar_fn(&exact.solution);
-            let grad: Option<VectorFn> = exact.gradient.as_ref().map(|g| {
-                let g = g.clone();
-                let f: VectorFn = Arc::new(move |x: &[f64]| {
-                    let mut v = [0.0; 3];
-                    for (i, e) in g.iter().enumerate() {
-                        v[i] = e.eval(x, 0.0);
-                    }
-                    v
-                });
-                f
-            });
+            let grad: Option<VectorFn> = exact.gradient.as_ref().map(|g| vector_fn(g));
             let errors = diffusion::errors(complex, &solution, &u, grad.as_ref());
             let flux_error = grad
                 .as_ref()

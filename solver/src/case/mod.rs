@@ -173,6 +173,8 @@ pub struct Case {
     pub exact: Option<ExactSpec>,
     pub solver: SolverSpec,
     pub output: OutputSpec,
+    /// SPLIT refinement steps after the first solve, if any.
+    pub refine: Option<crate::refinement::RefineSpec>,
     /// Keeps spans for messages found after reading (mesh problems).
     collector: Collector,
     mesh_spans: BTreeMap<String, Range<usize>>,

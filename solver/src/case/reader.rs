@@ -11,6 +11,7 @@ use super::{
 use crate::diffusion::Method;
 use crate::linear::Factorization;
 use crate::mesh_spec::MeshSpec;
+use crate::refinement::{RefineSpec, Strategy};
 use hasse_complex::DualKind;
 use std::collections::BTreeMap;
 use std::ops::Range;
@@ -28,6 +29,7 @@ const TOP_KEYS: &[&str] = &[
     "exact",
     "solver",
     "output",
+    "refine",
 ];
 const MESH_KEYS: &[&str] = &[
     "generator",
@@ -67,6 +69,13 @@ const SOLVER_KEYS: &[&str] = &[
     "residual_limit",
 ];
 const OUTPUT_KEYS: &[&str] = &["directory", "name", "write"];
+const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "tolerance"];
+const STRATEGIES: &[&str] = &[
+    "uniform",
+    "adaptive",
+    "divide-longest-axis",
+    "divide-shortest-wall",
+];
 const METRIC_KEYS: &[&str] = &["type", "value", "file", "scale"];
 const METHODS: &[&str] = &["fd", "fe", "fv", "fv-mimetic", "dec", "dec-barycentric"];
 
@@ -202,6 +211,7 @@ impl Reader {
         let exact = reader.exact(root, &scope);
         let solver = reader.solver(root);
         let output = reader.output(root);
+        let refine = reader.refine(root);
 
         if !reader.collector.diagnostics.is_empty() {
             return Err(Diagnostics(reader.collector.diagnostics));
@@ -218,6 +228,7 @@ impl Reader {
                 exact,
                 solver,
                 output,
+                refine,
                 collector: reader.collector,
                 mesh_spans,
             }),
@@ -1019,6 +1030,95 @@ impl Reader {
             }
         }
         spec
+    }
+
+    fn refine(&mut self, root: &dyn TableLike) -> Option<RefineSpec> {
+        let (table, entry) = self.subtable(root, "", "refine")?;
+        self.check_keys(table, "refine", REFINE_KEYS);
+        let mut spec = RefineSpec::default();
+        let theta = self.number_at(table, "refine", "theta");
+        if let Some(t) = theta {
+            if !(t > 0.0 && t <= 1.0) {
+                let span = self.entry(table, "refine", "theta").and_then(|e| e.span());
+                self.error(
+                    span,
+                    "refine.theta",
+                    format!("the Dörfler fraction must lie in (0, 1], found {t}"),
+                    None,
+                );
+            }
+        }
+        match self.string_at(table, "refine", "strategy").as_deref() {
+            None | Some("uniform") => {}
+            Some("adaptive") => {
+                spec.strategy = Strategy::Adaptive {
+                    theta: theta.unwrap_or(0.5),
+                }
+            }
+            Some("divide-longest-axis") => spec.strategy = Strategy::DivideLongestAxis,
+            Some("divide-shortest-wall") => spec.strategy = Strategy::DivideShortestWall,
+            Some(other) => {
+                let span = self
+                    .entry(table, "refine", "strategy")
+                    .and_then(|e| e.span());
+                let owned: Vec<String> = STRATEGIES.iter().map(|s| s.to_string()).collect();
+                let help = closest(other, &owned)
+                    .map_or(format!("strategies: {}", STRATEGIES.join(", ")), |s| {
+                        format!("did you mean \"{s}\"?")
+                    });
+                self.error(
+                    span,
+                    "refine.strategy",
+                    format!("unknown refinement strategy \"{other}\""),
+                    Some(help),
+                );
+            }
+        }
+        if theta.is_some() && !matches!(spec.strategy, Strategy::Adaptive { .. }) {
+            let span = self
+                .entry(table, "refine", "theta")
+                .and_then(|e| e.key_span.clone());
+            self.error(
+                span,
+                "refine.theta",
+                "only the adaptive strategy marks cells",
+                None,
+            );
+        }
+        match self.entry(table, "refine", "steps") {
+            Some(e) => match e.item.as_integer() {
+                Some(n) if (0..=20).contains(&n) => spec.steps = n as usize,
+                Some(n) => self.error(
+                    e.span(),
+                    &e.name,
+                    format!("between 0 and 20 steps, found {n}"),
+                    Some("each step multiplies the cell count by up to 2ⁿ".into()),
+                ),
+                None => self.type_error(&e, "an integer"),
+            },
+            None => self.error(
+                entry.span(),
+                "refine.steps",
+                "missing: how many refinement steps",
+                Some("e.g. steps = 3".into()),
+            ),
+        }
+        if let Some(t) = self.number_at(table, "refine", "tolerance") {
+            if t > 0.0 && t < 1.0 {
+                spec.tolerance = t;
+            } else {
+                let span = self
+                    .entry(table, "refine", "tolerance")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "refine.tolerance",
+                    format!("a relative residual in (0, 1), found {t}"),
+                    None,
+                );
+            }
+        }
+        Some(spec)
     }
 
     fn output(&mut self, root: &dyn TableLike) -> OutputSpec {
