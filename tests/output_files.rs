@@ -645,6 +645,7 @@ fn bad_cochains_are_rejected_before_anything_is_written() {
     let short = steady(&k, vec![Cochain::new("u", 0, vec![1.0; 5])]);
     match write_run(&dir.join("run"), &short) {
         Err(OutputError::Shape {
+            step: 0,
             name,
             dim: 0,
             expected: 6,

@@ -2,7 +2,8 @@
 
 use super::topology::GridTopology;
 use super::xdmf::{center, Center};
-use super::{OutputError, RunOutput};
+use super::{Levels, MeshAt, OutputError};
+use hasse_complex::Complex;
 use hdf5::types::VarLenUnicode;
 use hdf5::{Group, H5Type, Location};
 use ndarray::ArrayView2;
@@ -11,7 +12,11 @@ use std::borrow::Cow;
 use std::path::Path;
 
 /// Version of the layout below `/`; bumped when a reader would need to change.
+/// Version 1 is the one-mesh layout of `write_run` (with `mesh_changes` = 0).
 pub(crate) const FORMAT_VERSION: u64 = 1;
+/// Version 2: `write_mesh_series`, one mesh per step under `/steps/<k>/mesh`
+/// (`mesh_changes` = 1), no `/mesh` and no `/xdmf`.
+pub(crate) const FORMAT_VERSION_MESH_SERIES: u64 = 2;
 
 /// Attach the file path to an HDF5 error.
 trait At<T> {
@@ -137,15 +142,16 @@ impl Writer<'_> {
     }
 }
 
-/// Write the whole h5 file at `path` (a temporary name) and close it.
+/// Write the whole h5 file at `path` (a temporary name) and close it;
+/// `grids[m]` are the XDMF grids of `levels.meshes[m]`.
 pub(crate) fn write(
     path: &Path,
-    run: &RunOutput,
-    grids: &[GridTopology],
+    levels: &Levels,
+    grids: &[Vec<GridTopology>],
     written_at: &str,
 ) -> Result<(), OutputError> {
     let file = hdf5::File::create(path).at(path)?;
-    write_contents(&Writer { path }, &file, run, grids, written_at)?;
+    write_contents(&Writer { path }, &file, levels, grids, written_at)?;
     file.flush().at(path)?;
     file.close().at(path)
 }
@@ -153,32 +159,79 @@ pub(crate) fn write(
 fn write_contents(
     w: &Writer,
     root: &Group,
-    run: &RunOutput,
-    grids: &[GridTopology],
+    levels: &Levels,
+    grids: &[Vec<GridTopology>],
     written_at: &str,
 ) -> Result<(), OutputError> {
-    let complex = run.complex;
+    let times: Vec<f64> = levels.steps.iter().map(|s| s.time).collect();
+    w.string_attr(root, "format", "hasse-output")?;
+    let version = if levels.mesh_changes {
+        FORMAT_VERSION_MESH_SERIES
+    } else {
+        FORMAT_VERSION
+    };
+    w.scalar_attr(root, "format_version", version)?;
+    w.scalar_attr(root, "step_count", levels.steps.len() as u64)?;
+    w.array_attr(root, "times", &times)?;
+    w.scalar_attr(root, "mesh_changes", u64::from(levels.mesh_changes))?;
+
+    // The steps first: in a series each mesh lives inside its step's group.
+    let steps = w.group(root, "steps")?;
+    for (k, step) in levels.steps.iter().enumerate() {
+        let g = w.group(&steps, &k.to_string())?;
+        w.scalar_attr(&g, "time", step.time)?;
+        for c in step.cochains {
+            w.vector(&g, &c.name, &c.values)?;
+            let ds = g.dataset(&c.name).at(w.path)?;
+            w.scalar_attr(&ds, "dim", c.dim as u64)?;
+            for (key, value) in [
+                ("units", &c.units),
+                ("method", &c.method),
+                ("description", &c.description),
+            ] {
+                if let Some(value) = value {
+                    w.string_attr(&ds, key, value)?;
+                }
+            }
+        }
+    }
+
+    for (mesh, grids) in levels.meshes.iter().zip(grids) {
+        write_mesh(w, &w.group(root, &mesh.group)?, mesh.complex)?;
+        write_xdmf_arrays(w, &w.group(root, &mesh.xdmf_group)?, levels, mesh, grids)?;
+    }
+
+    let prov = w.group(root, "provenance")?;
+    let p = levels.provenance;
+    w.string_attr(&prov, "hasse_version", &p.hasse_version)?;
+    w.string_attr(&prov, "written_at", written_at)?;
+    if let Some(path) = &p.case_path {
+        w.string_attr(&prov, "case_path", path)?;
+    }
+    if let Some(text) = &p.case_text {
+        w.string_dataset(&prov, "case_text", text)?;
+    }
+    w.string_dataset(&prov, "report", &p.report.to_string())
+}
+
+/// One complex into group `mesh` (`/mesh`, or `/steps/<k>/mesh`): attrs
+/// `dim` and `embedding_dim`, `vertices`, `cells/<p>`, `boundary/<p>`,
+/// `tags/<name>`.
+fn write_mesh(w: &Writer, mesh: &Group, complex: &Complex) -> Result<(), OutputError> {
     let n = complex.dim();
     let d = complex.embedding_dim();
-    let times: Vec<f64> = run.steps.iter().map(|s| s.time).collect();
-    w.string_attr(root, "format", "hasse-output")?;
-    w.scalar_attr(root, "format_version", FORMAT_VERSION)?;
-    w.scalar_attr(root, "step_count", run.steps.len() as u64)?;
-    w.array_attr(root, "times", &times)?;
-
-    let mesh = w.group(root, "mesh")?;
-    w.scalar_attr(&mesh, "dim", n as u64)?;
-    w.scalar_attr(&mesh, "embedding_dim", d as u64)?;
+    w.scalar_attr(mesh, "dim", n as u64)?;
+    w.scalar_attr(mesh, "embedding_dim", d as u64)?;
     let nv = complex.cell_count(0);
     let mut xyz = vec![0.0; nv * 3];
     for v in 0..nv {
         xyz[3 * v..3 * v + d].copy_from_slice(complex.vertices().point(v));
     }
-    w.matrix(&mesh, "vertices", &xyz, 3)?;
+    w.matrix(mesh, "vertices", &xyz, 3)?;
     let vertices = mesh.dataset("vertices").at(w.path)?;
     w.scalar_attr(&vertices, "embedding_dim", d as u64)?;
 
-    let cells = w.group(&mesh, "cells")?;
+    let cells = w.group(mesh, "cells")?;
     let identity = CsMat::new(
         (nv, nv),
         (0..=nv).collect(),
@@ -195,7 +248,7 @@ fn write_contents(
             })?;
         w.csr(&w.group(&cells, &p.to_string())?, m, false)?;
     }
-    let boundary = w.group(&mesh, "boundary")?;
+    let boundary = w.group(mesh, "boundary")?;
     for p in 1..=n {
         w.csr(
             &w.group(&boundary, &p.to_string())?,
@@ -203,49 +256,30 @@ fn write_contents(
             true,
         )?;
     }
-    let tags = w.group(&mesh, "tags")?;
+    let tags = w.group(mesh, "tags")?;
     for (name, tag) in complex.tags().iter() {
         let ids: Vec<u64> = tag.cells.iter().map(|&c| c as u64).collect();
         w.vector(&tags, name, &ids)?;
         let ds = tags.dataset(name).at(w.path)?;
         w.scalar_attr(&ds, "dim", tag.dim as u64)?;
     }
+    Ok(())
+}
 
-    let steps = w.group(root, "steps")?;
-    for (k, step) in run.steps.iter().enumerate() {
-        let g = w.group(&steps, &k.to_string())?;
-        w.scalar_attr(&g, "time", step.time)?;
-        for c in &step.cochains {
-            w.vector(&g, &c.name, &c.values)?;
-            let ds = g.dataset(&c.name).at(w.path)?;
-            w.scalar_attr(&ds, "dim", c.dim as u64)?;
-            for (key, value) in [
-                ("units", &c.units),
-                ("method", &c.method),
-                ("description", &c.description),
-            ] {
-                if let Some(value) = value {
-                    w.string_attr(&ds, key, value)?;
-                }
-            }
-        }
-    }
-
-    let prov = w.group(root, "provenance")?;
-    let p = &run.provenance;
-    w.string_attr(&prov, "hasse_version", &p.hasse_version)?;
-    w.string_attr(&prov, "written_at", written_at)?;
-    if let Some(path) = &p.case_path {
-        w.string_attr(&prov, "case_path", path)?;
-    }
-    if let Some(text) = &p.case_text {
-        w.string_dataset(&prov, "case_text", text)?;
-    }
-    w.string_dataset(&prov, "report", &p.report.to_string())?;
-
-    let xdmf = w.group(root, "xdmf")?;
+/// The XDMF arrays of one mesh into group `xdmf` (`/xdmf`, or
+/// `/steps/<k>/mesh/xdmf`): `<p>/topology`, and for split cells
+/// `<p>/cell_ids` with the expanded cochains `<p>/steps/<k>/<name>` of the
+/// levels on this mesh.
+fn write_xdmf_arrays(
+    w: &Writer,
+    xdmf: &Group,
+    levels: &Levels,
+    mesh: &MeshAt,
+    grids: &[GridTopology],
+) -> Result<(), OutputError> {
+    let n = levels.dim();
     for grid in grids {
-        let g = w.group(&xdmf, &grid.degree.to_string())?;
+        let g = w.group(xdmf, &grid.degree.to_string())?;
         match grid.uniform {
             Some((_, nodes)) => w.matrix(&g, "topology", &grid.connectivity, nodes)?,
             None => w.vector(&g, "topology", &grid.connectivity)?,
@@ -255,9 +289,9 @@ fn write_contents(
         };
         w.vector(&g, "cell_ids", cell_ids)?;
         let expanded = w.group(&g, "steps")?;
-        for (k, step) in run.steps.iter().enumerate() {
+        for &k in &mesh.steps {
             let sg = w.group(&expanded, &k.to_string())?;
-            for c in &step.cochains {
+            for c in levels.steps[k].cochains {
                 if center(grid, n, c) != Some(Center::Cell) {
                     continue;
                 }

@@ -179,7 +179,49 @@ pub struct RunOutput<'a> {
     pub provenance: Provenance,
 }
 
-/// The files [`write_run`] wrote.
+/// One time level with its own complex, for [`write_mesh_series`].
+///
+/// ```
+/// use hasse_solver::output::{Cochain, MeshStep};
+/// let k = hasse_complex::generate::interval(3, 0.0, 1.0).unwrap();
+/// let step = MeshStep { time: 0.5, complex: &k, cochains: vec![Cochain::new("q", 1, vec![1.0; 3])] };
+/// assert_eq!(step.cochains[0].values.len(), step.complex.cell_count(1));
+/// ```
+#[derive(Clone, Debug)]
+pub struct MeshStep<'a> {
+    /// Time of the level; times must be finite and strictly increasing.
+    pub time: f64,
+    /// The complex of this level; the cochains live on it.
+    pub complex: &'a Complex,
+    /// The fields at this time, on `complex`.
+    pub cochains: Vec<Cochain>,
+}
+
+/// Everything [`write_mesh_series`] stores: time levels, each with its own
+/// complex, and the provenance.
+///
+/// ```
+/// use hasse_solver::output::{MeshStep, Provenance, SeriesOutput};
+/// let coarse = hasse_complex::generate::interval(2, 0.0, 1.0).unwrap();
+/// let fine = hasse_complex::generate::interval(4, 0.0, 1.0).unwrap();
+/// let series = SeriesOutput {
+///     steps: vec![
+///         MeshStep { time: 0.0, complex: &coarse, cochains: vec![] },
+///         MeshStep { time: 1.0, complex: &fine, cochains: vec![] },
+///     ],
+///     provenance: Provenance::new(serde_json::Value::Null),
+/// };
+/// assert_eq!(series.steps[1].complex.cell_count(1), 4);
+/// ```
+#[derive(Clone, Debug)]
+pub struct SeriesOutput<'a> {
+    /// Time levels in increasing time; at least one.
+    pub steps: Vec<MeshStep<'a>>,
+    /// Where the run came from.
+    pub provenance: Provenance,
+}
+
+/// The files [`write_run`] or [`write_mesh_series`] wrote.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OutputFiles {
     /// `<stem>.h5`.
@@ -210,19 +252,24 @@ pub enum OutputError {
     /// The HDF5 library refused an operation on the (temporary) h5 file.
     #[error("{path}: HDF5 error: {message}")]
     Hdf5 { path: PathBuf, message: String },
-    /// A cochain's length is not the number of cells of its degree.
+    /// A cochain's length is not the number of cells of its degree (in
+    /// the complex of its step).
     #[error(
-        "cochain '{name}' of degree {dim} has {got} values, the complex has {expected} {dim}-cells"
+        "cochain '{name}' (step {step}) of degree {dim} has {got} values, the complex has {expected} {dim}-cells"
     )]
     Shape {
+        step: usize,
         name: String,
         dim: usize,
         expected: usize,
         got: usize,
     },
     /// A cochain's degree exceeds the dimension of the complex.
-    #[error("cochain '{name}' has degree {dim}, the complex has dimension {complex_dim}")]
+    #[error(
+        "cochain '{name}' (step {step}) has degree {dim}, the complex has dimension {complex_dim}"
+    )]
     Degree {
+        step: usize,
         name: String,
         dim: usize,
         complex_dim: usize,
@@ -247,6 +294,18 @@ pub enum OutputError {
     /// Times must be finite and strictly increasing.
     #[error("step {step} has time {time}: times must be finite and strictly increasing")]
     Time { step: usize, time: f64 },
+    /// A series whose mesh changes needs at least one time level: the
+    /// complexes come with the levels.
+    #[error("a series whose mesh changes needs at least one step")]
+    EmptySeries,
+    /// The complexes of a series must all have the same dimension (the
+    /// XDMF files are one per cell degree).
+    #[error("step {step} has a complex of dimension {dim}, step 0 one of dimension {expected}")]
+    MeshDimension {
+        step: usize,
+        dim: usize,
+        expected: usize,
+    },
     /// The output stem cannot name the output files.
     #[error("output stem '{path}': {reason}")]
     Stem { path: PathBuf, reason: &'static str },
@@ -287,7 +346,55 @@ pub enum OutputError {
 /// std::fs::remove_dir_all(&dir).unwrap();
 /// ```
 pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputError> {
-    validate(run)?;
+    write_levels(stem, &Levels::of_run(run))
+}
+
+/// Writes `<stem>.h5`, `<stem>.xdmf` and one `<stem>.<grid>.xdmf` per
+/// lower cochain degree for a time series whose complex changes from one
+/// level to the next (refinement studies, growing tissues), and returns
+/// their paths.
+///
+/// Each level k stores its own complex under `/steps/<k>/mesh` (the layout
+/// of `/mesh` in a [`write_run`] file, plus the XDMF arrays under
+/// `/steps/<k>/mesh/xdmf`) next to its cochains `/steps/<k>/<name>`; the
+/// root attribute `mesh_changes` is 1 (0 in [`write_run`] files). In every
+/// XDMF file the k-th grid of the temporal collection has its own geometry
+/// and topology pointing into `/steps/<k>/mesh`.
+///
+/// Checks, temporary files and renames are those of [`write_run`]. Besides
+/// its checks, the series must have at least one level
+/// ([`OutputError::EmptySeries`]), all complexes the same dimension
+/// ([`OutputError::MeshDimension`]), and no cochain may be named `mesh`.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::output::{write_mesh_series, Cochain, MeshStep, Provenance, SeriesOutput};
+/// let coarse = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let fine = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let x = |k: &hasse_complex::Complex| -> Vec<f64> {
+///     (0..k.cell_count(0)).map(|v| k.vertices().point(v)[0]).collect()
+/// };
+/// let series = SeriesOutput {
+///     steps: vec![
+///         MeshStep { time: 0.0, complex: &coarse, cochains: vec![Cochain::new("x", 0, x(&coarse))] },
+///         MeshStep { time: 1.0, complex: &fine, cochains: vec![Cochain::new("x", 0, x(&fine))] },
+///     ],
+///     provenance: Provenance::new(serde_json::json!({"note": "doctest"})),
+/// };
+/// let dir = std::env::temp_dir().join(format!("hasse-doc-series-{}", std::process::id()));
+/// let files = write_mesh_series(&dir.join("grow"), &series).unwrap();
+/// let xdmf = std::fs::read_to_string(&files.xdmf).unwrap();
+/// assert!(xdmf.contains("grow.h5:/steps/1/mesh/vertices"));
+/// assert!(xdmf.contains("grow.h5:/steps/1/x"));
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn write_mesh_series(stem: &Path, series: &SeriesOutput) -> Result<OutputFiles, OutputError> {
+    write_levels(stem, &Levels::of_series(series))
+}
+
+/// The shared body of [`write_run`] and [`write_mesh_series`].
+fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError> {
+    validate(levels)?;
     let stem_error = |reason| OutputError::Stem {
         path: stem.to_path_buf(),
         reason,
@@ -308,26 +415,27 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    let grids = xdmf::grids(run)?;
+    let degrees = xdmf::degrees(levels);
+    let grids = xdmf::grids(levels, &degrees)?;
 
     std::fs::create_dir_all(&dir).map_err(|source| OutputError::Io {
         path: dir.clone(),
         source,
     })?;
     let h5_name = format!("{file_name}.h5");
-    let n = run.complex.dim();
+    let n = levels.dim();
     let final_h5 = dir.join(&h5_name);
     let final_xdmf = dir.join(format!("{file_name}.xdmf"));
-    // One XDMF document per grid: the top grid (first in `grids`) under
+    // One XDMF document per degree: the top grid (first in `degrees`) under
     // `<stem>.xdmf`, each lower degree under `<stem>.<grid>.xdmf`.
     let mut extra_xdmf = Vec::new();
     let mut documents = Vec::new();
-    for (i, grid) in grids.iter().enumerate() {
-        let text = xdmf::document(run, grid, &h5_name);
+    for (i, &p) in degrees.iter().enumerate() {
+        let text = xdmf::document(levels, &grids, i, &h5_name);
         if i == 0 {
             documents.push((final_xdmf.clone(), text));
         } else {
-            let path = dir.join(format!("{file_name}.{}.xdmf", xdmf::grid_name(grid, n)));
+            let path = dir.join(format!("{file_name}.{}.xdmf", xdmf::grid_name(p, n)));
             extra_xdmf.push(path.clone());
             documents.push((path, text));
         }
@@ -353,7 +461,7 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
     finals.extend(documents.iter().map(|(path, _)| path.clone()));
     let mut temps = Temporaries(finals.iter().map(|path| temp(path)).collect());
 
-    hdf5_file::write(&temps.0[0], run, &grids, &rfc3339_now())?;
+    hdf5_file::write(&temps.0[0], levels, &grids, &rfc3339_now())?;
     for (path, (_, text)) in temps.0[1..].iter().zip(&documents) {
         std::fs::write(path, text).map_err(|source| OutputError::Io {
             path: path.clone(),
@@ -391,6 +499,94 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
     })
 }
 
+/// An output as the writers see it, whichever entry point built it: the
+/// meshes with the h5 groups they go to, and the time levels on them.
+pub(crate) struct Levels<'a> {
+    /// One mesh shared by every level ([`write_run`]) or one per level.
+    pub meshes: Vec<MeshAt<'a>>,
+    pub steps: Vec<Level<'a>>,
+    pub provenance: &'a Provenance,
+    /// Each level has its own mesh under `/steps/<k>/mesh`.
+    pub mesh_changes: bool,
+}
+
+/// A complex and where it goes in the h5 file.
+pub(crate) struct MeshAt<'a> {
+    pub complex: &'a Complex,
+    /// Group of the mesh, from the root without a leading `/`: `mesh`, or
+    /// `steps/<k>/mesh` in a series.
+    pub group: String,
+    /// Group of its XDMF arrays: `xdmf`, or `steps/<k>/mesh/xdmf`.
+    pub xdmf_group: String,
+    /// The levels whose cochains live on it, in increasing order.
+    pub steps: Vec<usize>,
+}
+
+/// One time level: its cochains live on `meshes[mesh]`.
+pub(crate) struct Level<'a> {
+    pub time: f64,
+    pub cochains: &'a [Cochain],
+    pub mesh: usize,
+}
+
+impl<'a> Levels<'a> {
+    fn of_run(run: &'a RunOutput) -> Self {
+        Levels {
+            meshes: vec![MeshAt {
+                complex: run.complex,
+                group: "mesh".into(),
+                xdmf_group: "xdmf".into(),
+                steps: (0..run.steps.len()).collect(),
+            }],
+            steps: run
+                .steps
+                .iter()
+                .map(|s| Level {
+                    time: s.time,
+                    cochains: &s.cochains,
+                    mesh: 0,
+                })
+                .collect(),
+            provenance: &run.provenance,
+            mesh_changes: false,
+        }
+    }
+
+    fn of_series(series: &'a SeriesOutput) -> Self {
+        let meshes = series
+            .steps
+            .iter()
+            .enumerate()
+            .map(|(k, s)| MeshAt {
+                complex: s.complex,
+                group: format!("steps/{k}/mesh"),
+                xdmf_group: format!("steps/{k}/mesh/xdmf"),
+                steps: vec![k],
+            })
+            .collect();
+        Levels {
+            meshes,
+            steps: series
+                .steps
+                .iter()
+                .enumerate()
+                .map(|(k, s)| Level {
+                    time: s.time,
+                    cochains: &s.cochains,
+                    mesh: k,
+                })
+                .collect(),
+            provenance: &series.provenance,
+            mesh_changes: true,
+        }
+    }
+
+    /// Dimension n of the top cells (the same on every mesh, see `validate`).
+    pub fn dim(&self) -> usize {
+        self.meshes.first().map_or(0, |m| m.complex.dim())
+    }
+}
+
 /// Every name a lower-degree grid file can have (see `xdmf::grid_name`).
 const LOWER_GRID_NAMES: [&str; 2] = ["edges", "faces"];
 
@@ -422,10 +618,13 @@ impl Drop for Temporaries {
     }
 }
 
-fn validate(run: &RunOutput) -> Result<(), OutputError> {
-    let complex = run.complex;
+fn validate(levels: &Levels) -> Result<(), OutputError> {
+    let Some(first) = levels.meshes.first() else {
+        return Err(OutputError::EmptySeries);
+    };
+    let n = first.complex.dim();
     let mut previous: Option<f64> = None;
-    for (k, step) in run.steps.iter().enumerate() {
+    for (k, step) in levels.steps.iter().enumerate() {
         if !step.time.is_finite() || previous.is_some_and(|t| step.time <= t) {
             return Err(OutputError::Time {
                 step: k,
@@ -433,9 +632,23 @@ fn validate(run: &RunOutput) -> Result<(), OutputError> {
             });
         }
         previous = Some(step.time);
+        let complex = levels.meshes[step.mesh].complex;
+        if complex.dim() != n {
+            return Err(OutputError::MeshDimension {
+                step: k,
+                dim: complex.dim(),
+                expected: n,
+            });
+        }
         let mut names = HashSet::new();
-        for c in &step.cochains {
+        for c in step.cochains {
             check_name(&c.name)?;
+            if levels.mesh_changes && c.name == "mesh" {
+                return Err(OutputError::InvalidName {
+                    name: c.name.clone(),
+                    reason: "'mesh' is the group of the step's own mesh in a series",
+                });
+            }
             if !names.insert(c.name.as_str()) {
                 return Err(OutputError::DuplicateName {
                     step: k,
@@ -444,6 +657,7 @@ fn validate(run: &RunOutput) -> Result<(), OutputError> {
             }
             if c.dim > complex.dim() {
                 return Err(OutputError::Degree {
+                    step: k,
                     name: c.name.clone(),
                     dim: c.dim,
                     complex_dim: complex.dim(),
@@ -452,6 +666,7 @@ fn validate(run: &RunOutput) -> Result<(), OutputError> {
             let expected = complex.cell_count(c.dim);
             if c.values.len() != expected {
                 return Err(OutputError::Shape {
+                    step: k,
                     name: c.name.clone(),
                     dim: c.dim,
                     expected,

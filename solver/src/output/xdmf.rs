@@ -2,26 +2,41 @@
 //! into the same h5 file.
 
 use super::topology::{grid_topology, GridTopology};
-use super::{Cochain, OutputError, RunOutput};
+use super::{Cochain, Levels, MeshAt, OutputError};
 use std::fmt::Write;
 
-/// The grids a run needs, top cells first: the top grid always (it also
-/// carries the point data), then edges and faces, in increasing degree,
-/// only when cochains live there.
-pub(crate) fn grids(run: &RunOutput) -> Result<Vec<GridTopology>, OutputError> {
-    let n = run.complex.dim();
+/// The cochain degrees that get a grid (and a document), top cells first:
+/// the top degree n always (it also carries the point data), then 1 ≤ p < n
+/// in increasing order when a cochain of some level lives there.
+pub(crate) fn degrees(levels: &Levels) -> Vec<usize> {
+    let n = levels.dim();
     let used = |p: usize| {
-        run.steps
+        levels
+            .steps
             .iter()
             .any(|s| s.cochains.iter().any(|c| c.dim == p))
     };
-    let mut grids = vec![grid_topology(run.complex, n)?];
-    for p in 1..n {
-        if used(p) {
-            grids.push(grid_topology(run.complex, p)?);
-        }
-    }
-    Ok(grids)
+    let mut degrees = vec![n];
+    degrees.extend((1..n).filter(|&p| used(p)));
+    degrees
+}
+
+/// The grids of every mesh: `grids[m][i]` is the grid of the cells of
+/// degree `degrees[i]` of `levels.meshes[m]`.
+pub(crate) fn grids(
+    levels: &Levels,
+    degrees: &[usize],
+) -> Result<Vec<Vec<GridTopology>>, OutputError> {
+    levels
+        .meshes
+        .iter()
+        .map(|mesh| {
+            degrees
+                .iter()
+                .map(|&p| grid_topology(mesh.complex, p))
+                .collect()
+        })
+        .collect()
 }
 
 /// How a cochain appears on a grid, if it does.
@@ -42,18 +57,28 @@ pub(crate) fn center(grid: &GridTopology, top_dim: usize, c: &Cochain) -> Option
 }
 
 /// HDF5 path of the values an XDMF attribute reads: the cochain itself, or
-/// its copy expanded to the grid's elements when cells were split.
-pub(crate) fn attribute_path(grid: &GridTopology, step: usize, c: &Cochain, at: Center) -> String {
+/// its copy expanded to the grid's elements when cells were split (kept
+/// with the grid's other arrays under the mesh's XDMF group).
+pub(crate) fn attribute_path(
+    mesh: &MeshAt,
+    grid: &GridTopology,
+    step: usize,
+    c: &Cochain,
+    at: Center,
+) -> String {
     match (at, &grid.cell_ids) {
-        (Center::Cell, Some(_)) => format!("/xdmf/{}/steps/{step}/{}", grid.degree, c.name),
+        (Center::Cell, Some(_)) => format!(
+            "/{}/{}/steps/{step}/{}",
+            mesh.xdmf_group, grid.degree, c.name
+        ),
         _ => format!("/steps/{step}/{}", c.name),
     }
 }
 
-/// Name of the grid in the XDMF text, also the middle part of the file
-/// name `<stem>.<name>.xdmf` of a lower-degree grid.
-pub(crate) fn grid_name(grid: &GridTopology, top_dim: usize) -> &'static str {
-    match grid.degree {
+/// Name of the grid of degree p in the XDMF text, also the middle part of
+/// the file name `<stem>.<name>.xdmf` of a lower-degree grid.
+pub(crate) fn grid_name(degree: usize, top_dim: usize) -> &'static str {
+    match degree {
         p if p == top_dim => "cells",
         1 => "edges",
         _ => "faces",
@@ -75,28 +100,43 @@ fn escape(text: &str) -> String {
     out
 }
 
-/// The XDMF document of one grid; `h5_name` is the h5 file name relative
+/// The XDMF document of the grid of degree `degrees[i]` (its grids are
+/// `grids[m][i]`, see [`grids`]); `h5_name` is the h5 file name relative
 /// to it. One grid per document, because `meshio.read` accepts only a
 /// domain holding a single uniform grid and `TimeSeriesReader` only the
 /// last temporal collection: a plain uniform grid for at most one time
-/// level, a temporal collection for several.
-pub(crate) fn document(run: &RunOutput, grid: &GridTopology, h5_name: &str) -> String {
+/// level, a temporal collection for several, whose k-th grid takes its
+/// geometry and topology from the mesh of level k.
+pub(crate) fn document(
+    levels: &Levels,
+    grids: &[Vec<GridTopology>],
+    i: usize,
+    h5_name: &str,
+) -> String {
     let h5 = escape(h5_name);
     let mut out = String::new();
     out.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
     out.push_str("<Xdmf Version=\"3.0\">\n  <Domain>\n");
-    if run.steps.len() <= 1 {
-        uniform_grid(&mut out, run, grid, 0, None, &h5, 4);
-    } else {
-        let name = grid_name(grid, run.complex.dim());
-        let _ = writeln!(
-            out,
-            "    <Grid Name=\"{name}\" GridType=\"Collection\" CollectionType=\"Temporal\">"
-        );
-        for (k, step) in run.steps.iter().enumerate() {
-            uniform_grid(&mut out, run, grid, k, Some(step.time), &h5, 6);
+    let grid = Grid {
+        levels,
+        grids,
+        i,
+        h5: &h5,
+    };
+    match levels.steps.as_slice() {
+        [] => grid.uniform(&mut out, 0, None, false, 4),
+        [only] => grid.uniform(&mut out, only.mesh, Some(0), false, 4),
+        steps => {
+            let name = grid_name(grids[0][i].degree, levels.dim());
+            let _ = writeln!(
+                out,
+                "    <Grid Name=\"{name}\" GridType=\"Collection\" CollectionType=\"Temporal\">"
+            );
+            for (k, step) in steps.iter().enumerate() {
+                grid.uniform(&mut out, step.mesh, Some(k), true, 6);
+            }
+            out.push_str("    </Grid>\n");
         }
-        out.push_str("    </Grid>\n");
     }
     out.push_str("  </Domain>\n</Xdmf>\n");
     out
@@ -107,85 +147,95 @@ fn float(x: f64) -> String {
     format!("{x:?}")
 }
 
-fn uniform_grid(
-    out: &mut String,
-    run: &RunOutput,
-    grid: &GridTopology,
-    step: usize,
-    time: Option<f64>,
-    h5: &str,
-    indent: usize,
-) {
-    let n = run.complex.dim();
-    let pad = " ".repeat(indent);
-    let name = grid_name(grid, n);
-    let _ = writeln!(out, "{pad}<Grid Name=\"{name}\" GridType=\"Uniform\">");
-    if let Some(t) = time {
-        let _ = writeln!(out, "{pad}  <Time Value=\"{}\"/>", float(t));
-    }
-    let e = grid.element_count;
-    match grid.uniform {
-        Some((kind, nodes)) => {
-            let _ = writeln!(
-                out,
-                "{pad}  <Topology TopologyType=\"{kind}\" NumberOfElements=\"{e}\" NodesPerElement=\"{nodes}\">"
-            );
-            let _ = writeln!(
-                out,
-                "{pad}    <DataItem Dimensions=\"{e} {nodes}\" DataType=\"Int\" Precision=\"8\" Format=\"HDF\">{h5}:/xdmf/{}/topology</DataItem>",
-                grid.degree
-            );
+/// What every uniform grid of one document shares.
+struct Grid<'a> {
+    levels: &'a Levels<'a>,
+    grids: &'a [Vec<GridTopology>],
+    /// Index of the document's degree in `degrees`.
+    i: usize,
+    /// The escaped h5 file name.
+    h5: &'a str,
+}
+
+impl Grid<'_> {
+    /// The uniform grid of mesh `m`, with the attributes of level `step`
+    /// (none for the bare mesh) and its `<Time>` when `timed`.
+    fn uniform(&self, out: &mut String, m: usize, step: Option<usize>, timed: bool, indent: usize) {
+        let (levels, h5) = (self.levels, self.h5);
+        let mesh = &levels.meshes[m];
+        let grid = &self.grids[m][self.i];
+        let n = levels.dim();
+        let pad = " ".repeat(indent);
+        let name = grid_name(grid.degree, n);
+        let _ = writeln!(out, "{pad}<Grid Name=\"{name}\" GridType=\"Uniform\">");
+        let level = step.and_then(|k| levels.steps.get(k).map(|s| (k, s)));
+        if let (true, Some((_, s))) = (timed, level) {
+            let _ = writeln!(out, "{pad}  <Time Value=\"{}\"/>", float(s.time));
         }
-        None => {
-            let _ = writeln!(
-                out,
-                "{pad}  <Topology TopologyType=\"Mixed\" NumberOfElements=\"{e}\">"
-            );
-            let _ = writeln!(
-                out,
-                "{pad}    <DataItem Dimensions=\"{}\" DataType=\"Int\" Precision=\"8\" Format=\"HDF\">{h5}:/xdmf/{}/topology</DataItem>",
-                grid.connectivity.len(),
-                grid.degree
-            );
+        let e = grid.element_count;
+        let topology = format!("{h5}:/{}/{}/topology", mesh.xdmf_group, grid.degree);
+        match grid.uniform {
+            Some((kind, nodes)) => {
+                let _ = writeln!(
+                    out,
+                    "{pad}  <Topology TopologyType=\"{kind}\" NumberOfElements=\"{e}\" NodesPerElement=\"{nodes}\">"
+                );
+                let _ = writeln!(
+                    out,
+                    "{pad}    <DataItem Dimensions=\"{e} {nodes}\" DataType=\"Int\" Precision=\"8\" Format=\"HDF\">{topology}</DataItem>"
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    out,
+                    "{pad}  <Topology TopologyType=\"Mixed\" NumberOfElements=\"{e}\">"
+                );
+                let _ = writeln!(
+                    out,
+                    "{pad}    <DataItem Dimensions=\"{}\" DataType=\"Int\" Precision=\"8\" Format=\"HDF\">{topology}</DataItem>",
+                    grid.connectivity.len(),
+                );
+            }
         }
-    }
-    let _ = writeln!(out, "{pad}  </Topology>");
-    let _ = writeln!(out, "{pad}  <Geometry GeometryType=\"XYZ\">");
-    let _ = writeln!(
-        out,
-        "{pad}    <DataItem Dimensions=\"{} 3\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/mesh/vertices</DataItem>",
-        run.complex.cell_count(0)
-    );
-    let _ = writeln!(out, "{pad}  </Geometry>");
-    if let Some(s) = run.steps.get(step) {
-        for c in &s.cochains {
-            let Some(at) = center(grid, n, c) else {
-                continue;
-            };
-            let (center_name, len) = match at {
-                Center::Node => ("Node", run.complex.cell_count(0)),
-                Center::Cell => ("Cell", e),
-            };
-            let _ = writeln!(
-                out,
-                "{pad}  <Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"{center_name}\">",
-                escape(&c.name)
-            );
-            let _ = writeln!(
-                out,
-                "{pad}    <DataItem Dimensions=\"{len}\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:{}</DataItem>",
-                escape(&attribute_path(grid, step, c, at))
-            );
-            let _ = writeln!(out, "{pad}  </Attribute>");
+        let _ = writeln!(out, "{pad}  </Topology>");
+        let _ = writeln!(out, "{pad}  <Geometry GeometryType=\"XYZ\">");
+        let _ = writeln!(
+            out,
+            "{pad}    <DataItem Dimensions=\"{} 3\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:/{}/vertices</DataItem>",
+            mesh.complex.cell_count(0),
+            mesh.group
+        );
+        let _ = writeln!(out, "{pad}  </Geometry>");
+        if let Some((k, s)) = level {
+            for c in s.cochains {
+                let Some(at) = center(grid, n, c) else {
+                    continue;
+                };
+                let (center_name, len) = match at {
+                    Center::Node => ("Node", mesh.complex.cell_count(0)),
+                    Center::Cell => ("Cell", e),
+                };
+                let _ = writeln!(
+                    out,
+                    "{pad}  <Attribute Name=\"{}\" AttributeType=\"Scalar\" Center=\"{center_name}\">",
+                    escape(&c.name)
+                );
+                let _ = writeln!(
+                    out,
+                    "{pad}    <DataItem Dimensions=\"{len}\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:{}</DataItem>",
+                    escape(&attribute_path(mesh, grid, k, c, at))
+                );
+                let _ = writeln!(out, "{pad}  </Attribute>");
+            }
         }
+        let _ = writeln!(out, "{pad}</Grid>");
     }
-    let _ = writeln!(out, "{pad}</Grid>");
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::{Provenance, Step};
+    use crate::output::{Provenance, RunOutput, Step};
 
     #[test]
     fn a_time_series_gives_one_temporal_collection_per_grid_document() {
@@ -202,11 +252,18 @@ mod tests {
             steps: vec![step(0.0), step(0.25)],
             provenance: Provenance::new(serde_json::Value::Null),
         };
-        let grids = grids(&run).unwrap();
-        assert_eq!(grids.iter().map(|g| g.degree).collect::<Vec<_>>(), [2, 1]);
-        assert_eq!(grid_name(&grids[1], 2), "edges");
+        let levels = Levels::of_run(&run);
+        let degrees = degrees(&levels);
+        assert_eq!(degrees, [2, 1]);
+        let grids = grids(&levels, &degrees).unwrap();
+        assert_eq!(grids.len(), 1);
+        assert_eq!(
+            grids[0].iter().map(|g| g.degree).collect::<Vec<_>>(),
+            [2, 1]
+        );
+        assert_eq!(grid_name(1, 2), "edges");
 
-        let cells = document(&run, &grids[0], "a&b.h5");
+        let cells = document(&levels, &grids, 0, "a&b.h5");
         assert_eq!(cells.matches("CollectionType=\"Temporal\"").count(), 1);
         assert!(cells
             .contains("<Grid Name=\"cells\" GridType=\"Collection\" CollectionType=\"Temporal\">"));
@@ -222,7 +279,7 @@ mod tests {
         assert!(!cells.contains("flux"));
         assert_eq!(cells.matches("<Grid ").count(), 1 + 2);
 
-        let edges = document(&run, &grids[1], "a&b.h5");
+        let edges = document(&levels, &grids, 1, "a&b.h5");
         assert!(edges
             .contains("<Grid Name=\"edges\" GridType=\"Collection\" CollectionType=\"Temporal\">"));
         assert_eq!(
@@ -254,15 +311,16 @@ mod tests {
             }],
             provenance: Provenance::new(serde_json::Value::Null),
         };
-        let grids = grids(&run).unwrap();
-        let text = document(&run, &grids[0], "r.h5");
+        let levels = Levels::of_run(&run);
+        let grids = grids(&levels, &degrees(&levels)).unwrap();
+        let text = document(&levels, &grids, 0, "r.h5");
         assert_eq!(text.matches("<Grid ").count(), 1);
         assert!(!text.contains("Collection"));
         assert!(!text.contains("<Time"));
         assert!(!text.contains("Name=\"q\""));
         assert!(text.contains("<DataItem Dimensions=\"2 4\" DataType=\"Int\" Precision=\"8\" Format=\"HDF\">r.h5:/xdmf/2/topology</DataItem>"));
         // 2×1 quads have 7 edges: 2 rows of 2 horizontal ones and 3 vertical ones.
-        let edges = document(&run, &grids[1], "r.h5");
+        let edges = document(&levels, &grids, 1, "r.h5");
         assert_eq!(edges.matches("<Grid ").count(), 1);
         assert!(!edges.contains("Collection"));
         assert!(edges.contains("<DataItem Dimensions=\"7\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">r.h5:/steps/0/q</DataItem>"));
