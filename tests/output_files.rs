@@ -7,7 +7,10 @@
 
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::output::{write_run, Cochain, OutputError, Provenance, RunOutput, Step};
+use hasse_solver::output::{
+    write_mesh_series, write_run, Cochain, MeshStep, OutputError, Provenance, RunOutput,
+    SeriesOutput, Step,
+};
 use hdf5::types::VarLenUnicode;
 use sprs::CsMat;
 use std::path::{Path, PathBuf};
@@ -100,28 +103,34 @@ fn usizes(v: &[u64]) -> Vec<usize> {
 /// The mesh part of the file equals the complex: coordinates, every M_p and
 /// every ∂_p rebuilt as a `CsMat` and compared with `complex.boundary(p)`.
 fn check_mesh(f: &hdf5::File, k: &Complex) {
+    check_mesh_at(f, "mesh", k);
+}
+
+/// [`check_mesh`] for the mesh stored in group `group` (`mesh`, or
+/// `steps/<k>/mesh` in a series).
+fn check_mesh_at(f: &hdf5::File, group: &str, k: &Complex) {
     let n = k.dim();
-    let mesh = f.group("mesh").unwrap();
+    let mesh = f.group(group).unwrap();
     assert_eq!(
         mesh.attr("dim").unwrap().read_scalar::<u64>().unwrap(),
         n as u64
     );
-    let vertices = f.dataset("mesh/vertices").unwrap();
+    let vertices = f.dataset(&format!("{group}/vertices")).unwrap();
     assert_eq!(vertices.shape(), vec![k.cell_count(0), 3]);
     let xyz = vertices.read_raw::<f64>().unwrap();
     for v in 0..k.cell_count(0) {
         assert_eq!(&xyz[3 * v..3 * v + 3], &point(k, v));
     }
     for p in 0..=n {
-        let indptr = usizes(&read_u64(f, &format!("mesh/cells/{p}/indptr")));
-        let indices = usizes(&read_u64(f, &format!("mesh/cells/{p}/indices")));
+        let indptr = usizes(&read_u64(f, &format!("{group}/cells/{p}/indptr")));
+        let indices = usizes(&read_u64(f, &format!("{group}/cells/{p}/indices")));
         assert_eq!(indptr.len(), k.cell_count(p) + 1);
         for i in 0..k.cell_count(p) {
             assert_eq!(&indices[indptr[i]..indptr[i + 1]], k.cell_vertices(p, i));
         }
     }
     for p in 1..=n {
-        let g = format!("mesh/boundary/{p}");
+        let g = format!("{group}/boundary/{p}");
         let shape: Vec<u64> = f
             .group(&g)
             .unwrap()
@@ -142,6 +151,14 @@ fn check_mesh(f: &hdf5::File, k: &Complex) {
         );
         assert_eq!(&m, k.boundary(p));
         assert_eq!((m.rows(), m.cols()), (k.cell_count(p - 1), k.cell_count(p)));
+    }
+    for (name, tag) in k.tags().iter() {
+        let ds = f.dataset(&format!("{group}/tags/{name}")).unwrap();
+        assert_eq!(usizes(&ds.read_raw::<u64>().unwrap()), tag.cells);
+        assert_eq!(
+            ds.attr("dim").unwrap().read_scalar::<u64>().unwrap(),
+            tag.dim as u64
+        );
     }
 }
 
@@ -219,6 +236,11 @@ fn quad_grid_round_trips_exactly() {
         1
     );
     assert_eq!(f.attr("times").unwrap().read_raw::<f64>().unwrap(), [0.0]);
+    // One mesh for all steps: the version-1 layout, flagged for readers.
+    let root_u64 = |name: &str| f.attr(name).unwrap().read_scalar::<u64>().unwrap();
+    assert_eq!(root_u64("mesh_changes"), 0);
+    assert_eq!(root_u64("format_version"), 1);
+    assert!(f.group("steps/0/mesh").is_err());
     let step = f.group("steps/0").unwrap();
     assert_eq!(
         step.attr("time").unwrap().read_scalar::<f64>().unwrap(),
@@ -242,14 +264,7 @@ fn quad_grid_round_trips_exactly() {
     assert!(flux.attr("units").is_err());
     assert_eq!(flux.read_raw::<f64>().unwrap().len(), 17);
 
-    for (name, tag) in k.tags().iter() {
-        let ds = f.dataset(&format!("mesh/tags/{name}")).unwrap();
-        assert_eq!(usizes(&ds.read_raw::<u64>().unwrap()), tag.cells);
-        assert_eq!(
-            ds.attr("dim").unwrap().read_scalar::<u64>().unwrap(),
-            tag.dim as u64
-        );
-    }
+    // Tags are compared by `check_mesh`; the 3×2 grid has 10 boundary edges.
     assert_eq!(read_u64(&f, "mesh/tags/boundary").len(), 10);
 
     let prov = f.group("provenance").unwrap();
@@ -881,4 +896,390 @@ fn stems_that_cannot_name_the_files_are_rejected() {
     let edges = std::fs::read_to_string(&files.extra_xdmf[0]).unwrap();
     assert!(edges.contains("TopologyType=\"Polyline\" NumberOfElements=\"7\""));
     assert!(edges.contains("edges-only.h5:/steps/0/q<"));
+}
+
+/// Mean of the vertices of p-cell i (exact for the dyadic grids used here).
+fn centroid(k: &Complex, p: usize, i: usize) -> [f64; 3] {
+    let vs = k.cell_vertices(p, i);
+    let mut c = [0.0; 3];
+    for &v in vs {
+        for (a, b) in c.iter_mut().zip(point(k, v)) {
+            *a += b;
+        }
+    }
+    c.map(|a| a / vs.len() as f64)
+}
+
+/// u = (1 + t)(x + 2y − z) on vertices, q = x + y of the edge midpoint + t,
+/// c = x − y of the cell centroid + 10t: analytic on every complex.
+fn analytic_cochains(k: &Complex, t: f64) -> Vec<Cochain> {
+    let n = k.dim();
+    let q = (0..k.cell_count(1))
+        .map(|e| {
+            let m = centroid(k, 1, e);
+            m[0] + m[1] + t
+        })
+        .collect();
+    let c = (0..k.cell_count(n))
+        .map(|i| {
+            let m = centroid(k, n, i);
+            m[0] - m[1] + 10.0 * t
+        })
+        .collect();
+    vec![
+        Cochain::new("u", 0, linear(k).iter().map(|u| (1.0 + t) * u).collect()).with_units("K"),
+        Cochain::new("q", 1, q),
+        Cochain::new("c", n, c),
+    ]
+}
+
+fn series<'a>(levels: &[(f64, &'a Complex)]) -> SeriesOutput<'a> {
+    SeriesOutput {
+        steps: levels
+            .iter()
+            .map(|&(time, complex)| MeshStep {
+                time,
+                complex,
+                cochains: analytic_cochains(complex, time),
+            })
+            .collect(),
+        provenance: run(levels[0].1, vec![]).provenance,
+    }
+}
+
+/// `(Dimensions, text)` of the one DataItem inside `<tag …>…</tag>` of `grid`.
+fn data_item<'x>(grid: &'x str, tag: &str) -> (&'x str, &'x str) {
+    let start = grid.find(&format!("<{tag} ")).expect(tag);
+    let end = grid[start..].find(&format!("</{tag}>")).expect(tag) + start;
+    let section = &grid[start..end];
+    let item = section.find("<DataItem ").expect("DataItem");
+    let dims = &section[item..];
+    let dims = &dims[dims.find("Dimensions=\"").unwrap() + 12..];
+    let dims = &dims[..dims.find('"').unwrap()];
+    let text = &section[item..];
+    let text = &text[text.find('>').unwrap() + 1..text.find("</DataItem>").unwrap()];
+    (dims, text)
+}
+
+/// The uniform grids of a document, in order.
+fn uniform_grids<'x>(xml: &'x str, name: &str) -> Vec<&'x str> {
+    let open = format!("<Grid Name=\"{name}\" GridType=\"Uniform\">");
+    xml.split(open.as_str())
+        .skip(1)
+        .map(|g| &g[..g.find("</Grid>").unwrap()])
+        .collect()
+}
+
+#[test]
+fn a_refinement_series_stores_each_mesh_with_its_step() {
+    let grids: Vec<Complex> = [2, 4, 8]
+        .iter()
+        .map(|&m| rectangle(m, m, [0.0, 1.0], [0.0, 1.0]).unwrap())
+        .collect();
+    let times = [0.0, 0.5, 1.25];
+    let levels: Vec<(f64, &Complex)> = times.iter().copied().zip(&grids).collect();
+    let dir = scratch("mesh-series");
+    let files = write_mesh_series(&dir.join("refine"), &series(&levels)).unwrap();
+    assert_eq!(files.hdf5, dir.join("refine.h5"));
+    assert_eq!(files.xdmf, dir.join("refine.xdmf"));
+    assert_eq!(files.extra_xdmf, [dir.join("refine.edges.xdmf")]);
+    assert_eq!(
+        files_in(&dir),
+        ["refine.edges.xdmf", "refine.h5", "refine.xdmf"]
+    );
+
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let root_u64 = |name: &str| f.attr(name).unwrap().read_scalar::<u64>().unwrap();
+    assert_eq!(root_u64("mesh_changes"), 1);
+    assert_eq!(root_u64("format_version"), 2);
+    assert_eq!(root_u64("step_count"), 3);
+    assert_eq!(f.attr("times").unwrap().read_raw::<f64>().unwrap(), times);
+    // No shared mesh: a reader that ignores `mesh_changes` fails loudly.
+    assert!(f.group("mesh").is_err() && f.group("xdmf").is_err());
+    for (k, (&t, grid)) in times.iter().zip(&grids).enumerate() {
+        let m = 2usize << k;
+        check_mesh_at(&f, &format!("steps/{k}/mesh"), grid);
+        assert_eq!(grid.cell_count(0), (m + 1) * (m + 1));
+        let g = f.group(&format!("steps/{k}")).unwrap();
+        assert_eq!(g.attr("time").unwrap().read_scalar::<f64>().unwrap(), t);
+        // The analytic values, recomputed from the coordinates read back.
+        let xyz = read_f64(&f, &format!("steps/{k}/mesh/vertices"));
+        let u: Vec<f64> = xyz
+            .chunks(3)
+            .map(|p| (1.0 + t) * (p[0] + 2.0 * p[1] - p[2]))
+            .collect();
+        assert_eq!(read_f64(&f, &format!("steps/{k}/u")), u);
+        let u_ds = f.dataset(&format!("steps/{k}/u")).unwrap();
+        assert_eq!(str_attr(&u_ds, "units"), "K");
+        for (name, values) in analytic_cochains(grid, t)
+            .into_iter()
+            .map(|c| (c.name, c.values))
+        {
+            assert_eq!(read_f64(&f, &format!("steps/{k}/{name}")), values, "{name}");
+        }
+        // The corner (1, 1) is the last vertex: u = (1 + t)·3.
+        assert_eq!(
+            *read_f64(&f, &format!("steps/{k}/u")).last().unwrap(),
+            3.0 * (1.0 + t)
+        );
+        // Quads of side 1/m, counter-clockwise; 2m(m + 1) edges.
+        let quads = f
+            .dataset(&format!("steps/{k}/mesh/xdmf/2/topology"))
+            .unwrap();
+        assert_eq!(quads.shape(), vec![m * m, 4]);
+        for q in quads.read_raw::<i64>().unwrap().chunks(4) {
+            let pts: Vec<[f64; 3]> = q.iter().map(|&v| point(grid, v as usize)).collect();
+            assert_eq!(shoelace(&pts), 1.0 / (m * m) as f64);
+        }
+        let edges = f
+            .dataset(&format!("steps/{k}/mesh/xdmf/1/topology"))
+            .unwrap();
+        assert_eq!(edges.shape(), vec![2 * m * (m + 1), 2]);
+    }
+
+    // Every XDMF file: one temporal collection of three grids, grid k
+    // taking geometry, topology and values from step k.
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    let edges_xml = std::fs::read_to_string(&files.extra_xdmf[0]).unwrap();
+    for (text, name) in [(&xml, "cells"), (&edges_xml, "edges")] {
+        assert_well_formed(text);
+        assert_eq!(text.matches("CollectionType=\"Temporal\"").count(), 1);
+        assert_eq!(text.matches("<Grid ").count(), 1 + 3);
+        assert_eq!(uniform_grids(text, name).len(), 3, "{name}");
+    }
+    for (k, (grid_xml, edge_xml)) in uniform_grids(&xml, "cells")
+        .into_iter()
+        .zip(uniform_grids(&edges_xml, "edges"))
+        .enumerate()
+    {
+        let m = 2usize << k;
+        let nv = (m + 1) * (m + 1);
+        assert!(grid_xml.contains(&format!("<Time Value=\"{:?}\"/>", times[k])));
+        assert!(grid_xml.contains(&format!(
+            "TopologyType=\"Quadrilateral\" NumberOfElements=\"{}\" NodesPerElement=\"4\"",
+            m * m
+        )));
+        let topology = format!("refine.h5:/steps/{k}/mesh/xdmf/2/topology");
+        assert_eq!(
+            data_item(grid_xml, "Topology"),
+            (format!("{} 4", m * m).as_str(), topology.as_str())
+        );
+        let geometry = format!("refine.h5:/steps/{k}/mesh/vertices");
+        let nv3 = format!("{nv} 3");
+        assert_eq!(
+            data_item(grid_xml, "Geometry"),
+            (nv3.as_str(), geometry.as_str())
+        );
+        assert!(grid_xml.contains(&format!(
+            "Dimensions=\"{nv}\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">refine.h5:/steps/{k}/u<"
+        )));
+        assert!(grid_xml.contains(&format!(
+            "Dimensions=\"{}\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">refine.h5:/steps/{k}/c<",
+            m * m
+        )));
+        assert!(!grid_xml.contains("/q<"));
+
+        let ne = 2 * m * (m + 1);
+        assert!(edge_xml.contains(&format!(
+            "TopologyType=\"Polyline\" NumberOfElements=\"{ne}\" NodesPerElement=\"2\""
+        )));
+        let topology = format!("refine.h5:/steps/{k}/mesh/xdmf/1/topology");
+        assert_eq!(data_item(edge_xml, "Topology").1, topology);
+        assert_eq!(
+            data_item(edge_xml, "Geometry"),
+            (nv3.as_str(), geometry.as_str())
+        );
+        assert!(edge_xml.contains(&format!(
+            "Dimensions=\"{ne}\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">refine.h5:/steps/{k}/q<"
+        )));
+        assert_eq!(edge_xml.matches("<Attribute ").count(), 1);
+    }
+}
+
+#[test]
+fn a_series_with_split_polyhedra_keeps_the_expanded_values_with_each_mesh() {
+    // Step 0: a cube of two prisms (written as tetrahedra); step 1: two hexahedra.
+    let v = Vertices::from_points(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+    ])
+    .unwrap();
+    let prism = |a: usize, b: usize, c: usize| {
+        vec![
+            vec![a, b, c],
+            vec![a + 4, b + 4, c + 4],
+            vec![a, b, b + 4, a + 4],
+            vec![b, c, c + 4, b + 4],
+            vec![c, a, a + 4, c + 4],
+        ]
+    };
+    let prisms = Complex::build(v, TopCells::polyhedra([prism(0, 1, 2), prism(0, 2, 3)])).unwrap();
+    let hexes = box3(2, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    fn step(time: f64, complex: &Complex, p: Vec<f64>) -> MeshStep<'_> {
+        MeshStep {
+            time,
+            complex,
+            cochains: vec![Cochain::new("p", 3, p)],
+        }
+    }
+    let out = SeriesOutput {
+        steps: vec![
+            step(0.0, &prisms, vec![10.0, 20.0]),
+            step(1.0, &hexes, vec![30.0, 40.0]),
+        ],
+        provenance: Provenance::new(serde_json::Value::Null),
+    };
+    let dir = scratch("mesh-series-split");
+    let files = write_mesh_series(&dir.join("split"), &out).unwrap();
+    assert!(files.extra_xdmf.is_empty());
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    check_mesh_at(&f, "steps/0/mesh", &prisms);
+    check_mesh_at(&f, "steps/1/mesh", &hexes);
+    let ids = usizes(&read_u64(&f, "steps/0/mesh/xdmf/3/cell_ids"));
+    assert_eq!(ids.len(), 6);
+    let expected: Vec<f64> = ids.iter().map(|&c| [10.0, 20.0][c]).collect();
+    assert_eq!(read_f64(&f, "steps/0/mesh/xdmf/3/steps/0/p"), expected);
+    // Hexahedra need no expansion.
+    assert!(f.dataset("steps/1/mesh/xdmf/3/cell_ids").is_err());
+    assert_eq!(read_f64(&f, "steps/1/p"), [30.0, 40.0]);
+    let xml = std::fs::read_to_string(&files.xdmf).unwrap();
+    assert_well_formed(&xml);
+    let grids = uniform_grids(&xml, "cells");
+    assert_eq!(grids.len(), 2);
+    assert!(grids[0].contains("TopologyType=\"Tetrahedron\" NumberOfElements=\"6\""));
+    assert!(grids[0].contains(">split.h5:/steps/0/mesh/xdmf/3/steps/0/p<"));
+    assert!(grids[1].contains("TopologyType=\"Hexahedron\" NumberOfElements=\"2\""));
+    assert!(grids[1].contains(">split.h5:/steps/1/p<"));
+}
+
+#[test]
+fn a_bad_mesh_series_is_rejected_before_anything_is_written() {
+    let coarse = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let fine = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let dir = scratch("mesh-series-bad");
+    let stem = dir.join("bad");
+    let good = || series(&[(0.0, &coarse), (1.0, &fine)]);
+
+    // Step 1's u sized for step 0's mesh: checked against step 1's complex.
+    let mut s = good();
+    s.steps[1].cochains[0].values = linear(&coarse);
+    match write_mesh_series(&stem, &s) {
+        Err(OutputError::Shape {
+            step: 1,
+            name,
+            dim: 0,
+            expected: 25,
+            got: 9,
+        }) => assert_eq!(name, "u"),
+        other => panic!("expected a shape error, got {other:?}"),
+    }
+    let mut s = good();
+    s.steps[1].cochains[2].values[3] = f64::NAN;
+    assert!(matches!(
+        write_mesh_series(&stem, &s),
+        Err(OutputError::NonFinite {
+            step: 1,
+            dim: 2,
+            cell: 3,
+            ..
+        })
+    ));
+    let mut s = good();
+    let copy = s.steps[1].cochains[1].clone();
+    s.steps[1].cochains.push(copy);
+    assert!(matches!(
+        write_mesh_series(&stem, &s),
+        Err(OutputError::DuplicateName { step: 1, .. })
+    ));
+    let mut s = good();
+    s.steps[1].time = 0.0;
+    assert!(matches!(
+        write_mesh_series(&stem, &s),
+        Err(OutputError::Time { step: 1, .. })
+    ));
+    let mut s = good();
+    s.steps[0].cochains.push(Cochain::new("w", 3, vec![]));
+    assert!(matches!(
+        write_mesh_series(&stem, &s),
+        Err(OutputError::Degree {
+            step: 0,
+            dim: 3,
+            complex_dim: 2,
+            ..
+        })
+    ));
+    // A cochain may not take the name of the step's mesh group.
+    let mut s = good();
+    s.steps[0]
+        .cochains
+        .push(Cochain::new("mesh", 0, vec![0.0; 9]));
+    assert!(matches!(
+        write_mesh_series(&stem, &s),
+        Err(OutputError::InvalidName { .. })
+    ));
+    let line = hasse_complex::generate::interval(2, 0.0, 1.0).unwrap();
+    let mixed = series(&[(0.0, &coarse), (1.0, &line)]);
+    assert!(matches!(
+        write_mesh_series(&stem, &mixed),
+        Err(OutputError::MeshDimension {
+            step: 1,
+            dim: 1,
+            expected: 2
+        })
+    ));
+    let empty = SeriesOutput {
+        steps: vec![],
+        provenance: Provenance::new(serde_json::Value::Null),
+    };
+    assert!(matches!(
+        write_mesh_series(&stem, &empty),
+        Err(OutputError::EmptySeries)
+    ));
+    assert!(
+        !dir.exists(),
+        "a rejected series must not create the directory"
+    );
+
+    // An older output survives a series that fails halfway through the h5
+    // (NUL in the case text), and no temporary is left.
+    let first = write_run(
+        &stem,
+        &steady(&coarse, vec![Cochain::new("q", 1, vec![0.5; 12])]),
+    )
+    .unwrap();
+    let before: Vec<Vec<u8>> = [&first.hdf5, &first.xdmf, &first.extra_xdmf[0]]
+        .iter()
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
+    let mut late = good();
+    late.provenance.case_text = Some("a\0b".into());
+    assert!(matches!(
+        write_mesh_series(&stem, &late),
+        Err(OutputError::Text { .. })
+    ));
+    let after: Vec<Vec<u8>> = [&first.hdf5, &first.xdmf, &first.extra_xdmf[0]]
+        .iter()
+        .map(|p| std::fs::read(p).unwrap())
+        .collect();
+    assert!(before == after);
+    assert_eq!(files_in(&dir), ["bad.edges.xdmf", "bad.h5", "bad.xdmf"]);
+
+    // A complete series then replaces it.
+    let files = write_mesh_series(&stem, &good()).unwrap();
+    assert_eq!(files.extra_xdmf, [dir.join("bad.edges.xdmf")]);
+    let f = hdf5::File::open(&files.hdf5).unwrap();
+    assert_eq!(
+        f.attr("mesh_changes")
+            .unwrap()
+            .read_scalar::<u64>()
+            .unwrap(),
+        1
+    );
+    assert_eq!(files_in(&dir), ["bad.edges.xdmf", "bad.h5", "bad.xdmf"]);
 }
