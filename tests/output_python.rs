@@ -3,7 +3,10 @@
 //! steady run, the main `<stem>.xdmf` and the `<stem>.edges.xdmf` of edge
 //! cochains; `meshio.xdmf.TimeSeriesReader` on both files of a time
 //! series) and compares with the values this test computes from analytic
-//! formulas.
+//! formulas. A series whose mesh changes (`write_mesh_series`) is read
+//! with h5py step by step, its XDMF files are parsed with `xml.etree` to
+//! check that grid k points at step k's mesh, and meshio's
+//! `TimeSeriesReader` is shown to give the first step's mesh only.
 //!
 //! Python runs in a private venv at `<target>/pyenv` (see
 //! `common/pyenv.rs`). Without network the test fails under `CI` and is
@@ -14,7 +17,9 @@ mod pyenv;
 
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::output::{write_run, Cochain, Provenance, RunOutput, Step};
+use hasse_solver::output::{
+    write_mesh_series, write_run, Cochain, MeshStep, Provenance, RunOutput, SeriesOutput, Step,
+};
 use serde_json::{json, Value};
 use std::path::Path;
 use std::process::Command;
@@ -256,8 +261,14 @@ fn h5py_and_meshio_read_the_output() {
     });
     cases.push(series);
 
+    let mesh_series = vec![mesh_series_case(&dir)];
+
     let manifest = dir.join("manifest.json");
-    std::fs::write(&manifest, json!({ "cases": cases }).to_string()).unwrap();
+    std::fs::write(
+        &manifest,
+        json!({ "cases": cases, "mesh_series": mesh_series }).to_string(),
+    )
+    .unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/python/check_output.py");
     let out = Command::new(&python)
         .arg(&script)
@@ -272,8 +283,100 @@ fn h5py_and_meshio_read_the_output() {
         "check_output.py failed:\n{stdout}\n{stderr}"
     );
     // One line per case (seven) and one per edges file read back (two
-    // steady cases and the series).
+    // steady cases and the series), then for the series whose mesh
+    // changes one line each for h5py, the two XDMF files and meshio.
     let ok: Vec<&str> = stdout.lines().filter(|l| l.starts_with("ok ")).collect();
-    assert_eq!(ok.iter().filter(|l| !l.contains("edges file")).count(), 7);
-    assert_eq!(ok.iter().filter(|l| l.contains("edges file")).count(), 3);
+    let changing = |l: &&&str| l.contains("mesh series");
+    assert_eq!(
+        ok.iter()
+            .filter(|l| !l.contains("edges file") && !changing(l))
+            .count(),
+        7
+    );
+    assert_eq!(
+        ok.iter()
+            .filter(|l| l.contains("edges file") && !changing(l))
+            .count(),
+        3
+    );
+    assert_eq!(ok.iter().filter(changing).count(), 4);
+}
+
+/// A series whose mesh changes: the 2×2 and 4×4 quads, then the 4×4 Kuhn
+/// triangulation, with u = (1 + t)(x + 2y + 3z) on vertices, the edge
+/// values 0.25 (i + 1) + 2t and the cell values 10 + 0.5 i + t. The
+/// manifest lists, per step, what h5py must find under `/steps/<k>` and
+/// what grid k of each XDMF file must point at.
+fn mesh_series_case(dir: &Path) -> Value {
+    let x = uniform_axis(4, 0.0, 1.0).unwrap();
+    let meshes = [
+        (
+            0.0,
+            rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap(),
+            "Quadrilateral",
+            4,
+        ),
+        (
+            0.5,
+            rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap(),
+            "Quadrilateral",
+            4,
+        ),
+        (1.5, kuhn(&[x.clone(), x]).unwrap(), "Triangle", 3),
+    ];
+    let values = |k: &Complex, t: f64| {
+        (
+            linear(k).iter().map(|u| (1.0 + t) * u).collect::<Vec<_>>(),
+            edge_series(k, t),
+            per_cell(k, 2).iter().map(|c| c + t).collect::<Vec<_>>(),
+        )
+    };
+    let series = SeriesOutput {
+        steps: meshes
+            .iter()
+            .map(|(t, k, _, _)| {
+                let (u, q, c) = values(k, *t);
+                MeshStep {
+                    time: *t,
+                    complex: k,
+                    cochains: vec![
+                        Cochain::new("u", 0, u),
+                        Cochain::new("q", 1, q),
+                        Cochain::new("c", 2, c),
+                    ],
+                }
+            })
+            .collect(),
+        provenance: provenance(),
+    };
+    let files = write_mesh_series(&dir.join("growing"), &series).unwrap();
+    assert_eq!(files.extra_xdmf, [dir.join("growing.edges.xdmf")]);
+    let steps: Vec<Value> = meshes
+        .iter()
+        .map(|(t, k, kind, nodes)| {
+            let (u, q, c) = values(k, *t);
+            let shapes: serde_json::Map<String, Value> = (1..=k.dim())
+                .map(|p| (p.to_string(), json!([k.cell_count(p - 1), k.cell_count(p)])))
+                .collect();
+            json!({
+                "vertices": padded(k),
+                "cell_counts": (0..=k.dim()).map(|p| k.cell_count(p)).collect::<Vec<_>>(),
+                "boundary_shapes": shapes,
+                "fields": {"u": u, "q": q, "c": c},
+                "field_dims": {"u": 0, "q": 1, "c": 2},
+                "top_type": kind,
+                "top_nodes": nodes,
+            })
+        })
+        .collect();
+    json!({
+        "name": "growing",
+        "h5": files.hdf5,
+        "xdmf": files.xdmf,
+        "edges_xdmf": files.extra_xdmf[0],
+        "dim": 2,
+        "times": meshes.iter().map(|m| m.0).collect::<Vec<_>>(),
+        "steps": steps,
+        "hasse_version": env!("CARGO_PKG_VERSION"),
+    })
 }

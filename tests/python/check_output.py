@@ -11,9 +11,16 @@ A case with "edges" also has an edge cochain: its main <stem>.xdmf must
 still be readable by meshio (top cells only), and <stem>.edges.xdmf must be
 readable too, with one line cell per edge, in edge-id order, carrying the
 edge values.
+
+A "mesh_series" case is a series whose mesh changes (write_mesh_series):
+h5py reads step k's mesh and fields from /steps/<k> with the recipe of
+cases/OUTPUT.md, xml.etree checks that grid k of every XDMF file points at
+step k's mesh with the right element counts, and meshio's TimeSeriesReader
+is shown to return the first step's mesh only (the documented limitation).
 """
 
 import json
+import xml.etree.ElementTree as ET
 import sys
 from pathlib import Path
 
@@ -154,8 +161,127 @@ def check_series(case):
                 equal(np.concatenate(cell_data[name]), values, f"step {k} cell_data {name}")
 
 
+def read_step(f, k):
+    """The recipe of cases/OUTPUT.md: step k's mesh and fields of a file
+    whose mesh changes (root attribute mesh_changes == 1)."""
+    step = f[f"steps/{k}"]
+    mesh = step["mesh"]
+    points = mesh["vertices"][()]
+    cells = {}
+    for p, g in mesh["cells"].items():
+        indptr, indices = g["indptr"][()], g["indices"][()]
+        cells[int(p)] = [indices[indptr[i] : indptr[i + 1]] for i in range(len(indptr) - 1)]
+    fields = {name: (int(ds.attrs["dim"]), ds[()]) for name, ds in step.items() if name != "mesh"}
+    return float(step.attrs["time"]), points, cells, fields
+
+
+def check_mesh_series_h5(case):
+    with h5py.File(case["h5"], "r") as f:
+        assert int(f.attrs["mesh_changes"]) == 1, "mesh_changes"
+        assert int(f.attrs["format_version"]) == 2, "format_version"
+        assert int(f.attrs["step_count"]) == len(case["steps"]), "step_count"
+        equal(f.attrs["times"], case["times"], "times")
+        assert "mesh" not in f and "xdmf" not in f, f"shared mesh groups in {list(f)}"
+        assert f["provenance"].attrs["hasse_version"] == case["hasse_version"]
+        for k, expected in enumerate(case["steps"]):
+            t, points, cells, fields = read_step(f, k)
+            assert t == case["times"][k], f"step {k}: time {t}"
+            equal(points, expected["vertices"], f"step {k} vertices")
+            counts = [len(cells[p]) for p in range(len(cells))]
+            assert counts == expected["cell_counts"], f"step {k}: cell counts {counts}"
+            assert int(f[f"steps/{k}/mesh"].attrs["dim"]) == case["dim"]
+            for p, (rows, cols) in expected["boundary_shapes"].items():
+                g = f[f"steps/{k}/mesh/boundary/{p}"]
+                equal(g.attrs["shape"], [rows, cols], f"step {k} shape of boundary {p}")
+                assert len(g["indptr"]) == rows + 1, f"step {k} boundary {p}: indptr"
+            # Every edge of cells[1] is two vertices of this step's mesh.
+            assert all(len(e) == 2 and e.max() < len(points) for e in cells[1]), f"step {k} edges"
+            assert set(fields) == set(expected["fields"]), f"step {k} fields {list(fields)}"
+            for name, values in expected["fields"].items():
+                dim, got = fields[name]
+                assert dim == expected["field_dims"][name], f"step {k} {name}: dim {dim}"
+                assert len(got) == counts[dim], f"step {k} {name}: {len(got)} values"
+                equal(got, values, f"step {k} {name}")
+
+
+def check_mesh_series_xdmf(case, path, degree, grid_name):
+    """Grid k of the temporal collection takes topology and geometry from
+    /steps/<k>/mesh, with NumberOfElements the count of step k's cells."""
+    h5_name = Path(case["h5"]).name
+    root = ET.parse(path).getroot()
+    (domain,) = list(root)
+    (collection,) = list(domain)
+    assert collection.get("CollectionType") == "Temporal", f"{path}: not temporal"
+    grids = list(collection)
+    assert len(grids) == len(case["steps"]), f"{path}: {len(grids)} grids"
+    with h5py.File(case["h5"], "r") as f:
+        for k, (grid, expected) in enumerate(zip(grids, case["steps"])):
+            assert grid.get("Name") == grid_name and grid.get("GridType") == "Uniform"
+            assert float(grid.find("Time").get("Value")) == case["times"][k], f"grid {k} time"
+            count = expected["cell_counts"][degree]
+            nv = len(expected["vertices"])
+            top = grid.find("Topology")
+            assert int(top.get("NumberOfElements")) == count, f"{path} grid {k}: elements"
+            nodes = 2 if degree == 1 else expected["top_nodes"]
+            kind = "Polyline" if degree == 1 else expected["top_type"]
+            assert top.get("TopologyType") == kind, f"{path} grid {k}: {top.get('TopologyType')}"
+            item = top.find("DataItem")
+            assert item.text == f"{h5_name}:/steps/{k}/mesh/xdmf/{degree}/topology", item.text
+            assert item.get("Dimensions") == f"{count} {nodes}", item.get("Dimensions")
+            conn = f[item.text.split(":", 1)[1]][()]
+            assert conn.shape == (count, nodes), f"grid {k}: topology shape {conn.shape}"
+            assert conn.min() >= 0 and conn.max() < nv, f"grid {k}: vertex ids out of range"
+            geo = grid.find("Geometry").find("DataItem")
+            assert geo.text == f"{h5_name}:/steps/{k}/mesh/vertices", geo.text
+            assert geo.get("Dimensions") == f"{nv} 3", geo.get("Dimensions")
+            equal(f[geo.text.split(":", 1)[1]][()], expected["vertices"], f"grid {k} geometry")
+            # The attributes read step k's values, sized for step k's mesh.
+            shown = {}
+            for attr in grid.findall("Attribute"):
+                item = attr.find("DataItem")
+                name = attr.get("Name")
+                assert item.text == f"{h5_name}:/steps/{k}/{name}", item.text
+                size = nv if attr.get("Center") == "Node" else count
+                assert item.get("Dimensions") == str(size), f"grid {k} {name}"
+                shown[name] = f[item.text.split(":", 1)[1]][()]
+            wanted = {
+                n: v
+                for n, v in expected["fields"].items()
+                if expected["field_dims"][n] == degree
+                or (degree == case["dim"] and expected["field_dims"][n] == 0)
+            }
+            assert set(shown) == set(wanted), f"{path} grid {k}: attributes {list(shown)}"
+            for name, values in wanted.items():
+                equal(shown[name], values, f"{path} grid {k} {name}")
+
+
+def check_mesh_series_meshio(case):
+    """meshio's TimeSeriesReader takes points and cells from the first grid
+    only (read_points_cells) and reads nothing but Time and Attribute of
+    grid k (read_data), so step k's data comes without step k's mesh."""
+    steps = case["steps"]
+    with meshio.xdmf.TimeSeriesReader(case["xdmf"]) as reader:
+        points, cells = reader.read_points_cells()
+        equal(points, steps[0]["vertices"], "meshio series points (step 0's mesh)")
+        last = len(steps) - 1
+        _, point_data, _ = reader.read_data(last)
+        assert len(point_data["u"]) == len(steps[last]["vertices"]) != len(points), (
+            "meshio's TimeSeriesReader now reads each grid's own mesh: update cases/OUTPUT.md"
+        )
+
+
 def main():
     manifest = json.loads(Path(sys.argv[1]).read_text())
+    for case in manifest.get("mesh_series", []):
+        name = case["name"]
+        check_mesh_series_h5(case)
+        print(f"ok mesh series {name}: h5py reads {len(case['steps'])} steps' meshes and fields")
+        check_mesh_series_xdmf(case, case["xdmf"], case["dim"], "cells")
+        print(f"ok mesh series {name}: {Path(case['xdmf']).name} grid k points at /steps/k/mesh")
+        check_mesh_series_xdmf(case, case["edges_xdmf"], 1, "edges")
+        print(f"ok mesh series {name}: {Path(case['edges_xdmf']).name} grid k points at /steps/k/mesh")
+        check_mesh_series_meshio(case)
+        print(f"ok mesh series {name}: meshio TimeSeriesReader gives step 0's mesh only, as documented")
     for case in manifest["cases"]:
         sets = check_h5(case)
         if len(case["times"]) > 1:
