@@ -8,7 +8,7 @@
 //!
 //! | path | content |
 //! | --- | --- |
-//! | `/` attrs `step_count` (u64), `times` (f64 array), `format` = `"hasse-output"`, `format_version` (u64) | |
+//! | `/` attrs `step_count` (u64), `times` (f64 array), `format` = `"hasse-output"`, `format_version` (u64: 1, or 2 for a mesh series), `mesh_changes` (u64: 0, or 1 for a mesh series) | |
 //! | `/mesh` attrs `dim` (n), `embedding_dim` (d) | |
 //! | `/mesh/vertices` | (N, 3) f64, zero-padded when d < 3; attr `embedding_dim` |
 //! | `/mesh/cells/<p>/indptr`, `indices` | CSR characteristic matrix M_p (u64), p = 0..=n; attr `shape` = (rows, cols). Row i lists the sorted vertex ids of p-cell i; p-cell ids everywhere else are these row numbers |
@@ -24,6 +24,18 @@
 //!
 //! Strings are variable-length UTF-8, so h5py returns attributes as `str`
 //! (string datasets need `.asstr()[()]`).
+//!
+//! # Series whose mesh changes ([`write_mesh_series`])
+//!
+//! Root attr `mesh_changes` = 1, `format_version` = 2; there is no `/mesh`
+//! and no `/xdmf`. Instead each level k has its own mesh inside its step:
+//! `/steps/<k>/mesh` holds what `/mesh` holds above (attrs, `vertices`,
+//! `cells/<p>`, `boundary/<p>`, `tags/<name>`, with that step's cell ids),
+//! and `/steps/<k>/mesh/xdmf` what `/xdmf` holds, for level k only
+//! (`<p>/topology`, `<p>/cell_ids`, `<p>/steps/<k>/<name>`). The cochains
+//! stay in `/steps/<k>/<name>`, so no cochain of a series may be named
+//! `mesh`. In the XDMF files, the k-th grid of the temporal collection
+//! reads its geometry and topology from `/steps/<k>/mesh`.
 //!
 //! # XDMF (`<stem>.xdmf`, `<stem>.edges.xdmf`, `<stem>.faces.xdmf`)
 //!
@@ -49,7 +61,9 @@
 //! 'Grid'") and `meshio.xdmf.TimeSeriesReader` only one temporal
 //! collection, so one grid per file lets meshio read every file, while
 //! ParaView opens each. One time level gives a plain uniform grid,
-//! several give a temporal collection.
+//! several give a temporal collection. `TimeSeriesReader` takes the mesh of the
+//! first grid only, so it cannot read a series whose mesh changes; h5py
+//! can (`cases/OUTPUT.md`).
 
 mod hdf5_file;
 mod topology;
