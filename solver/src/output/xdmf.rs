@@ -235,7 +235,7 @@ impl Grid<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::{Provenance, RunOutput, Step};
+    use crate::output::{MeshStep, Provenance, RunOutput, SeriesOutput, Step};
 
     #[test]
     fn a_time_series_gives_one_temporal_collection_per_grid_document() {
@@ -325,5 +325,54 @@ mod tests {
         assert!(!edges.contains("Collection"));
         assert!(edges.contains("<DataItem Dimensions=\"7\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">r.h5:/steps/0/q</DataItem>"));
         assert!(!edges.contains("Name=\"p\""));
+    }
+
+    #[test]
+    fn series_grids_read_their_own_step_mesh() {
+        let coarse = hasse_complex::generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let fine = hasse_complex::generate::rectangle(2, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let one = SeriesOutput {
+            steps: vec![MeshStep {
+                time: 3.0,
+                complex: &fine,
+                cochains: vec![Cochain::new("c", 2, vec![1.0, 2.0])],
+            }],
+            provenance: Provenance::new(serde_json::Value::Null),
+        };
+        let levels = Levels::of_series(&one);
+        let meshes = grids(&levels, &degrees(&levels)).unwrap();
+        let text = document(&levels, &meshes, 0, "s.h5");
+        // One step: a plain uniform grid, still on the step's own mesh.
+        assert!(!text.contains("Collection") && !text.contains("<Time"));
+        assert!(text.contains(">s.h5:/steps/0/mesh/vertices<"));
+        assert!(text.contains(">s.h5:/steps/0/mesh/xdmf/2/topology<"));
+        assert!(text.contains(">s.h5:/steps/0/c<"));
+        assert!(!text.contains(":/mesh/") && !text.contains(":/xdmf/"));
+
+        let two = SeriesOutput {
+            steps: vec![
+                MeshStep {
+                    time: 0.0,
+                    complex: &coarse,
+                    cochains: vec![],
+                },
+                MeshStep {
+                    time: 1.0,
+                    complex: &fine,
+                    cochains: vec![],
+                },
+            ],
+            provenance: Provenance::new(serde_json::Value::Null),
+        };
+        let levels = Levels::of_series(&two);
+        let meshes = grids(&levels, &degrees(&levels)).unwrap();
+        assert_eq!(meshes.len(), 2);
+        let text = document(&levels, &meshes, 0, "s.h5");
+        assert_eq!(text.matches("CollectionType=\"Temporal\"").count(), 1);
+        assert!(text.contains("NumberOfElements=\"1\" NodesPerElement=\"4\""));
+        assert!(text.contains("NumberOfElements=\"2\" NodesPerElement=\"4\""));
+        assert!(text.contains("Dimensions=\"4 3\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">s.h5:/steps/0/mesh/vertices<"));
+        assert!(text.contains("Dimensions=\"6 3\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">s.h5:/steps/1/mesh/vertices<"));
+        assert!(!text.contains("<Attribute"));
     }
 }
