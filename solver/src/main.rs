@@ -334,7 +334,11 @@ fn run_case(
             match refinement::refine_and_solve(&case, &complex, spec, &mut |name| {
                 progress.phase(name)
             }) {
-                Ok(study) => (study.complex, Some(study.steps), Ok(study.result)),
+                Ok(study) => (
+                    study.complex,
+                    Some((study.steps, study.levels)),
+                    Ok(study.result),
+                ),
                 Err(e) => (complex, None, Err(e)),
             }
         }
@@ -358,7 +362,16 @@ fn run_case(
         let stem = output
             .map(Path::to_path_buf)
             .unwrap_or_else(|| case.output.directory.join(&case.output.name));
-        match run::write_output(&case, &complex, &result, &stem) {
+        let written = match &study {
+            // A refinement writes every level, each on its own mesh.
+            Some((steps, levels)) => {
+                let mut report = result.report_json(&complex);
+                report["refinement"] = refinement::steps_json(steps);
+                run::write_levels(&case, levels, report, &stem)
+            }
+            None => run::write_output(&case, &complex, &result, &stem),
+        };
+        match written {
             Ok(files) => Some(files),
             Err(e) => {
                 progress.finish();
@@ -381,7 +394,7 @@ fn run_case(
             complex_kind(&complex),
             complex.cell_counts()
         );
-        if let Some(steps) = &study {
+        if let Some((steps, _)) = &study {
             println!("refinement {}", refinement::TABLE_HEADER);
             for step in steps {
                 println!("           {step}");

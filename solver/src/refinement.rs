@@ -103,6 +103,9 @@ pub struct StepReport {
 /// The study's steps, the final complex and its solution.
 pub struct RefinementStudy {
     pub steps: Vec<StepReport>,
+    /// Every level's complex and fields (`u`, and `u_exact`, `error` when
+    /// the case has an exact solution), for a time series whose mesh changes.
+    pub levels: Vec<(Complex, Vec<run::Field>)>,
     pub complex: Complex,
     pub result: run::RunResult,
 }
@@ -221,6 +224,49 @@ fn diffusion_of(case: &Case) -> Result<Diffusion, RunError> {
     }
 }
 
+/// The primary field of a level and, with an exact solution, its error.
+fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<run::Field> {
+    let dim = match solution.location {
+        Location::Nodal => 0,
+        _ => complex.dim(),
+    };
+    let u = solution.field(complex).to_vec();
+    let mut fields = Vec::new();
+    if let Some(exact) = &case.exact {
+        let points: Vec<Vec<f64>> = match &solution.cell_points {
+            Some(given) => given
+                .chunks(complex.embedding_dim())
+                .map(<[f64]>::to_vec)
+                .collect(),
+            None => run::field_points(complex, dim),
+        };
+        let exact_values: Vec<f64> = points.iter().map(|x| exact.solution.eval(x, 0.0)).collect();
+        let error = u.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
+        fields.push(run::Field {
+            name: "u_exact".into(),
+            dim,
+            values: exact_values,
+            description: "the exact solution".into(),
+        });
+        fields.push(run::Field {
+            name: "error".into(),
+            dim,
+            values: error,
+            description: "u − u_exact".into(),
+        });
+    }
+    fields.insert(
+        0,
+        run::Field {
+            name: "u".into(),
+            dim,
+            values: u,
+            description: "the solution on this level".into(),
+        },
+    );
+    fields
+}
+
 fn report(
     step: usize,
     complex: &Complex,
@@ -270,6 +316,7 @@ pub fn refine_and_solve(
         &solution,
         started.elapsed().as_secs_f64(),
     )];
+    let mut levels = vec![(current.clone(), level_fields(case, &current, &solution))];
     for step in 1..=spec.steps {
         phase(&format!("step {step}: refining ({})", spec.strategy.name()));
         let started = std::time::Instant::now();
@@ -307,6 +354,7 @@ pub fn refine_and_solve(
         r.warm_iterations = warm.iterations.map(|c| c.iterations);
         r.warm_initial_residual = warm.iterations.map(|c| c.initial_residual);
         steps.push(r);
+        levels.push((fine.clone(), level_fields(case, &fine, &warm)));
         current = fine;
         solution = warm;
     }
@@ -314,6 +362,7 @@ pub fn refine_and_solve(
     let result = run::solve(case, &current, &mut |_| {})?;
     Ok(RefinementStudy {
         steps,
+        levels,
         complex: current,
         result,
     })
@@ -343,3 +392,25 @@ impl fmt::Display for StepReport {
 /// The header matching [`StepReport`]'s `Display`.
 pub const TABLE_HEADER: &str =
     "step     cells  unknowns    L2 error   max error  grad error   cold   warm    marked";
+
+/// The steps as JSON (stored in the output's provenance report).
+pub fn steps_json(steps: &[StepReport]) -> serde_json::Value {
+    steps
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "step": s.step,
+                "cells": s.cells,
+                "unknowns": s.unknowns,
+                "marked": s.marked,
+                "l2": s.l2,
+                "max": s.max,
+                "gradient_l2": s.gradient_l2,
+                "cold_iterations": s.cold_iterations,
+                "warm_iterations": s.warm_iterations,
+                "warm_initial_residual": s.warm_initial_residual,
+                "seconds": s.seconds,
+            })
+        })
+        .collect()
+}

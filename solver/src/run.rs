@@ -337,7 +337,7 @@ fn check_residual(case: &Case, residual: f64, warnings: &mut Vec<String>) -> Res
 }
 
 /// Where the values of a `dim`-cochain are sampled: vertices or centroids.
-fn field_points(complex: &Complex, dim: usize) -> Vec<Vec<f64>> {
+pub(crate) fn field_points(complex: &Complex, dim: usize) -> Vec<Vec<f64>> {
     let d = complex.embedding_dim();
     if dim == 0 {
         (0..complex.cell_count(0))
@@ -612,4 +612,39 @@ pub fn write_output(
         provenance,
     };
     crate::output::write_run(stem, &run)
+}
+
+/// Write a refinement study as a time series whose mesh changes: level k
+/// at "time" k, each with its own complex (see `cases/OUTPUT.md`).
+pub fn write_levels(
+    case: &Case,
+    levels: &[(Complex, Vec<Field>)],
+    report: serde_json::Value,
+    stem: &std::path::Path,
+) -> Result<crate::output::OutputFiles, crate::output::OutputError> {
+    use crate::output::{Cochain, MeshStep, Provenance, SeriesOutput};
+    let method = case.method().map(|m| m.name().to_string());
+    let steps = levels
+        .iter()
+        .enumerate()
+        .map(|(k, (complex, fields))| MeshStep {
+            time: k as f64,
+            complex,
+            cochains: fields
+                .iter()
+                .map(|f| {
+                    let c = Cochain::new(f.name.clone(), f.dim, f.values.clone())
+                        .with_description(f.description.clone());
+                    match &method {
+                        Some(m) => c.with_method(m.clone()),
+                        None => c,
+                    }
+                })
+                .collect(),
+        })
+        .collect();
+    let mut provenance = Provenance::new(report);
+    provenance.case_text = Some(case.text.clone());
+    provenance.case_path = Some(case.path.display().to_string());
+    crate::output::write_mesh_series(stem, &SeriesOutput { steps, provenance })
 }
