@@ -5,6 +5,7 @@
 //! case files, output and the `hasse` command line.
 
 pub mod canonical;
+pub mod converge;
 pub mod case;
 pub mod diffusion;
 pub mod info;
