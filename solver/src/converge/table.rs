@@ -28,12 +28,26 @@ impl fmt::Display for StudyResult {
     ///     methods: vec!["fd".into()], rows: vec![row(0, 0.2, 4e-2), row(1, 0.1, 1e-2)],
     /// };
     /// let table = result.to_string();
-    /// assert!(table.contains("fd      1  16×16"));
+    /// assert!(table.contains("fd         1  16×16"));
     /// assert!(table.contains("least squares"));
     /// assert!(table.contains("2.00")); // L² order
     /// assert!(table.contains("1.00")); // flux order
     /// ```
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Built whole, then written line by line without trailing blanks
+        // (columns a method lacks would otherwise leave them).
+        let mut text = String::new();
+        self.write_table(&mut text)?;
+        for line in text.lines() {
+            writeln!(out, "{}", line.trim_end())?;
+        }
+        Ok(())
+    }
+}
+
+impl StudyResult {
+    fn write_table(&self, f: &mut String) -> fmt::Result {
+        use std::fmt::Write;
         match &self.title {
             Some(t) => writeln!(f, "case     {} ({t})", self.case)?,
             None => writeln!(f, "case     {}", self.case)?,

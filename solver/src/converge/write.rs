@@ -75,7 +75,9 @@ impl StudyResult {
     /// let lines: Vec<&str> = csv.lines().collect();
     /// assert_eq!(lines.len(), 3);
     /// assert!(lines[0].starts_with("method,level,resolution,h,cells,unknowns,l2,l2_order"));
-    /// assert!(lines[2].starts_with("fe,1,8,1.25e-1,8,6,2.5e-3,2e0,"));
+    /// assert!(lines[2].starts_with("fe,1,8,1.25e-1,8,6,2.5e-3,"));
+    /// let l2_order: f64 = lines[2].split(',').nth(7).unwrap().parse().unwrap();
+    /// assert!((l2_order - 2.0).abs() < 1e-12);
     /// ```
     pub fn csv(&self) -> String {
         let mut out = String::from("method,level,resolution,h,cells,unknowns");
