@@ -116,7 +116,9 @@ fn expect_fails_the_run_when_an_order_is_missed_and_passes_when_met() {
     let stderr = text(&missed.stderr);
     for method in ["fd", "fe"] {
         assert!(
-            stderr.contains(&format!("expectation missed: {method} least-squares L² order")),
+            stderr.contains(&format!(
+                "expectation missed: {method} least-squares L² order"
+            )),
             "{stderr}"
         );
     }
@@ -131,7 +133,10 @@ fn expect_fails_the_run_when_an_order_is_missed_and_passes_when_met() {
     assert!(stdout.contains(": met"), "{stdout}");
     // One progress line per level on stderr.
     let progress = text(&met.stderr);
-    assert_eq!(progress.lines().filter(|l| l.starts_with("level ")).count(), 3);
+    assert_eq!(
+        progress.lines().filter(|l| l.starts_with("level ")).count(),
+        3
+    );
     let quiet = poisson(&dir, "fd", &["-q"]);
     assert!(quiet.status.success());
     assert!(quiet.stdout.is_empty() && quiet.stderr.is_empty());
@@ -171,7 +176,10 @@ fn csv_json_png_and_svg_are_written_with_the_stated_shape() {
     assert!(lines.iter().all(|l| l.split(',').count() == columns));
     // fe (nodal) has no face flux: empty fields, not zeros.
     let fe: Vec<&str> = lines[4].split(',').collect();
-    assert!(fe[0] == "fe" && fe[12].is_empty() && fe[13].is_empty(), "{fe:?}");
+    assert!(
+        fe[0] == "fe" && fe[12].is_empty() && fe[13].is_empty(),
+        "{fe:?}"
+    );
 
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("convergence.json")).unwrap())
@@ -179,7 +187,9 @@ fn csv_json_png_and_svg_are_written_with_the_stated_shape() {
     assert_eq!(json["levels"], 3);
     let methods = json["methods"].as_array().unwrap();
     assert_eq!(methods.len(), 3);
-    let fd_l2 = methods[0]["orders"]["l2"]["least_squares"].as_f64().unwrap();
+    let fd_l2 = methods[0]["orders"]["l2"]["least_squares"]
+        .as_f64()
+        .unwrap();
     assert!((fd_l2 - 2.0).abs() < 0.15, "{fd_l2}");
     assert_eq!(methods[0]["rows"].as_array().unwrap().len(), 3);
     assert!(methods[1]["orders"].get("flux").is_none(), "fe has no flux");
@@ -222,7 +232,10 @@ fn svg_size(svg: &str) -> (u32, u32) {
     let root = &root[..root.find('>').unwrap()];
     let attribute = |name: &str| -> u32 {
         let key = format!(" {name}=\"");
-        let start = root.find(&key).unwrap_or_else(|| panic!("no {name} in {root}")) + key.len();
+        let start = root
+            .find(&key)
+            .unwrap_or_else(|| panic!("no {name} in {root}"))
+            + key.len();
         root[start..][..root[start..].find('"').unwrap()]
             .parse()
             .unwrap()
@@ -405,7 +418,10 @@ fn studies_need_an_exact_solution_and_a_refinable_mesh() {
     let e = study
         .run_text("plain.toml", no_exact, &[], &mut |_, _| {})
         .unwrap_err();
-    assert!(matches!(e, StudyError::NoExact { .. }) && e.is_input(), "{e}");
+    assert!(
+        matches!(e, StudyError::NoExact { .. }) && e.is_input(),
+        "{e}"
+    );
     let from_file = exact_case("[mesh]\nfile = \"some.msh\"\n");
     let e = study
         .run_text("file.toml", &from_file, &[], &mut |_, _| {})

@@ -5,8 +5,8 @@
 //! case files, output and the `hasse` command line.
 
 pub mod canonical;
-pub mod converge;
 pub mod case;
+pub mod converge;
 pub mod diffusion;
 pub mod info;
 pub mod linear;

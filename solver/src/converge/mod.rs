@@ -49,9 +49,9 @@ pub use write::WriteError;
 
 use crate::case::{Case, CaseError, Diagnostics, Problem};
 use crate::diffusion::Method;
-use hasse_complex::dual::DualKind;
 use crate::mesh_spec::MeshSpec;
 use crate::run::{self, RunError};
+use hasse_complex::dual::DualKind;
 use serde::Serialize;
 use std::path::Path;
 use std::str::FromStr;
@@ -286,7 +286,9 @@ pub enum StudyError {
     BadExpectation(String),
     #[error("a study needs at least 1 level")]
     NoLevels,
-    #[error("{case}: a convergence study needs a diffusion problem (this case is a gradient problem)")]
+    #[error(
+        "{case}: a convergence study needs a diffusion problem (this case is a gradient problem)"
+    )]
     NotDiffusion { case: String },
     #[error("{case}: a convergence study needs the exact solution: add an [exact] table with `solution` (and `gradient` for gradient and flux errors)")]
     NoExact { case: String },
@@ -366,11 +368,7 @@ fn uniform_overrides(
     let mut overrides = vec![format!("mesh.n={}", list(&refined))];
     if generator == "hollow-box" {
         if let Some([a, b]) = mesh.cavity {
-            overrides.push(format!(
-                "mesh.cavity=[{}, {}]",
-                scale(a, 2)?,
-                scale(b, 2)?
-            ));
+            overrides.push(format!("mesh.cavity=[{}, {}]", scale(a, 2)?, scale(b, 2)?));
         }
     }
     if let Some(grading) = &mesh.grading {

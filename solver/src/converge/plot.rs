@@ -57,9 +57,8 @@ impl Default for PlotOptions {
 
 fn register_font() -> Result<(), PlotError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = REGISTERED.get_or_init(|| {
-        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok()
-    });
+    let ok = REGISTERED
+        .get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
     if *ok {
         Ok(())
     } else {
@@ -114,6 +113,25 @@ where
     .map_err(draw_error)
 }
 
+/// Axis labels at 1, 2 and 5 × 10ᵏ only: plotters' log axes put key
+/// points at every integer mantissa, and their labels collide inside one
+/// decade.
+fn log_label(v: &f64) -> String {
+    if !(*v > 0.0 && v.is_finite()) {
+        return String::new();
+    }
+    let exponent = v.log10().floor();
+    let mantissa = v / 10f64.powf(exponent);
+    let rounded = mantissa.round();
+    if (mantissa - rounded).abs() < 1e-6 && [1.0, 2.0, 5.0].contains(&rounded) {
+        format!("{rounded}e{exponent}")
+    } else if (mantissa - 10.0).abs() < 1e-6 {
+        format!("1e{}", exponent + 1.0)
+    } else {
+        String::new()
+    }
+}
+
 impl StudyResult {
     fn series(&self) -> Vec<Series> {
         let mut out = Vec::new();
@@ -146,9 +164,8 @@ impl StudyResult {
             return Err(PlotError::Empty);
         }
         let points = || series.iter().flat_map(|s| s.points.iter().copied());
-        let (h_lo, h_hi) = points().fold((f64::MAX, f64::MIN), |(a, b), (h, _)| {
-            (a.min(h), b.max(h))
-        });
+        let (h_lo, h_hi) =
+            points().fold((f64::MAX, f64::MIN), |(a, b), (h, _)| (a.min(h), b.max(h)));
         // Reference slopes start below every series at the coarsest h, so
         // they never hide data, and fall as h^1 and h^2 from there.
         let coarsest_min = points()
@@ -192,8 +209,9 @@ impl StudyResult {
             .y_desc("error")
             .label_style((FAMILY, 13))
             .axis_desc_style((FAMILY, 15))
-            .x_label_formatter(&|v| format!("{v:.1e}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .max_light_lines(0)
+            .x_label_formatter(&log_label)
+            .y_label_formatter(&log_label)
             .draw()
             .map_err(draw_error)?;
         let grey = RGBColor(110, 110, 110);
@@ -280,8 +298,8 @@ impl StudyResult {
         register_font()?;
         let mut text = String::new();
         {
-            let root =
-                SVGBackend::with_string(&mut text, (options.width, options.height)).into_drawing_area();
+            let root = SVGBackend::with_string(&mut text, (options.width, options.height))
+                .into_drawing_area();
             self.draw(root)?;
         }
         Ok(text)

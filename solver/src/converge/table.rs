@@ -5,14 +5,16 @@ use super::{Norm, StudyResult};
 use std::fmt;
 
 fn resolution(r: &[usize]) -> String {
-    r.iter()
-        .map(usize::to_string)
-        .collect::<Vec<_>>()
-        .join("×")
+    r.iter().map(usize::to_string).collect::<Vec<_>>().join("×")
 }
 
 fn order(p: Option<f64>) -> String {
-    p.map_or_else(|| "-".to_string(), |p| format!("{p:.2}"))
+    // A slope that rounds to zero prints as 0.00, not -0.00.
+    match p.map(|p| format!("{p:.2}")) {
+        None => "-".to_string(),
+        Some(s) if s == "-0.00" => "0.00".to_string(),
+        Some(s) => s,
+    }
 }
 
 impl fmt::Display for StudyResult {

@@ -86,13 +86,9 @@ impl StudyResult {
         }
         out.push_str(",mesh_seconds,solve_seconds\n");
         for method in &self.methods {
-            let orders: Vec<_> = Norm::ALL
-                .iter()
-                .map(|&n| self.orders(method, n))
-                .collect();
+            let orders: Vec<_> = Norm::ALL.iter().map(|&n| self.orders(method, n)).collect();
             for row in self.method_rows(method) {
-                let resolution: Vec<String> =
-                    row.resolution.iter().map(usize::to_string).collect();
+                let resolution: Vec<String> = row.resolution.iter().map(usize::to_string).collect();
                 out.push_str(&format!(
                     "{},{},{},{:e},{},{}",
                     row.method,
