@@ -100,8 +100,10 @@ enum Command {
     /// Examples:
     ///   hasse converge cases/poisson-square.toml --levels 4 --methods fd,fe,fv,fv-mimetic
     ///   hasse converge cases/distorted-quads.toml --levels 5 --methods fv,fv-mimetic,fe -o out/dq
-    ///   hasse converge cases/box-3d.toml --levels 3 --expect 2
+    ///   hasse converge cases/box-3d.toml --levels 3 --set mesh.n=[8,8,8] --expect 2
     ///   hasse converge cases/poisson-square.toml --levels 4 --methods dec,fe --set mesh.cells=simplex
+    // Verbatim: the examples are one per line.
+    #[command(verbatim_doc_comment)]
     Converge {
         /// The case file (.toml); it needs an [exact] table.
         case: PathBuf,
