@@ -306,6 +306,23 @@ impl StudyResult {
     }
 
     /// Write the plot to `path` as PNG or SVG (atomically).
+    ///
+    /// ```
+    /// use hasse_solver::converge::{PlotFormat, PlotOptions, Refinement, StudyResult, StudyRow};
+    /// let row = |level: usize, h: f64, l2: f64| StudyRow {
+    ///     method: "fe".into(), level, resolution: vec![], h, cells: 0, unknowns: 0,
+    ///     l2, max: l2, gradient_l2: None, flux: None, mesh_seconds: 0.0, solve_seconds: 0.0,
+    /// };
+    /// let result = StudyResult {
+    ///     case: "demo.toml".into(), title: Some("demo".into()), refinement: Refinement::Uniform,
+    ///     levels: 2, methods: vec!["fe".into()], rows: vec![row(0, 0.2, 4e-2), row(1, 0.1, 1e-2)],
+    /// };
+    /// let path = std::env::temp_dir().join(format!("hasse-doc-plot-{}.png", std::process::id()));
+    /// result.write_plot(&path, PlotFormat::Png, PlotOptions { width: 320, height: 200 }).unwrap();
+    /// let png = std::fs::read(&path).unwrap();
+    /// assert_eq!(&png[1..4], b"PNG");
+    /// # std::fs::remove_file(&path).unwrap();
+    /// ```
     pub fn write_plot(
         &self,
         path: &Path,
