@@ -113,6 +113,69 @@ enum Command {
         #[arg(long)]
         timing: bool,
     },
+    /// Convergence study: solve CASE on N successively refined meshes and
+    /// report the errors against its [exact] solution and the observed
+    /// orders of convergence.
+    ///
+    /// For each method and level: the generator's resolution, the mesh size
+    /// h (largest top-cell diameter), unknowns, L² and max errors of the
+    /// solution, the gradient L² error (an energy-norm error; needs
+    /// [exact].gradient), the face-flux error where the method defines one,
+    /// and seconds. Orders: between consecutive levels, and the
+    /// least-squares slope of log e against log h over all levels.
+    ///
+    /// Refinement `uniform` re-generates the case's mesh with 2^k times its
+    /// mesh.n on level k (voronoi: 4^k times the sites; sphere: k more
+    /// subdivisions). A mesh read from a file cannot be refined this way;
+    /// refinement by SPLIT (`--refine split`) will be added with SPLIT.
+    ///
+    /// Prints the table, writes DIR/convergence.csv, .json, .png and .svg
+    /// (log–log error against h, reference slopes 1 and 2).
+    /// Exit code 0 on success, 1 when a solve fails or an --expect order is
+    /// missed, 2 for bad input.
+    ///
+    /// Examples:
+    ///   hasse converge cases/poisson-square.toml --levels 4 --methods fd,fe,fv,fv-mimetic
+    ///   hasse converge cases/distorted-quads.toml --levels 5 --methods fv,fv-mimetic,fe -o out/dq
+    ///   hasse converge cases/box-3d.toml --levels 3 --set mesh.n=[8,8,8] --expect 2
+    ///   hasse converge cases/poisson-square.toml --levels 4 --methods dec,fe --set mesh.cells=simplex
+    // Verbatim: the examples are one per line.
+    #[command(verbatim_doc_comment)]
+    Converge {
+        /// The case file (.toml); it needs an [exact] table.
+        case: PathBuf,
+        /// Number of meshes: the case's own resolution, then N − 1 refinements.
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
+        levels: u32,
+        /// How meshes are refined (split refinement will be added with SPLIT).
+        #[arg(long, value_enum, default_value_t = RefineArg::Uniform)]
+        refine: RefineArg,
+        /// Methods side by side on the same meshes (default: the case's own):
+        /// fd, fe, fv, fv-mimetic, dec, dec-barycentric.
+        #[arg(long, value_delimiter = ',', value_name = "METHOD,...")]
+        methods: Vec<String>,
+        /// Output directory (default: converge-<case file stem>).
+        #[arg(short, long, value_name = "DIR")]
+        output: Option<PathBuf>,
+        /// Fail (exit code 1) when the least-squares L² order of any method
+        /// is below ORDER − TOL (TOL defaults to 0.15), e.g. --expect 2 or
+        /// --expect 1:0.3.
+        #[arg(long, value_name = "ORDER[:TOL]")]
+        expect: Option<String>,
+        /// Override a case key before refining, as for `run` (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Print only errors and missed expectations (no progress, no table).
+        #[arg(short, long)]
+        quiet: bool,
+    },
+}
+
+/// Values of `hasse converge --refine`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum RefineArg {
+    /// Re-generate the mesh at 2^k times the case's resolution.
+    Uniform,
 }
 
 /// Exit code for bad input (case file, mesh file, parameters).
@@ -185,6 +248,25 @@ fn main() -> ExitCode {
             }
             run_case(&case_path, output.as_deref(), &set, quiet, verbose)
         }
+        Command::Converge {
+            case,
+            levels,
+            refine,
+            methods,
+            output,
+            expect,
+            set,
+            quiet,
+        } => converge(
+            &case,
+            levels as usize,
+            refine,
+            &methods,
+            output,
+            expect.as_deref(),
+            &set,
+            quiet,
+        ),
         Command::Info {
             mesh,
             betti,
@@ -421,4 +503,138 @@ fn complex_kind(complex: &hasse_complex::Complex) -> String {
         complex.dim(),
         complex.embedding_dim()
     )
+}
+
+/// `hasse converge`: a thin layer over [`hasse_solver::converge::Study`].
+#[allow(clippy::too_many_arguments)]
+fn converge(
+    path: &Path,
+    levels: usize,
+    refine: RefineArg,
+    methods: &[String],
+    output: Option<PathBuf>,
+    expect: Option<&str>,
+    set: &[String],
+    quiet: bool,
+) -> ExitCode {
+    use hasse_solver::converge::{
+        parse_method, Expectation, PlotFormat, PlotOptions, Refinement, Study, StudyError,
+    };
+    let bad_input = |message: String| {
+        eprintln!("error: {message}");
+        ExitCode::from(EXIT_BAD_INPUT)
+    };
+    let methods = match methods
+        .iter()
+        .map(|m| parse_method(m))
+        .collect::<Result<Vec<_>, _>>()
+    {
+        Ok(methods) => methods,
+        Err(e) => return bad_input(e.to_string()),
+    };
+    let expect: Option<Expectation> = match expect.map(str::parse).transpose() {
+        Ok(e) => e,
+        Err(e) => return bad_input(format!("--expect {e}")),
+    };
+    if expect.is_some() && levels < 2 {
+        return bad_input("--expect needs at least 2 levels to observe an order".into());
+    }
+    let study = Study {
+        levels,
+        refinement: match refine {
+            RefineArg::Uniform => Refinement::Uniform,
+        },
+        methods,
+    };
+    let result = study.run(path, set, &mut |level, rows| {
+        if quiet {
+            return;
+        }
+        let Some(first) = rows.first() else { return };
+        let solves: Vec<String> = rows
+            .iter()
+            .map(|r| format!("{} {:.2} s", r.method, r.solve_seconds))
+            .collect();
+        eprintln!(
+            "level {}/{levels}: n = {:?}, h = {:.3e}, {} cells, mesh {:.2} s; {}",
+            level + 1,
+            first.resolution,
+            first.h,
+            first.cells,
+            first.mesh_seconds,
+            solves.join(", ")
+        );
+    });
+    let result = match result {
+        Ok(result) => result,
+        Err(StudyError::Invalid(diagnostics)) => {
+            eprintln!("{diagnostics}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            eprintln!("no output written");
+            return ExitCode::from(if e.is_input() {
+                EXIT_BAD_INPUT
+            } else {
+                EXIT_SOLVE_FAILED
+            });
+        }
+    };
+    let directory = output.unwrap_or_else(|| {
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "case".into());
+        PathBuf::from(format!("converge-{stem}"))
+    });
+    if let Err(e) = std::fs::create_dir_all(&directory) {
+        eprintln!("error: {}: {e}", directory.display());
+        return ExitCode::from(EXIT_SOLVE_FAILED);
+    }
+    let file = |ext: &str| directory.join(format!("convergence.{ext}"));
+    let written = result
+        .write_csv(&file("csv"))
+        .and_then(|()| result.write_json(&file("json")))
+        .and_then(|()| result.write_plot(&file("png"), PlotFormat::Png, PlotOptions::default()))
+        .and_then(|()| result.write_plot(&file("svg"), PlotFormat::Svg, PlotOptions::default()));
+    if let Err(e) = written {
+        eprintln!("error: writing the study: {e}");
+        return ExitCode::from(EXIT_SOLVE_FAILED);
+    }
+    if !quiet {
+        print!("{result}");
+        println!(
+            "\nwritten  {}/convergence.{{csv,json,png,svg}}",
+            directory.display()
+        );
+    }
+    if let Some(expect) = expect {
+        let missed = result.shortfalls(expect);
+        let bound = expect.order - expect.tolerance;
+        for m in &missed {
+            match m.observed {
+                Some(p) => eprintln!(
+                    "expectation missed: {} least-squares L² order {p:.2} < {} − {} = {bound:.2}",
+                    m.method, expect.order, expect.tolerance
+                ),
+                None => eprintln!(
+                    "expectation missed: {} least-squares L² order cannot be computed (an error is zero or not finite)",
+                    m.method
+                ),
+            }
+        }
+        if !missed.is_empty() {
+            return ExitCode::from(EXIT_SOLVE_FAILED);
+        }
+        if !quiet {
+            println!(
+                "expect   least-squares L² order ≥ {} − {} for {}: met",
+                expect.order,
+                expect.tolerance,
+                result.methods.join(", ")
+            );
+        }
+    }
+    ExitCode::SUCCESS
 }
