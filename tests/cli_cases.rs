@@ -485,11 +485,24 @@ fn refinement_cases_run_as_shipped() {
     assert!(stdout.contains("[6402, 9601, 3200]"), "{stdout}");
     // The output is a time series whose mesh changes: level k at time k.
     let file = hdf5::File::open(stem.with_extension("h5")).unwrap();
-    assert_eq!(file.attr("mesh_changes").unwrap().read_scalar::<u8>().unwrap(), 1);
+    assert_eq!(
+        file.attr("mesh_changes")
+            .unwrap()
+            .read_scalar::<u8>()
+            .unwrap(),
+        1
+    );
     for (k, cells) in [50usize, 100, 200, 400, 800, 1600, 3200].iter().enumerate() {
-        let u = file.dataset(&format!("steps/{k}/u")).unwrap().read_raw::<f64>().unwrap();
+        let u = file
+            .dataset(&format!("steps/{k}/u"))
+            .unwrap()
+            .read_raw::<f64>()
+            .unwrap();
         assert_eq!(u.len(), *cells, "level {k}");
-        let vertices = file.dataset(&format!("steps/{k}/mesh/vertices")).unwrap().shape();
+        let vertices = file
+            .dataset(&format!("steps/{k}/mesh/vertices"))
+            .unwrap()
+            .shape();
         assert!(vertices[0] > *cells, "level {k} has its own mesh");
     }
 }
