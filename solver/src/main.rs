@@ -26,6 +26,7 @@ enum Command {
     /// Examples:
     ///   hasse run cases/poisson-square.toml
     ///   hasse run cases/poisson-square.toml --set problem.method=fv --set mesh.n=[64,64] -o out/fv
+    #[command(verbatim_doc_comment)]
     Run {
         /// The case file (.toml).
         case: PathBuf,
@@ -55,6 +56,7 @@ enum Command {
     /// Options override the case's [refine] table. Output: the final mesh.
     ///
     /// Example: hasse refine cases/l-shape-adaptive.toml --steps 4
+    #[command(verbatim_doc_comment)]
     Refine {
         /// The case file (.toml).
         case: PathBuf,
