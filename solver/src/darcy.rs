@@ -67,11 +67,21 @@
 //!   meets span(N) only in 0). On a box with a diagonal K, M_c = S exactly,
 //!   i.e. the mimetic mass reduces to the two-point one.
 //!
-//! The system is symmetric indefinite (n_faces positive and n_cells
-//! negative eigenvalues), so it is solved with faer's Bunch–Kaufman LBLᵀ
-//! ([`Factorization::Lblt`]): unpivoted LDLᵀ may meet the zero diagonal
-//! of the pressure block whenever the fill-reducing ordering eliminates a
-//! cell before its faces, and LLᵀ does not apply.
+//! The system is symmetric indefinite (as many positive eigenvalues as
+//! free faces, as many negative ones as cells), so LLᵀ does not apply.
+//! Which symmetric factorisation is right was checked, not assumed
+//! (`cargo run -p hasse-solver --example darcy_factorizations -- 64 0.2`):
+//! under faer's default AMD ordering both unpivoted LDLᵀ and faer's LBLᵀ
+//! fail on the mimetic system with a zero pivot — LBLᵀ pivots only inside
+//! a supernode (intranodal Bunch–Kaufman), and AMD readily eliminates a
+//! cell pressure, whose diagonal is 0, before the faces that would make
+//! its pivot nonzero — while LU succeeds. [`solve`] therefore uses faer's
+//! LDLᵀ with a constrained AMD ordering ([`saddle_ordering`]): each
+//! pressure is eliminated only after all of its free faces, which makes
+//! every leading principal submatrix nonsingular (proof there), keeps the
+//! symmetric factor (about half of LU's work and memory) and keeps most of
+//! AMD's fill reduction. [`DarcySystem::solve`] runs any factorisation of
+//! [`crate::linear`] on the same matrix for comparison.
 //!
 //! ```
 //! use hasse_complex::generate::rectangle;
@@ -98,10 +108,18 @@
 
 use crate::linear::{self, Factorization, SolveError, SolveReport};
 use crate::metric::{check_tensors, fv, MetricError, Tensor};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::perm::PermRef;
+use faer::sparse::linalg::amd;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+};
 use faer::sparse::{SparseColMat, Triplet};
+use faer::{Conj, Mat, Par, Side};
 use hasse_complex::{Complex, DualKind};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
+use std::time::Instant;
 
 /// Which flux mass matrix M_u to use. See the [module documentation](self)
 /// for the formulas.
@@ -155,7 +173,10 @@ pub struct BoundaryConditions {
 impl BoundaryConditions {
     /// Conditions chosen per boundary face from its centroid; `None` leaves
     /// the face no-flow.
-    pub fn from_fn(complex: &Complex, mut condition: impl FnMut(&[f64]) -> Option<FaceCondition>) -> Self {
+    pub fn from_fn(
+        complex: &Complex,
+        mut condition: impl FnMut(&[f64]) -> Option<FaceCondition>,
+    ) -> Self {
         let mut bc = Self::default();
         for face in boundary_faces(complex) {
             match condition(complex.centroid_of(complex.dim() - 1, face)) {
@@ -228,9 +249,10 @@ pub fn boundary_faces(complex: &Complex) -> Vec<usize> {
 /// ```
 /// use hasse_complex::generate::rectangle;
 /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
-/// // A unit flux through every face along its normal: the normals of a
-/// // single cell all point outward, so the outflow is 4.
-/// assert_eq!(hasse_solver::darcy::divergence(&k, &[1.0; 4]), vec![4.0]);
+/// // A unit flux out through every face: u_F = ∂(F, c) (u runs along n_F,
+/// // which points out of c exactly when ∂(F, c) = +1). Net outflow 4.
+/// let outward: Vec<f64> = (0..4).map(|f| f64::from(*k.boundary(2).get(f, 0).unwrap())).collect();
+/// assert_eq!(hasse_solver::darcy::divergence(&k, &outward), vec![4.0]);
 /// ```
 pub fn divergence(complex: &Complex, flux: &[f64]) -> Vec<f64> {
     let n = complex.dim();
@@ -387,10 +409,7 @@ fn classify(
     let boundary = complex.boundary(n);
     let faces = boundary.rows();
     let mut out = vec![None; faces];
-    let lists = [
-        ("pressure", &bc.pressure, true),
-        ("flux", &bc.flux, false),
-    ];
+    let lists = [("pressure", &bc.pressure, true), ("flux", &bc.flux, false)];
     for (kind, list, is_pressure) in lists {
         for &(face, value) in list.iter() {
             if face >= faces {
@@ -416,12 +435,125 @@ fn classify(
     Ok(out)
 }
 
-/// Assemble and solve the mixed Darcy problem.
+/// The assembled saddle-point system of one Darcy problem: unknowns are
+/// the free face fluxes (faces without a prescribed flux, in face order),
+/// then the cell pressures, then (pure-flux problems only) the multiplier
+/// of the mean-pressure constraint.
+pub struct DarcySystem {
+    /// The symmetric indefinite matrix [[M_u, B], [Bᵀ, 0]] (both triangles).
+    pub matrix: SparseColMat<usize, f64>,
+    /// The right-hand side, with the known fluxes eliminated.
+    pub rhs: Vec<f64>,
+    /// Number of free face fluxes (rows `0..free_faces`).
+    pub free_faces: usize,
+    /// Number of pressure unknowns (rows `free_faces..free_faces + cells`).
+    pub cells: usize,
+    /// Per face: the prescribed flux u_F along n_F, or `None` when free.
+    known: Vec<Option<f64>>,
+    column: Vec<usize>,
+    points: Vec<f64>,
+}
+
+impl DarcySystem {
+    /// Split a solution vector of [`DarcySystem::matrix`] into face fluxes
+    /// (prescribed ones filled in) and cell pressures.
+    pub fn unpack(&self, x: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let flux = self
+            .known
+            .iter()
+            .zip(&self.column)
+            .map(|(k, &c)| k.unwrap_or_else(|| x[c]))
+            .collect();
+        let pressure = x[self.free_faces..self.free_faces + self.cells].to_vec();
+        (flux, pressure)
+    }
+
+    /// Solve with faer's unpivoted sparse LDLᵀ under a constrained
+    /// fill-reducing ordering (see [`saddle_ordering`]); this is what
+    /// [`solve`] uses.
+    pub fn solve_ldlt(&self) -> Result<DarcySolution, DarcyError> {
+        let started = Instant::now();
+        let a = self.matrix.as_ref();
+        let size = a.nrows();
+        let (forward, inverse) = saddle_ordering(self);
+        let perm = PermRef::new_checked(&forward, &inverse, size);
+        let symbolic = factorize_symbolic_cholesky(
+            a.symbolic(),
+            Side::Lower,
+            SymmetricOrdering::Custom(perm),
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
+        let symbolic_seconds = started.elapsed().as_secs_f64();
+        let started = Instant::now();
+        let par = Par::Seq;
+        let mut values = vec![0.0; symbolic.len_val()];
+        let mut buffer = MemBuffer::try_new(
+            symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(par, Default::default())
+                .or(symbolic.solve_in_place_scratch::<f64>(1, par)),
+        )
+        .map_err(|_| SolveError::OutOfMemory)?;
+        let singular = SolveError::Singular { method: "LDLᵀ" };
+        let ldlt = symbolic
+            .factorize_numeric_ldlt(
+                &mut values,
+                a,
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut buffer),
+                Default::default(),
+            )
+            .map_err(|_| singular.clone())?;
+        let numeric_seconds = started.elapsed().as_secs_f64();
+        let started = Instant::now();
+        let mut x = Mat::from_fn(size, 1, |i, _| self.rhs[i]);
+        ldlt.solve_in_place_with_conj(Conj::No, x.as_mut(), par, MemStack::new(&mut buffer));
+        let x: Vec<f64> = (0..size).map(|i| x[(i, 0)]).collect();
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err(singular.into());
+        }
+        let report = SolveReport {
+            factorization: Factorization::Ldlt,
+            unknowns: size,
+            nonzeros: a.compute_nnz(),
+            symbolic_seconds,
+            numeric_seconds,
+            solve_seconds: started.elapsed().as_secs_f64(),
+            relative_residual: linear::relative_residual(a, &x, &self.rhs),
+        };
+        let (flux, pressure) = self.unpack(&x);
+        Ok(DarcySolution {
+            flux,
+            pressure,
+            points: self.points.clone(),
+            report,
+        })
+    }
+
+    /// Factorise with `kind` through [`crate::linear`] (AMD ordering) and
+    /// solve. faer's LBLᵀ pivots only inside a supernode, so under AMD it
+    /// can still meet a zero pressure pivot; see the module documentation.
+    pub fn solve(&self, kind: Factorization) -> Result<DarcySolution, DarcyError> {
+        let (x, report) = linear::solve(&self.matrix, &self.rhs, kind)?;
+        let (flux, pressure) = self.unpack(&x);
+        Ok(DarcySolution {
+            flux,
+            pressure,
+            points: self.points.clone(),
+            report,
+        })
+    }
+}
+
+/// Assemble and solve the mixed Darcy problem with faer's LDLᵀ under the
+/// constrained ordering of [`saddle_ordering`].
 ///
 /// `tensors`: the permeability K per top cell (symmetric positive
 /// definite, checked); `source`: F_c = ∫_c f per top cell (see
-/// [`cell_integrals`]); `bc`: pressure and flux faces. Solved with faer's
-/// LBLᵀ; the report carries the relative residual.
+/// [`cell_integrals`]); `bc`: pressure and flux faces. The report carries
+/// the relative residual.
 ///
 /// Errors: [`DarcyError`] for bad coefficients, faces, data or a singular
 /// system.
@@ -432,6 +564,106 @@ pub fn solve(
     source: &[f64],
     bc: &BoundaryConditions,
 ) -> Result<DarcySolution, DarcyError> {
+    assemble(complex, tensors, mass, source, bc)?.solve_ldlt()
+}
+
+/// The elimination order used by [`DarcySystem::solve_ldlt`] as
+/// (forward, inverse) permutations: faer's approximate minimum degree
+/// order of the whole matrix, except that each cell pressure is delayed
+/// until all of its free faces have been eliminated (and the mean
+/// multiplier of a pure-flux problem goes just before the last pressure).
+///
+/// Why this makes unpivoted LDLᵀ safe: every leading principal submatrix
+/// is then [[M_UU, B_UP], [B_UPᵀ, 0]] with M_UU a principal submatrix of
+/// the SPD mass and every column of B_UP = −∂ₙ carrying all its free
+/// faces, so B_UP has full column rank (∂ₙ restricted to the free faces is
+/// injective as long as some face carries a pressure condition) and the
+/// submatrix is nonsingular. Face pivots come out positive and pressure
+/// pivots negative (Schur complements −B_UPᵀ M_UU⁻¹ B_UP): the inertia of
+/// a saddle point.
+pub fn saddle_ordering(system: &DarcySystem) -> (Vec<usize>, Vec<usize>) {
+    let a = system.matrix.as_ref();
+    let size = a.nrows();
+    let (free, cells) = (system.free_faces, system.cells);
+    let mut amd = vec![0usize; size];
+    let mut amd_inv = vec![0usize; size];
+    let amd_ok = MemBuffer::try_new(amd::order_scratch::<usize>(size, a.compute_nnz()))
+        .ok()
+        .and_then(|mut buffer| {
+            amd::order(
+                &mut amd,
+                &mut amd_inv,
+                a.symbolic(),
+                Default::default(),
+                MemStack::new(&mut buffer),
+            )
+            .ok()
+        })
+        .is_some();
+    if !amd_ok {
+        // Natural order is valid too (every face before every pressure),
+        // only with more fill.
+        amd = (0..size).collect();
+    }
+    // Free faces of each cell still to be eliminated.
+    let mut pending: Vec<usize> = (0..cells)
+        .map(|c| {
+            let j = free + c;
+            a.row_idx()[a.col_range(j)]
+                .iter()
+                .filter(|&&i| i < free)
+                .count()
+        })
+        .collect();
+    let mut waiting = vec![false; cells];
+    let mut order = Vec::with_capacity(size);
+    let lambda = (size > free + cells).then_some(free + cells);
+    for &j in &amd {
+        if Some(j) == lambda {
+            continue;
+        }
+        if j >= free {
+            let c = j - free;
+            if pending[c] == 0 {
+                order.push(j);
+            } else {
+                waiting[c] = true;
+            }
+            continue;
+        }
+        order.push(j);
+        for &i in &a.row_idx()[a.col_range(j)] {
+            if i >= free && i < free + cells {
+                let c = i - free;
+                pending[c] -= 1;
+                if pending[c] == 0 && waiting[c] {
+                    waiting[c] = false;
+                    order.push(i);
+                }
+            }
+        }
+    }
+    // Cells without free faces (only possible with no pressure anywhere).
+    order.extend((0..cells).filter(|&c| waiting[c]).map(|c| free + c));
+    if let Some(l) = lambda {
+        let last = order.iter().rposition(|&j| j >= free).unwrap_or(0);
+        order.insert(last, l);
+    }
+    let mut inverse = vec![0; size];
+    for (k, &j) in order.iter().enumerate() {
+        inverse[j] = k;
+    }
+    (order, inverse)
+}
+
+/// Assemble the saddle-point system (see [`solve`] for the arguments).
+pub fn assemble(
+    complex: &Complex,
+    tensors: &[Tensor],
+    mass: FluxMass,
+    source: &[f64],
+    bc: &BoundaryConditions,
+) -> Result<DarcySystem, DarcyError> {
     let mass_entries = flux_mass(complex, tensors, mass)?;
     let n = complex.dim();
     let cells = complex.cell_count(n);
@@ -522,20 +754,20 @@ pub fn solve(
     }
     let matrix = SparseColMat::try_new_from_triplets(size, size, &triplets)
         .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
-    let (x, report) = linear::solve(&matrix, &rhs, Factorization::Lblt)?;
-
-    let flux = (0..faces)
-        .map(|f| known[f].unwrap_or_else(|| x[column[f]]))
-        .collect();
-    let pressure = x[free..free + cells].to_vec();
     let points = match mass {
-        FluxMass::Dec(kind) => complex.dual_vertices(kind).map_err(MetricError::from)?.to_vec(),
+        FluxMass::Dec(kind) => complex
+            .dual_vertices(kind)
+            .map_err(MetricError::from)?
+            .to_vec(),
         FluxMass::Mimetic => complex.centroid(n).to_vec(),
     };
-    Ok(DarcySolution {
-        flux,
-        pressure,
+    Ok(DarcySystem {
+        matrix,
+        rhs,
+        free_faces: free,
+        cells,
+        known,
+        column,
         points,
-        report,
     })
 }
