@@ -376,7 +376,11 @@ fn mimetic_mass(
             let qr = normals.clone().qr();
             let r = qr.r();
             let scale = (0..d).fold(0.0f64, |a, i| a.max(r[(i, i)].abs()));
-            if (0..d).any(|i| !(r[(i, i)].abs() > 1e-12 * scale)) {
+            // A zero or NaN diagonal of R: the outward normals lost rank.
+            if (0..d).any(|i| {
+                let v = r[(i, i)].abs();
+                v.is_nan() || v <= 1e-12 * scale
+            }) {
                 return Err(MetricError::UnsupportedCell {
                     method: METHOD,
                     needs: "a non-degenerate cell (face normals spanning the space)",
