@@ -148,6 +148,10 @@ pub enum FaceCondition {
     Pressure(f64),
     /// Outward total flux ∫_F u·n_out through the face (essential).
     Flux(f64),
+    /// Outward normal velocity u·n_out on the face (essential):
+    /// [`BoundaryConditions::from_fn`] turns it into the total flux
+    /// q_F = (u·n_out) |F|.
+    FluxDensity(f64),
 }
 
 /// Pressure and flux conditions on boundary (n−1)-cells, by face number.
@@ -178,10 +182,14 @@ impl BoundaryConditions {
         mut condition: impl FnMut(&[f64]) -> Option<FaceCondition>,
     ) -> Self {
         let mut bc = Self::default();
+        let n = complex.dim();
         for face in boundary_faces(complex) {
-            match condition(complex.centroid_of(complex.dim() - 1, face)) {
+            match condition(complex.centroid_of(n - 1, face)) {
                 Some(FaceCondition::Pressure(v)) => bc.pressure.push((face, v)),
                 Some(FaceCondition::Flux(v)) => bc.flux.push((face, v)),
+                Some(FaceCondition::FluxDensity(v)) => {
+                    bc.flux.push((face, v * complex.measure(n - 1)[face]))
+                }
                 None => {}
             }
         }
@@ -693,7 +701,8 @@ pub fn assemble(
         let sign = f64::from(*row.data().first().expect("one cell"));
         match conditions[face] {
             Some(FaceCondition::Pressure(_)) => pressure_faces += 1,
-            Some(FaceCondition::Flux(q)) => {
+            // `classify` stores totals only (Flux), never FluxDensity.
+            Some(FaceCondition::Flux(q) | FaceCondition::FluxDensity(q)) => {
                 known[face] = Some(sign * q);
                 outflow += q;
             }
