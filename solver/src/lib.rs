@@ -7,6 +7,7 @@
 pub mod canonical;
 pub mod case;
 pub mod converge;
+pub mod darcy;
 pub mod diffusion;
 pub mod info;
 pub mod iterative;
