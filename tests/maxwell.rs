@@ -94,9 +94,9 @@ fn square_cavity_converges_at_second_order() {
                 .collect::<Vec<_>>(),
         );
     }
-    for j in 0..count {
-        for l in 1..levels.len() {
-            let order = (errors[l - 1][j] / errors[l][j]).log2();
+    for (l, pair) in errors.windows(2).enumerate() {
+        for (j, (coarse, fine)) in pair[0].iter().zip(&pair[1]).enumerate() {
+            let order = (coarse / fine).log2();
             println!(
                 "mode {j} levels {}→{}: order {order:.4}",
                 levels[l - 1],

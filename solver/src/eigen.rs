@@ -9,10 +9,11 @@
 //! positive definite; Bunch–Kaufman LBLᵀ otherwise) and every step costs
 //! one forward/back substitution per vector.
 //!
-//! Why not faer's `partial_self_adjoint_eigen`: it is a single-vector,
-//! Euclidean-inner-product Krylov–Schur. T is only M-self-adjoint (a
-//! symmetric form needs M^{±1/2}, which for a Whitney mass is a second
-//! factorisation), and a single start vector sees one direction of every
+//! Why not `faer::matrix_free::eigen::partial_self_adjoint_eigen`: it is a
+//! single-vector, restarted Lanczos for the largest-magnitude eigenvalues
+//! of an operator self-adjoint in the Euclidean inner product. T is only
+//! M-self-adjoint (a symmetric form needs M^{±1/2}, which for a Whitney
+//! mass is a second factorisation), and a single start vector sees one direction of every
 //! eigenspace: the exact multiplicities of symmetric grids (2 on a square,
 //! 3 and 6 on a cube) would only appear through rounding. A block of b
 //! random vectors sees b directions of each eigenspace, so multiplicities up
