@@ -99,8 +99,8 @@ fn square_cavity_converges_at_second_order() {
             let order = (coarse / fine).log2();
             println!(
                 "mode {j} levels {}→{}: order {order:.4}",
-                levels[l - 1],
-                levels[l]
+                levels[l],
+                levels[l + 1]
             );
             assert!((order - 2.0).abs() <= 0.15, "mode {j}: order {order}");
         }

@@ -47,6 +47,14 @@ use hasse_complex::{Complex, ComplexError, DualKind};
 use sprs::{CsMat, TriMat};
 
 /// Why a cavity could not be set up or solved.
+///
+/// ```
+/// use hasse_complex::{dual::DualKind, generate::interval};
+/// use hasse_solver::maxwell::{Cavity, Mass, MaxwellError};
+/// let line = interval(4, 0.0, 1.0).unwrap();
+/// let err = Cavity::new(&line, DualKind::Barycentric, Mass::Hodge).err().unwrap();
+/// assert_eq!(err, MaxwellError::Dimension { dim: 1 });
+/// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MaxwellError {
     #[error("a Maxwell cavity needs a 2- or 3-dimensional complex (curl lives on edges and faces); this one is {dim}-dimensional")]
@@ -110,6 +118,19 @@ pub struct Cavity {
 }
 
 /// Resonant modes, ascending in ω².
+///
+/// ```
+/// use hasse_complex::{dual::DualKind, generate::box3};
+/// use hasse_solver::maxwell::{Cavity, Mass};
+/// use std::f64::consts::PI;
+/// let k = box3(4, 4, 4, [0.0, PI], [0.0, PI], [0.0, PI]).unwrap();
+/// let cavity = Cavity::new(&k, DualKind::Barycentric, Mass::Hodge).unwrap();
+/// let modes = cavity.modes(3, &cavity.default_options()).unwrap();
+/// // The lowest cube mode ω² = 2 is threefold; on 4 cells per side it is 2 (4/h²) sin²(h/2).
+/// let h = PI / 4.0;
+/// let want = (8.0 / (h * h) * (h / 2.0).sin().powi(2)).sqrt();
+/// assert!(modes.frequencies().iter().all(|w| (w - want).abs() < 1e-8));
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Modes {
     /// ω² (for a unit wave speed), ascending.
