@@ -255,7 +255,8 @@ fn a_quadratic_in_time_part_gives_backward_euler_exactly_t_dt_and_crank_nicolson
     let fe =
         Heat::new(Method::Fe, unit(), dt).with_source(TimeFn::Varying(Arc::new(|_, t| 2.0 * t)));
     let exact_fe = |_: &[f64], t: f64| 1.0 + t * t;
-    let runs: [(&str, Heat, bool, &dyn Fn(&[f64], f64) -> f64, ScalarFn); 2] = [
+    type Exact<'a> = &'a dyn Fn(&[f64], f64) -> f64;
+    let runs: [(&str, Heat, bool, Exact, ScalarFn); 2] = [
         ("fv", fv, false, &exact_fv, Arc::new(|x| x[0] + x[1])),
         ("fe", fe, true, &exact_fe, Arc::new(|_| 1.0)),
     ];

@@ -289,8 +289,8 @@ impl Heat {
         let stiffness = &first.matrix;
         let mut free_index = vec![usize::MAX; unknowns];
         let mut free = Vec::new();
-        for i in 0..unknowns {
-            if first.fixed[i].is_none() {
+        for (i, g) in first.fixed.iter().enumerate() {
+            if g.is_none() {
                 free_index[i] = free.len();
                 free.push(i);
             }
