@@ -139,6 +139,8 @@ pub struct History {
     pub factorization_seconds: f64,
     /// Mean seconds per step (right-hand side, data and solve).
     pub seconds_per_step: f64,
+    /// The part of `seconds_per_step` spent in the triangular solves.
+    pub solve_seconds_per_step: f64,
     /// Steps taken.
     pub steps: usize,
 }
@@ -337,6 +339,7 @@ impl Heat {
         let mut b_new = first.rhs.clone();
         let mut rhs = vec![0.0; free.len()];
         let mut ku = vec![0.0; unknowns];
+        let mut solve_seconds = 0.0;
         let started = Instant::now();
         for step in 1..=steps {
             let t = t0 + step as f64 * dt;
@@ -366,7 +369,9 @@ impl Heat {
                 rhs[fi] -= v * fixed_new[j].unwrap_or(0.0);
             }
             if let Some(factor) = &factor {
+                let solving = Instant::now();
                 let x = factor.solve(&rhs)?;
+                solve_seconds += solving.elapsed().as_secs_f64();
                 for (k, &i) in free.iter().enumerate() {
                     u[i] = x[k];
                 }
@@ -384,11 +389,14 @@ impl Heat {
                 fields.push(u.clone());
             }
         }
-        let seconds_per_step = if steps > 0 {
-            started.elapsed().as_secs_f64() / steps as f64
-        } else {
-            0.0
+        let per_step = |seconds: f64| {
+            if steps > 0 {
+                seconds / steps as f64
+            } else {
+                0.0
+            }
         };
+        let seconds_per_step = per_step(started.elapsed().as_secs_f64());
         Ok(History {
             location,
             degree: if location == Location::Nodal { 0 } else { n },
@@ -396,6 +404,7 @@ impl Heat {
             fields,
             factorization_seconds,
             seconds_per_step,
+            solve_seconds_per_step: per_step(solve_seconds),
             steps,
         })
     }
