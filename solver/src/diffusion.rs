@@ -266,6 +266,31 @@ pub struct Errors {
     pub gradient_l2: f64,
 }
 
+/// The assembled system of a diffusion problem (see [`Diffusion::assemble`]).
+#[derive(Clone, Debug)]
+pub struct Assembled {
+    pub location: Location,
+    /// The canonical operator, with boundary and ghost rows.
+    pub canonical: Canonical,
+    /// M = Aᵀ Ω A over all unknowns (full symmetric storage for symmetric Ω).
+    pub matrix: SparseColMat<usize, f64>,
+    /// Sources, Neumann data and lifted Dirichlet/Robin ghost values.
+    pub rhs: Vec<f64>,
+    /// Unknowns held at a Dirichlet value (nodal and hybrid methods).
+    pub fixed: Vec<Option<f64>>,
+    /// No Dirichlet or Robin boundary: M is singular (constants).
+    pub pure_neumann: bool,
+    /// Rows of A before the ghost rows.
+    pub flux_rows: usize,
+    /// Ghost values w on the rows of A (b contains Aᵀ Ω w).
+    pub ghost_values: Vec<f64>,
+    /// The data's flux on cell-centred Neumann faces.
+    pub neumann_flux: Vec<f64>,
+    /// Cell points of [`Method::Fv`] when they are not the centroids.
+    pub cell_points: Option<Vec<f64>>,
+    pub assembly_seconds: f64,
+}
+
 struct Faces {
     /// Condition index applied to each boundary (n−1)-cell, if any.
     condition: Vec<Option<usize>>,
@@ -371,8 +396,25 @@ impl Diffusion {
         Ok(Faces { condition })
     }
 
-    /// Assemble and solve on `complex`.
-    pub fn solve(&self, complex: &Complex) -> Result<Solution, DiffusionError> {
+    /// Assemble the system on `complex` without solving it: the operator
+    /// M = Aᵀ Ω A (boundary rows and ghosts included), the right-hand side
+    /// and the unknowns held fixed by Dirichlet conditions. [`Diffusion::solve`]
+    /// is this followed by [`solve_with_fixed`]; transient problems reuse M
+    /// as their stiffness.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::diffusion::{BoundaryKind, Conductivity, Diffusion, Method};
+    /// use std::sync::Arc;
+    /// let mesh = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let problem = Diffusion::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+    ///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)));
+    /// let system = problem.assemble(&mesh).unwrap();
+    /// // 3×3 vertices, only the centre is free.
+    /// assert_eq!(system.fixed.iter().filter(|g| g.is_none()).count(), 1);
+    /// assert_eq!(system.matrix.nrows(), 9);
+    /// ```
+    pub fn assemble(&self, complex: &Complex) -> Result<Assembled, DiffusionError> {
         let started = Instant::now();
         let n = complex.dim();
         let d = complex.embedding_dim();
@@ -597,7 +639,37 @@ impl Diffusion {
                     top.outer_view(f).map_or(0, |r| r.nnz()) != 1 || face_weight[f] == Some(0.0)
                 }));
         let assembly_seconds = started.elapsed().as_secs_f64();
+        Ok(Assembled {
+            location,
+            canonical,
+            matrix,
+            rhs,
+            fixed,
+            pure_neumann,
+            flux_rows,
+            ghost_values,
+            neumann_flux,
+            cell_points,
+            assembly_seconds,
+        })
+    }
 
+    /// Assemble and solve on `complex`.
+    pub fn solve(&self, complex: &Complex) -> Result<Solution, DiffusionError> {
+        let Assembled {
+            location,
+            canonical,
+            matrix,
+            mut rhs,
+            mut fixed,
+            pure_neumann,
+            flux_rows,
+            ghost_values,
+            neumann_flux,
+            cell_points,
+            assembly_seconds,
+        } = self.assemble(complex)?;
+        let unknowns = rhs.len();
         let mut neumann_imbalance = 0.0;
         if pure_neumann {
             let components = complex.betti_numbers_over(hasse_complex::Field::Z2)[0];

@@ -4,6 +4,7 @@
 //! the metrics Ω of FD, FE, FV and DEC, boundary conditions, faer solves,
 //! case files, output and the `hasse` command line.
 
+pub mod block;
 pub mod canonical;
 pub mod case;
 pub mod converge;
@@ -19,3 +20,4 @@ pub mod metric;
 pub mod output;
 pub mod refinement;
 pub mod run;
+pub mod transient;
