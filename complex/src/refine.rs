@@ -67,6 +67,19 @@ fn centroid_planes(
     Ok((current, total))
 }
 
+/// (n, d) of a complex that SPLIT can cut: cells filling R² or R³.
+fn space_filling_dims(complex: &Complex) -> Result<(usize, usize), SplitError> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    if n != d || !(2..=3).contains(&n) {
+        return Err(SplitError::Unsupported {
+            dim: n,
+            embedding: d,
+        });
+    }
+    Ok((n, d))
+}
+
 fn check_cells(complex: &Complex, cells: &[usize]) -> Result<(), SplitError> {
     let n = complex.dim();
     let count = complex.cell_count(n);
@@ -136,14 +149,7 @@ pub fn bisect_longest_edge(
     complex: &Complex,
     cells: &[usize],
 ) -> Result<(Complex, Refinement), SplitError> {
-    let n = complex.dim();
-    let d = complex.embedding_dim();
-    if n != d || !(2..=3).contains(&n) {
-        return Err(SplitError::Unsupported {
-            dim: n,
-            embedding: d,
-        });
-    }
+    let (n, d) = space_filling_dims(complex)?;
     check_cells(complex, cells)?;
     let point = |v: usize| padded(complex.vertices().point(v));
     let mut cuts = Vec::with_capacity(cells.len());
@@ -317,14 +323,7 @@ pub fn divide_shortest_wall(
             "the shortest-wall search needs at least one direction".into(),
         ));
     }
-    let n = complex.dim();
-    let d = complex.embedding_dim();
-    if n != d || !(2..=3).contains(&n) {
-        return Err(SplitError::Unsupported {
-            dim: n,
-            embedding: d,
-        });
-    }
+    let (n, d) = space_filling_dims(complex)?;
     check_cells(complex, cells)?;
     let normals: Vec<[f64; 3]> = (0..directions)
         .map(|k| {
