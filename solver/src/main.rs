@@ -341,9 +341,18 @@ fn check_case(path: &Path, set: &[String]) -> ExitCode {
 }
 
 fn describe_problem(case: &Case) -> String {
-    match case.method() {
-        Some(m) => format!("diffusion, method {}", m.name()),
-        None => "gradient".to_string(),
+    use hasse_solver::case::Problem;
+    match &case.problem {
+        Problem::Diffusion(d) => format!("diffusion, method {}", d.method.name()),
+        Problem::Gradient(_) => "gradient".to_string(),
+        Problem::Heat(h) => format!(
+            "heat, method {}, {} steps of dt = {}",
+            h.method.name(),
+            h.time.steps,
+            h.time.dt
+        ),
+        Problem::Darcy(d) => format!("darcy, flux mass {:?}", d.mass),
+        Problem::Maxwell(m) => format!("maxwell, {} modes, dual {:?}", m.modes, m.dual),
     }
 }
 

@@ -218,9 +218,10 @@ fn refine_once(
 fn diffusion_of(case: &Case) -> Result<Diffusion, RunError> {
     match &case.problem {
         Problem::Diffusion(spec) => Ok(run::diffusion_problem(case, spec)),
-        Problem::Gradient(_) => Err(RunError::Input(
-            "refinement re-solves diffusion problems; this case is a gradient problem".into(),
-        )),
+        other => Err(RunError::Input(format!(
+            "refinement re-solves diffusion problems; this case is kind = \"{}\"",
+            other.kind()
+        ))),
     }
 }
 
@@ -232,7 +233,7 @@ fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<run:
     };
     let u = solution.field(complex).to_vec();
     let mut fields = Vec::new();
-    if let Some(exact) = &case.exact {
+    if let Some(solution_fn) = case.exact.as_ref().and_then(|e| e.solution.as_ref()) {
         let points: Vec<Vec<f64>> = match &solution.cell_points {
             Some(given) => given
                 .chunks(complex.embedding_dim())
@@ -240,7 +241,7 @@ fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<run:
                 .collect(),
             None => run::field_points(complex, dim),
         };
-        let exact_values: Vec<f64> = points.iter().map(|x| exact.solution.eval(x, 0.0)).collect();
+        let exact_values: Vec<f64> = points.iter().map(|x| solution_fn.eval(x, 0.0)).collect();
         let error = u.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
         fields.push(run::Field {
             name: "u_exact".into(),
@@ -274,10 +275,10 @@ fn report(
     solution: &Solution,
     seconds: f64,
 ) -> StepReport {
-    let errors = case.exact.as_ref().map(|exact| {
-        let u = run::scalar_fn(&exact.solution);
+    let errors = case.exact.as_ref().and_then(|exact| {
+        let u = run::scalar_fn(exact.solution.as_ref()?);
         let grad = exact.gradient.as_ref().map(|g| run::vector_fn(g));
-        diffusion::errors(complex, solution, &u, grad.as_ref())
+        Some(diffusion::errors(complex, solution, &u, grad.as_ref()))
     });
     StepReport {
         step,

@@ -38,6 +38,10 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod darcy;
+mod heat;
+mod maxwell;
+
 /// A scalar cochain computed by a run: values on the `dim`-cells.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Field {
@@ -65,6 +69,15 @@ pub struct RunResult {
     /// Messages worth a user's attention (large residual, pure Neumann…).
     pub warnings: Vec<String>,
     pub pure_neumann: bool,
+    /// Saved time levels of a transient run, (t, fields) in order; the
+    /// output writes them as a time series. Empty for steady problems,
+    /// whose `fields` are the one step.
+    pub series: Vec<(f64, Vec<Field>)>,
+    /// Further summary lines (label, text), e.g. time stepping or modes.
+    pub notes: Vec<(String, String)>,
+    /// Problem-specific entries of the stored report (per-level errors,
+    /// eigenvalues…), merged into [`RunResult::report_json`].
+    pub report: serde_json::Map<String, serde_json::Value>,
 }
 
 /// Why a run failed after the case was read.
@@ -100,6 +113,9 @@ pub fn solve(
     match &case.problem {
         Problem::Diffusion(spec) => solve_diffusion(case, spec, complex, phase),
         Problem::Gradient(spec) => gradient(case, spec, complex, phase),
+        Problem::Heat(spec) => heat::solve(case, spec, complex, phase),
+        Problem::Darcy(spec) => darcy::solve(case, spec, complex, phase),
+        Problem::Maxwell(spec) => maxwell::solve(case, spec, complex, phase),
     }
 }
 
@@ -115,8 +131,9 @@ pub(crate) fn vector_fn(components: &[crate::case::expr::Expression]) -> VectorF
     })
 }
 
-pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
-    let conductivity = match &spec.conductivity {
+/// A case coefficient as a conductivity of the library (evaluated at t = 0).
+pub(crate) fn conductivity(coefficient: &Coefficient) -> Conductivity {
+    match coefficient {
         Coefficient::Scalar(e) => Conductivity::Scalar(scalar_fn(e)),
         Coefficient::Tensor(rows) => {
             let rows = rows.clone();
@@ -131,7 +148,11 @@ pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion 
             });
             Conductivity::Tensor(f)
         }
-    };
+    }
+}
+
+pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
+    let conductivity = conductivity(&spec.conductivity);
     let mut problem = Diffusion::new(spec.method, conductivity, scalar_fn(&spec.source));
     for b in &spec.boundary {
         let kind = match &b.kind {
@@ -259,10 +280,14 @@ fn solve_diffusion(
             description: format!("∂u/∂{name} reconstructed per cell"),
         });
     }
-    let (errors, flux_error) = match &case.exact {
+    let exact = case
+        .exact
+        .as_ref()
+        .and_then(|e| Some((e.solution.as_ref()?, e)));
+    let (errors, flux_error) = match exact {
         None => (None, None),
-        Some(exact) => {
-            let u = scalar_fn(&exact.solution);
+        Some((solution_fn, exact)) => {
+            let u = scalar_fn(solution_fn);
             let grad: Option<VectorFn> = exact.gradient.as_ref().map(|g| vector_fn(g));
             let errors = diffusion::errors(complex, &solution, &u, grad.as_ref());
             let flux_error = grad
@@ -316,6 +341,9 @@ fn solve_diffusion(
         timings,
         warnings,
         pure_neumann: solution.pure_neumann,
+        series: Vec::new(),
+        notes: Vec::new(),
+        report: serde_json::Map::new(),
     })
 }
 
@@ -504,6 +532,9 @@ fn gradient(
         timings: vec![("sample + Ω δ".into(), seconds)],
         warnings: Vec::new(),
         pure_neumann: false,
+        series: Vec::new(),
+        notes: Vec::new(),
+        report: serde_json::Map::new(),
     })
 }
 
@@ -533,6 +564,12 @@ impl fmt::Display for RunResult {
         if let Some(q) = self.flux_error {
             writeln!(f, "flux error L2 {q:.6e}")?;
         }
+        for (label, text) in &self.notes {
+            for (i, line) in text.lines().enumerate() {
+                let label = if i == 0 { label.as_str() } else { "" };
+                writeln!(f, "{label:<10} {line}")?;
+            }
+        }
         let timing: Vec<String> = self
             .timings
             .iter()
@@ -561,7 +598,7 @@ impl RunResult {
             .iter()
             .map(|(name, s)| (name.clone(), serde_json::json!(s)))
             .collect();
-        serde_json::json!({
+        let mut report = serde_json::json!({
             "problem": self.problem,
             "method": self.method,
             "cells_per_dimension": complex.cell_counts(),
@@ -573,7 +610,11 @@ impl RunResult {
             "pure_neumann": self.pure_neumann,
             "timings_seconds": timings,
             "warnings": self.warnings,
-        })
+        });
+        if let Some(map) = report.as_object_mut() {
+            map.extend(self.report.clone());
+        }
+        report
     }
 }
 
@@ -588,27 +629,40 @@ pub fn write_output(
     stem: &std::path::Path,
 ) -> Result<crate::output::OutputFiles, crate::output::OutputError> {
     use crate::output::{Cochain, Provenance, RunOutput, Step};
-    let cochains = result
-        .fields
-        .iter()
-        .map(|f| {
-            let c = Cochain::new(f.name.clone(), f.dim, f.values.clone())
-                .with_description(f.description.clone());
-            match &result.method {
-                Some(m) => c.with_method(m.clone()),
-                None => c,
-            }
-        })
-        .collect();
+    let cochains = |fields: &[Field]| -> Vec<Cochain> {
+        fields
+            .iter()
+            .map(|f| {
+                let c = Cochain::new(f.name.clone(), f.dim, f.values.clone())
+                    .with_description(f.description.clone());
+                match &result.method {
+                    Some(m) => c.with_method(m.clone()),
+                    None => c,
+                }
+            })
+            .collect()
+    };
+    let steps = if result.series.is_empty() {
+        vec![Step {
+            time: 0.0,
+            cochains: cochains(&result.fields),
+        }]
+    } else {
+        result
+            .series
+            .iter()
+            .map(|(time, fields)| Step {
+                time: *time,
+                cochains: cochains(fields),
+            })
+            .collect()
+    };
     let mut provenance = Provenance::new(result.report_json(complex));
     provenance.case_text = Some(case.text.clone());
     provenance.case_path = Some(case.path.display().to_string());
     let run = RunOutput {
         complex,
-        steps: vec![Step {
-            time: 0.0,
-            cochains,
-        }],
+        steps,
         provenance,
     };
     crate::output::write_run(stem, &run)

@@ -255,6 +255,19 @@ impl Heat {
         steps: usize,
         save_every: usize,
     ) -> Result<History, HeatError> {
+        self.run_with_progress(complex, initial, steps, save_every, &mut |_| {})
+    }
+
+    /// As [`run`](Self::run), telling `progress` the number of each step
+    /// taken (for progress display on long runs).
+    pub fn run_with_progress(
+        &self,
+        complex: &Complex,
+        initial: &dyn Fn(&[f64]) -> f64,
+        steps: usize,
+        save_every: usize,
+        progress: &mut dyn FnMut(usize),
+    ) -> Result<History, HeatError> {
         self.check()?;
         let n = complex.dim();
         let d = complex.embedding_dim();
@@ -388,6 +401,7 @@ impl Heat {
                 times.push(t);
                 fields.push(u.clone());
             }
+            progress(step);
         }
         let per_step = |seconds: f64| {
             if steps > 0 {

@@ -112,19 +112,112 @@ pub struct GradientSpec {
     pub metric: GradientMetric,
 }
 
+/// The time stepping of a transient problem (`[time]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TimeSpec {
+    /// Constant step Δt > 0.
+    pub dt: f64,
+    /// Number of steps taken from t₀.
+    pub steps: usize,
+    /// Start time t₀.
+    pub start: f64,
+    /// θ of the θ-scheme: 1 backward Euler, ½ Crank–Nicolson.
+    pub theta: f64,
+    /// Every how many steps a level is written (t₀ and the last always are).
+    pub save_every: usize,
+}
+
+/// ∂u/∂t − ∇·(K∇u) = f(x, t) from u(x, t₀) = `initial`.
+#[derive(Clone, Debug)]
+pub struct HeatSpec {
+    pub method: Method,
+    pub conductivity: Coefficient,
+    /// f(x, t).
+    pub source: Expression,
+    /// u(x, t₀).
+    pub initial: Expression,
+    /// Values may depend on t; a Robin α may not.
+    pub boundary: Vec<BoundarySpec>,
+    pub time: TimeSpec,
+}
+
+/// Mixed Darcy: u = −K∇p, ∇·u = f, flux on faces and pressure on cells.
+///
+/// Boundary conditions reuse [`BoundarySpec`]: `type = "pressure"` is read
+/// as [`BoundaryKindSpec::Dirichlet`] (p given), `type = "flux"` as
+/// [`BoundaryKindSpec::Neumann`] with the value the outward normal velocity
+/// u·n. Boundary faces in no tag are no-flow.
+#[derive(Clone, Debug)]
+pub struct DarcySpec {
+    pub mass: crate::darcy::FluxMass,
+    pub permeability: Coefficient,
+    pub source: Expression,
+    pub boundary: Vec<BoundarySpec>,
+}
+
+/// Resonant modes of a cavity with perfectly conducting walls.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaxwellSpec {
+    /// The dual whose Hodge stars ⋆₁, ⋆₂ are used.
+    pub dual: hasse_complex::DualKind,
+    pub mass: crate::maxwell::Mass,
+    /// How many of the smallest nonzero ω² to compute.
+    pub modes: usize,
+}
+
 /// What the case solves.
 #[derive(Clone, Debug)]
 pub enum Problem {
     Diffusion(DiffusionSpec),
     Gradient(GradientSpec),
+    Heat(HeatSpec),
+    Darcy(DarcySpec),
+    Maxwell(MaxwellSpec),
+}
+
+impl Problem {
+    /// The `problem.kind` that names this problem.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Problem::Diffusion(_) => "diffusion",
+            Problem::Gradient(_) => "gradient",
+            Problem::Heat(_) => "heat",
+            Problem::Darcy(_) => "darcy",
+            Problem::Maxwell(_) => "maxwell",
+        }
+    }
+
+    /// The boundary conditions, whatever the kind.
+    pub fn boundary(&self) -> &[BoundarySpec] {
+        match self {
+            Problem::Diffusion(d) => &d.boundary,
+            Problem::Heat(h) => &h.boundary,
+            Problem::Darcy(d) => &d.boundary,
+            Problem::Gradient(_) | Problem::Maxwell(_) => &[],
+        }
+    }
+
+    /// The diffusion coefficient or permeability, if the problem has one.
+    pub fn coefficient(&self) -> Option<&Coefficient> {
+        match self {
+            Problem::Diffusion(d) => Some(&d.conductivity),
+            Problem::Heat(h) => Some(&h.conductivity),
+            Problem::Darcy(d) => Some(&d.permeability),
+            Problem::Gradient(_) | Problem::Maxwell(_) => None,
+        }
+    }
 }
 
 /// The exact solution, when known.
 #[derive(Clone, Debug)]
 pub struct ExactSpec {
-    pub solution: Expression,
+    /// u(x, y, z) (and t for heat; the pressure for Darcy). Absent for
+    /// eigenproblems.
+    pub solution: Option<Expression>,
     /// ∇u, one expression per coordinate (enables flux errors).
     pub gradient: Option<Vec<Expression>>,
+    /// Exact eigenvalues, ascending (Maxwell: ω²).
+    pub eigenvalues: Vec<f64>,
 }
 
 /// Linear solver settings.
@@ -235,7 +328,7 @@ impl Case {
                 return Err(Diagnostics(collector.diagnostics));
             }
         };
-        if let Problem::Diffusion(spec) = &self.problem {
+        {
             let n = complex.dim();
             let available: Vec<String> = complex
                 .tags()
@@ -243,7 +336,7 @@ impl Case {
                 .filter(|(_, t)| n > 0 && t.dim == n - 1)
                 .map(|(name, _)| name.to_string())
                 .collect();
-            for b in &spec.boundary {
+            for b in self.problem.boundary() {
                 match complex.tag(&b.tag) {
                     None => {
                         let help = match expr::closest(&b.tag, &available) {
@@ -278,7 +371,7 @@ impl Case {
                     Some(_) => {}
                 }
             }
-            if let Coefficient::Tensor(rows) = &spec.conductivity {
+            if let Some(Coefficient::Tensor(rows)) = self.problem.coefficient() {
                 let d = complex.embedding_dim();
                 if rows.len() != d {
                     collector.error(
@@ -301,11 +394,12 @@ impl Case {
         }
     }
 
-    /// The method of a diffusion problem.
+    /// The method of a diffusion or heat problem.
     pub fn method(&self) -> Option<Method> {
         match &self.problem {
             Problem::Diffusion(d) => Some(d.method),
-            Problem::Gradient(_) => None,
+            Problem::Heat(h) => Some(h.method),
+            Problem::Gradient(_) | Problem::Darcy(_) | Problem::Maxwell(_) => None,
         }
     }
 }

@@ -18,6 +18,9 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml_edit::{ImDocument, Item, TableLike, Value};
 
+mod kinds;
+use kinds::{kind_help, problem_kind, Conditions};
+
 const TOP_KEYS: &[&str] = &[
     "title",
     "description",
@@ -30,6 +33,7 @@ const TOP_KEYS: &[&str] = &[
     "solver",
     "output",
     "refine",
+    "time",
 ];
 const MESH_KEYS: &[&str] = &[
     "generator",
@@ -59,9 +63,24 @@ const PROBLEM_KEYS: &[&str] = &[
     "field",
     "metric",
     "cell_points",
+    "initial",
+    "permeability",
+    "mass",
+    "modes",
+];
+/// The `problem` keys each kind takes (besides `kind`).
+const KIND_KEYS: &[(&str, &[&str])] = &[
+    (
+        "diffusion",
+        &["method", "conductivity", "source", "cell_points"],
+    ),
+    ("gradient", &["field", "metric"]),
+    ("heat", &["method", "conductivity", "source", "initial"]),
+    ("darcy", &["method", "permeability", "source"]),
+    ("maxwell", &["method", "mass", "modes"]),
 ];
 const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha"];
-const EXACT_KEYS: &[&str] = &["solution", "gradient"];
+const EXACT_KEYS: &[&str] = &["solution", "gradient", "eigenvalues"];
 const SOLVER_KEYS: &[&str] = &[
     "type",
     "factorization",
@@ -212,6 +231,18 @@ impl Reader {
         let solver = reader.solver(root);
         let output = reader.output(root);
         let refine = reader.refine(root);
+        if refine.is_some() && problem_kind(root) != "diffusion" {
+            let span = root.get_key_value("refine").and_then(|(k, _)| k.span());
+            reader.error(
+                span,
+                "refine",
+                format!(
+                    "[refine] is for diffusion problems; this case is kind = \"{}\"",
+                    problem_kind(root)
+                ),
+                Some("remove [refine], or run `hasse converge` for a study".into()),
+            );
+        }
 
         if !reader.collector.diagnostics.is_empty() {
             return Err(Diagnostics(reader.collector.diagnostics));
@@ -503,25 +534,16 @@ impl Reader {
         let kind = self
             .string_at(table, "problem", "kind")
             .unwrap_or_else(|| "diffusion".into());
+        self.check_kind_keys(root, table, &kind);
         match kind.as_str() {
             "diffusion" => {
-                for key in ["field", "metric"] {
-                    if let Some(e) = self.entry(table, "problem", key) {
-                        self.error(
-                            e.key_span.clone(),
-                            &e.name,
-                            "only used by kind = \"gradient\"",
-                            None,
-                        );
-                    }
-                }
                 let method = self.method(table, problem_entry.span());
-                let conductivity = self.conductivity(table, scope);
+                let conductivity = self.coefficient(table, "conductivity", scope);
                 let source = match self.entry(table, "problem", "source") {
                     Some(_) => self.expression_at(table, "problem", "source", scope),
                     None => scope.parse("0").ok(),
                 };
-                let boundary = self.boundary(root, scope);
+                let boundary = self.boundary(root, scope, Conditions::Steady);
                 let circumcentres = match self.string_at(table, "problem", "cell_points").as_deref()
                 {
                     None | Some("centroids") => false,
@@ -548,17 +570,10 @@ impl Reader {
                     circumcentres,
                 }))
             }
+            "heat" => self.heat(root, table, problem_entry.span(), scope),
+            "darcy" => self.darcy(root, table, problem_entry.span(), scope),
+            "maxwell" => self.maxwell(root, table, problem_entry.span()),
             "gradient" => {
-                for key in ["method", "conductivity", "source", "cell_points"] {
-                    if let Some(e) = self.entry(table, "problem", key) {
-                        self.error(
-                            e.key_span.clone(),
-                            &e.name,
-                            "not used by kind = \"gradient\"",
-                            Some("a gradient problem takes `field` and `metric`".into()),
-                        );
-                    }
-                }
                 if let Some(e) = self.entry(root, "", "boundary") {
                     self.error(
                         e.key_span.clone(),
@@ -591,7 +606,7 @@ impl Reader {
                     span,
                     "problem.kind",
                     format!("unknown problem kind \"{other}\""),
-                    Some("use \"diffusion\" (default) or \"gradient\"".into()),
+                    Some(kind_help(other)),
                 );
                 None
             }
@@ -638,8 +653,14 @@ impl Reader {
         Some(method)
     }
 
-    fn conductivity(&mut self, table: &dyn TableLike, scope: &Scope) -> Option<Coefficient> {
-        let Some(entry) = self.entry(table, "problem", "conductivity") else {
+    /// A scalar or tensor coefficient under `problem.<key>` (default 1).
+    fn coefficient(
+        &mut self,
+        table: &dyn TableLike,
+        key: &str,
+        scope: &Scope,
+    ) -> Option<Coefficient> {
+        let Some(entry) = self.entry(table, "problem", key) else {
             return scope.parse("1").ok().map(Coefficient::Scalar);
         };
         let Some(Value::Array(rows)) = entry.item.as_value() else {
@@ -703,7 +724,7 @@ impl Reader {
             for (j, a) in row.iter().enumerate().take(i) {
                 let b = &tensor[j][i];
                 if a.is_constant() && b.is_constant() && a.eval(&[], 0.0) != b.eval(&[], 0.0) {
-                    self.error(entry.span(), &entry.name, format!("the tensor is not symmetric: entry [{i}][{j}] = {} but [{j}][{i}] = {}", a.text(), b.text()), Some("a diffusion tensor is symmetric positive definite".into()));
+                    self.error(entry.span(), &entry.name, format!("the tensor is not symmetric: entry [{i}][{j}] = {} but [{j}][{i}] = {}", a.text(), b.text()), Some("a diffusion or permeability tensor is symmetric positive definite".into()));
                     return None;
                 }
             }
@@ -711,7 +732,13 @@ impl Reader {
         Some(Coefficient::Tensor(tensor))
     }
 
-    fn boundary(&mut self, root: &dyn TableLike, scope: &Scope) -> Vec<BoundarySpec> {
+    fn boundary(
+        &mut self,
+        root: &dyn TableLike,
+        scope: &Scope,
+        conditions: Conditions,
+    ) -> Vec<BoundarySpec> {
+        let names = conditions.names();
         let mut out = Vec::new();
         let Some(entry) = self.entry(root, "", "boundary") else {
             return out;
@@ -746,7 +773,7 @@ impl Reader {
                     self.error(
                         header.clone(),
                         &format!("{prefix}.type"),
-                        "missing: dirichlet, neumann or robin",
+                        format!("missing: {}", names.join(", ")),
                         None,
                     );
                     None
@@ -764,10 +791,12 @@ impl Reader {
                     None
                 }
             };
-            let kind = match kind_name.as_deref() {
-                Some("dirichlet") => value.map(BoundaryKindSpec::Dirichlet),
-                Some("neumann") => value.map(BoundaryKindSpec::Neumann),
-                Some("robin") => {
+            let kind = match (conditions, kind_name.as_deref()) {
+                (Conditions::Steady | Conditions::Transient, Some("dirichlet"))
+                | (Conditions::Darcy, Some("pressure")) => value.map(BoundaryKindSpec::Dirichlet),
+                (Conditions::Steady | Conditions::Transient, Some("neumann"))
+                | (Conditions::Darcy, Some("flux")) => value.map(BoundaryKindSpec::Neumann),
+                (Conditions::Steady | Conditions::Transient, Some("robin")) => {
                     let alpha = match self.entry(table, &prefix, "alpha") {
                         Some(_) => self.expression_at(table, &prefix, "alpha", scope),
                         None => {
@@ -780,6 +809,12 @@ impl Reader {
                             None
                         }
                     };
+                    if conditions == Conditions::Transient
+                        && alpha.as_ref().is_some_and(|a| a.uses_time())
+                    {
+                        let span = self.entry(table, &prefix, "alpha").and_then(|e| e.span());
+                        self.error(span, &format!("{prefix}.alpha"), "a Robin coefficient α enters the matrix, which is factorised once: it may not depend on t", Some("the value g may depend on t".into()));
+                    }
                     match (alpha, value) {
                         (Some(alpha), Some(value)) => {
                             Some(BoundaryKindSpec::Robin { alpha, value })
@@ -787,13 +822,13 @@ impl Reader {
                         _ => None,
                     }
                 }
-                Some(other) => {
+                (_, Some(other)) => {
                     let span = self.entry(table, &prefix, "type").and_then(|e| e.span());
-                    let kinds = ["dirichlet".to_string(), "neumann".into(), "robin".into()];
-                    let help = closest(other, &kinds)
-                        .map_or("use dirichlet, neumann or robin".into(), |s| {
-                            format!("did you mean \"{s}\"?")
-                        });
+                    let kinds: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+                    let help = closest(other, &kinds).map_or_else(
+                        || conditions.help().to_string(),
+                        |s| format!("did you mean \"{s}\"? {}", conditions.help()),
+                    );
                     self.error(
                         span,
                         &format!("{prefix}.type"),
@@ -802,9 +837,9 @@ impl Reader {
                     );
                     None
                 }
-                None => None,
+                (_, None) => None,
             };
-            if kind_name.as_deref() != Some("robin") {
+            if kind_name.as_deref() != Some("robin") || conditions == Conditions::Darcy {
                 if let Some(e) = self.entry(table, &prefix, "alpha") {
                     self.error(
                         e.key_span.clone(),
@@ -932,8 +967,19 @@ impl Reader {
     fn exact(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<ExactSpec> {
         let (table, entry) = self.subtable(root, "", "exact")?;
         self.check_keys(table, "exact", EXACT_KEYS);
+        let eigenproblem = problem_kind(root) == "maxwell";
         let solution = match self.entry(table, "exact", "solution") {
+            Some(e) if eigenproblem => {
+                self.error(
+                    e.key_span.clone(),
+                    "exact.solution",
+                    "an eigenproblem has no single solution",
+                    Some("give the exact eigenvalues: eigenvalues = [...]".into()),
+                );
+                None
+            }
             Some(_) => self.expression_at(table, "exact", "solution", scope),
+            None if eigenproblem => None,
             None => {
                 self.error(
                     entry.span(),
@@ -941,7 +987,7 @@ impl Reader {
                     "missing: the exact solution u(x, y, z)",
                     None,
                 );
-                None
+                return None;
             }
         };
         let gradient = match self.entry(table, "exact", "gradient") {
@@ -968,9 +1014,32 @@ impl Reader {
                 }
             },
         };
+        let eigenvalues = match self.entry(table, "exact", "eigenvalues") {
+            None if eigenproblem => {
+                self.error(
+                    entry.span(),
+                    "exact.eigenvalues",
+                    "missing: the exact eigenvalues, ascending",
+                    Some("e.g. eigenvalues = [\"pi^2\", \"pi^2\", \"2*pi^2\"]".into()),
+                );
+                return None;
+            }
+            None => Vec::new(),
+            Some(e) if !eigenproblem => {
+                self.error(
+                    e.key_span.clone(),
+                    "exact.eigenvalues",
+                    "only an eigenproblem (kind = \"maxwell\") has eigenvalues",
+                    None,
+                );
+                Vec::new()
+            }
+            Some(e) => self.constant_list(&e, scope)?,
+        };
         Some(ExactSpec {
-            solution: solution?,
+            solution: if eigenproblem { None } else { Some(solution?) },
             gradient,
+            eigenvalues,
         })
     }
 

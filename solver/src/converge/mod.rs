@@ -286,10 +286,8 @@ pub enum StudyError {
     BadExpectation(String),
     #[error("a study needs at least 1 level")]
     NoLevels,
-    #[error(
-        "{case}: a convergence study needs a diffusion problem (this case is a gradient problem)"
-    )]
-    NotDiffusion { case: String },
+    #[error("{case}: a convergence study compares methods on a diffusion problem; this case is kind = \"{kind}\"")]
+    NotDiffusion { case: String, kind: &'static str },
     #[error("{case}: a convergence study needs the exact solution: add an [exact] table with `solution` (and `gradient` for gradient and flux errors)")]
     NoExact { case: String },
     /// The case's mesh cannot be refined as asked.
@@ -429,9 +427,10 @@ impl Study {
         let base = Case::from_text(file, text, overrides).map_err(StudyError::Invalid)?;
         let own = match &base.problem {
             Problem::Diffusion(d) => d.method,
-            Problem::Gradient(_) => {
+            other => {
                 return Err(StudyError::NotDiffusion {
                     case: file.to_string(),
+                    kind: other.kind(),
                 })
             }
         };

@@ -1,0 +1,619 @@
+//! The problem kinds beyond steady diffusion and gradients: which `problem`
+//! keys each kind takes, and reading transient heat (with its `[time]`
+//! table), mixed Darcy and Maxwell cavity problems.
+
+use super::{join, Reader, KIND_KEYS};
+use crate::case::expr::{closest, Scope};
+use crate::case::{DarcySpec, HeatSpec, MaxwellSpec, Problem, TimeSpec};
+use crate::darcy::FluxMass;
+use crate::diffusion::Method;
+use crate::maxwell::Mass;
+use hasse_complex::DualKind;
+use std::ops::Range;
+use toml_edit::{Item, TableLike, Value};
+
+const TIME_KEYS: &[&str] = &[
+    "dt",
+    "steps",
+    "end",
+    "start",
+    "scheme",
+    "theta",
+    "save_every",
+];
+const SCHEMES: &[&str] = &["backward-euler", "crank-nicolson"];
+const DARCY_METHODS: &[&str] = &["mimetic", "dec", "dec-barycentric"];
+const MAXWELL_METHODS: &[&str] = &["dec", "dec-barycentric"];
+const MAXWELL_MASSES: &[&str] = &["hodge", "whitney"];
+/// More steps than this is almost certainly a typo in `dt` or `end`.
+const MAX_STEPS: i64 = 10_000_000;
+
+/// The kind a case's `problem.kind` names (default diffusion), read
+/// directly from the document so other tables can depend on it.
+pub(in crate::case) fn problem_kind(root: &dyn TableLike) -> &str {
+    root.get("problem")
+        .and_then(Item::as_table_like)
+        .and_then(|p| p.get("kind"))
+        .and_then(Item::as_str)
+        .unwrap_or("diffusion")
+}
+
+/// The help line of an unknown `problem.kind`.
+pub(in crate::case) fn kind_help(other: &str) -> String {
+    let kinds: Vec<String> = KIND_KEYS.iter().map(|(k, _)| k.to_string()).collect();
+    let list = kinds.join(", ");
+    match closest(other, &kinds) {
+        Some(s) => format!("did you mean \"{s}\"? kinds: {list} (default diffusion)"),
+        None => format!("kinds: {list} (default diffusion)"),
+    }
+}
+
+/// Which boundary condition types a problem kind accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(in crate::case) enum Conditions {
+    /// Dirichlet, Neumann and Robin on a steady scalar problem.
+    Steady,
+    /// As `Steady`, with values that may depend on t (not the Robin α).
+    Transient,
+    /// Pressure (natural) and normal velocity (essential) on Darcy flow.
+    Darcy,
+}
+
+impl Conditions {
+    pub(in crate::case) fn names(self) -> &'static [&'static str] {
+        match self {
+            Conditions::Steady | Conditions::Transient => &["dirichlet", "neumann", "robin"],
+            Conditions::Darcy => &["pressure", "flux"],
+        }
+    }
+
+    pub(in crate::case) fn help(self) -> &'static str {
+        match self {
+            Conditions::Steady | Conditions::Transient => "use dirichlet, neumann or robin",
+            Conditions::Darcy => "a Darcy boundary takes \"pressure\" (p given) or \"flux\" (outward normal velocity u·n given); untagged boundary faces are no-flow",
+        }
+    }
+}
+
+impl Reader {
+    /// Report `problem` keys the kind does not use, and a `[time]` table
+    /// on a steady problem.
+    pub(super) fn check_kind_keys(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        kind: &str,
+    ) {
+        let Some((_, keys)) = KIND_KEYS.iter().find(|(k, _)| *k == kind) else {
+            // An unknown kind is reported by the caller.
+            return;
+        };
+        for (key, _) in table.iter() {
+            if key == "kind" || keys.contains(&key) || !super::PROBLEM_KEYS.contains(&key) {
+                continue;
+            }
+            let span = table.get_key_value(key).and_then(|(k, _)| k.span());
+            let users: Vec<&str> = KIND_KEYS
+                .iter()
+                .filter(|(_, ks)| ks.contains(&key))
+                .map(|(k, _)| *k)
+                .collect();
+            self.error(
+                span,
+                &join("problem", key),
+                format!(
+                    "not used by kind = \"{kind}\" (only by {})",
+                    users.join(", ")
+                ),
+                Some(format!("a {kind} problem takes: {}", keys.join(", "))),
+            );
+        }
+        if kind != "heat" {
+            if let Some((k, _)) = root.get_key_value("time") {
+                self.error(
+                    k.span(),
+                    "time",
+                    format!("[time] is for kind = \"heat\"; this problem is {kind}"),
+                    Some("remove [time], or set problem.kind = \"heat\"".into()),
+                );
+            }
+        }
+    }
+
+    pub(super) fn heat(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+        scope: &Scope,
+    ) -> Option<Problem> {
+        let method = self.method(table, header.clone());
+        if method == Some(Method::FvMimetic) {
+            let span = self
+                .entry(table, "problem", "method")
+                .and_then(|e| e.span());
+            self.error(
+                span,
+                "problem.method",
+                "fv-mimetic has half-face unknowns, which carry no mass: it cannot step in time",
+                Some("use fe, fv, fd, dec or dec-barycentric".into()),
+            );
+        }
+        let conductivity = self.coefficient(table, "conductivity", scope);
+        let source = match self.entry(table, "problem", "source") {
+            Some(_) => self.expression_at(table, "problem", "source", scope),
+            None => scope.parse("0").ok(),
+        };
+        let initial = match self.entry(table, "problem", "initial") {
+            Some(_) => self.expression_at(table, "problem", "initial", scope),
+            None => {
+                self.error(
+                    header,
+                    "problem.initial",
+                    "missing: the initial temperature u(x, y, z) at t₀",
+                    Some("e.g. initial = \"sin(pi*x)*sin(pi*y)\"".into()),
+                );
+                None
+            }
+        };
+        let boundary = self.boundary(root, scope, Conditions::Transient);
+        let time = self.time(root);
+        if method == Some(Method::FvMimetic) {
+            return None;
+        }
+        Some(Problem::Heat(HeatSpec {
+            method: method?,
+            conductivity: conductivity?,
+            source: source?,
+            initial: initial?,
+            boundary,
+            time: time?,
+        }))
+    }
+
+    /// The `[time]` table of a heat problem.
+    fn time(&mut self, root: &dyn TableLike) -> Option<TimeSpec> {
+        let Some((table, entry)) = self.subtable(root, "", "time") else {
+            if root.get("time").is_none() {
+                self.error(
+                    None,
+                    "time",
+                    "no [time] table: a heat problem steps in time",
+                    Some("add [time] with `dt = 0.01` and `steps = 100` (or `end = 1.0`)".into()),
+                );
+            }
+            return None;
+        };
+        let header = entry.span();
+        self.check_keys(table, "time", TIME_KEYS);
+        let dt = match self.entry(table, "time", "dt") {
+            None => {
+                self.error(header.clone(), "time.dt", "missing: the time step Δt", None);
+                None
+            }
+            Some(e) => match self.number(&e) {
+                Some(v) if v > 0.0 && v.is_finite() => Some(v),
+                Some(v) => {
+                    self.error(
+                        e.span(),
+                        "time.dt",
+                        format!("the time step must be positive and finite, found {v}"),
+                        None,
+                    );
+                    None
+                }
+                None => None,
+            },
+        };
+        let start = match self.number_at(table, "time", "start") {
+            Some(v) if !v.is_finite() => {
+                let span = self.entry(table, "time", "start").and_then(|e| e.span());
+                self.error(span, "time.start", format!("not finite: {v}"), None);
+                None
+            }
+            Some(v) => Some(v),
+            None => Some(0.0),
+        };
+        let steps = self.step_count(table, header.clone(), dt, start);
+        let theta = self.theta(table);
+        let save_every = match self.entry(table, "time", "save_every") {
+            None => Some(1),
+            Some(e) => match e.item.as_integer() {
+                Some(k) if k >= 0 => Some(k as usize),
+                Some(k) => {
+                    self.error(
+                        e.span(),
+                        "time.save_every",
+                        format!("a step count ≥ 0, found {k}"),
+                        Some("0 saves only the first and last levels".into()),
+                    );
+                    None
+                }
+                None => {
+                    self.type_error(&e, "an integer");
+                    None
+                }
+            },
+        };
+        Some(TimeSpec {
+            dt: dt?,
+            steps: steps?,
+            start: start?,
+            theta: theta?,
+            save_every: save_every?,
+        })
+    }
+
+    /// `steps`, or `end` turned into a whole number of steps of `dt`.
+    fn step_count(
+        &mut self,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+        dt: Option<f64>,
+        start: Option<f64>,
+    ) -> Option<usize> {
+        let steps = self.entry(table, "time", "steps");
+        let end = self.entry(table, "time", "end");
+        match (steps, end) {
+            (Some(_), Some(e)) => {
+                self.error(
+                    e.key_span.clone(),
+                    "time.end",
+                    "give either steps or end, not both",
+                    None,
+                );
+                None
+            }
+            (None, None) => {
+                self.error(
+                    header,
+                    "time.steps",
+                    "missing: how long to run",
+                    Some("give `steps = 100` or `end = 1.0`".into()),
+                );
+                None
+            }
+            (Some(e), None) => match e.item.as_integer() {
+                Some(n) if (1..=MAX_STEPS).contains(&n) => Some(n as usize),
+                Some(n) => {
+                    self.error(
+                        e.span(),
+                        "time.steps",
+                        format!("between 1 and {MAX_STEPS} steps, found {n}"),
+                        None,
+                    );
+                    None
+                }
+                None => {
+                    self.type_error(&e, "an integer");
+                    None
+                }
+            },
+            (None, Some(e)) => {
+                let end = self.number(&e)?;
+                let (dt, start) = (dt?, start?);
+                let span = e.span();
+                if !(end.is_finite() && end > start) {
+                    self.error(
+                        span,
+                        "time.end",
+                        format!(
+                            "the end time must be finite and after the start {start}, found {end}"
+                        ),
+                        None,
+                    );
+                    return None;
+                }
+                let exact = (end - start) / dt;
+                let steps = exact.round();
+                // Steps must tile [t₀, end] exactly, or the last level would
+                // not be at `end` and errors there would be misleading.
+                if (exact - steps).abs() > 1e-9 * exact.max(1.0) || steps < 1.0 {
+                    self.error(
+                        span,
+                        "time.end",
+                        format!("end − start = {} is not a whole number of steps dt = {dt} ({exact:.6} steps)", end - start),
+                        Some("change dt or end, or give `steps` instead".into()),
+                    );
+                    return None;
+                }
+                if steps > MAX_STEPS as f64 {
+                    self.error(
+                        span,
+                        "time.end",
+                        format!("{steps} steps of dt = {dt}: more than {MAX_STEPS}"),
+                        Some("check dt and end".into()),
+                    );
+                    return None;
+                }
+                Some(steps as usize)
+            }
+        }
+    }
+
+    /// θ from `scheme` or `theta` (default backward Euler, θ = 1).
+    fn theta(&mut self, table: &dyn TableLike) -> Option<f64> {
+        let scheme = self.entry(table, "time", "scheme");
+        let theta = self.entry(table, "time", "theta");
+        if let (Some(_), Some(t)) = (&scheme, &theta) {
+            self.error(
+                t.key_span.clone(),
+                "time.theta",
+                "give either scheme or theta, not both",
+                None,
+            );
+            return None;
+        }
+        if let Some(t) = theta {
+            let v = self.number(&t)?;
+            if !(0.0..=1.0).contains(&v) {
+                self.error(
+                    t.span(),
+                    "time.theta",
+                    format!("θ must lie in [0, 1], found {v}"),
+                    Some("1 is backward Euler, 0.5 Crank–Nicolson".into()),
+                );
+                return None;
+            }
+            return Some(v);
+        }
+        let Some(s) = scheme else {
+            return Some(1.0);
+        };
+        match s.item.as_str() {
+            Some("backward-euler") => Some(1.0),
+            Some("crank-nicolson") => Some(0.5),
+            Some(other) => {
+                let owned: Vec<String> = SCHEMES.iter().map(|s| s.to_string()).collect();
+                let help = closest(other, &owned).map_or_else(
+                    || format!("schemes: {} (or theta = …)", SCHEMES.join(", ")),
+                    |s| format!("did you mean \"{s}\"?"),
+                );
+                self.error(
+                    s.span(),
+                    "time.scheme",
+                    format!("unknown time scheme \"{other}\""),
+                    Some(help),
+                );
+                None
+            }
+            None => {
+                self.type_error(&s, "a string");
+                None
+            }
+        }
+    }
+
+    /// A string key of `problem` chosen from `choices`.
+    fn choice(
+        &mut self,
+        table: &dyn TableLike,
+        key: &str,
+        choices: &[&str],
+        what: &str,
+        header: Option<Range<usize>>,
+        default: Option<&'static str>,
+    ) -> Option<String> {
+        let name = join("problem", key);
+        let Some(entry) = self.entry(table, "problem", key) else {
+            if default.is_none() {
+                self.error(
+                    header,
+                    &name,
+                    format!("missing: the {what}"),
+                    Some(format!("one of {}", choices.join(", "))),
+                );
+            }
+            return default.map(str::to_string);
+        };
+        match entry.item.as_str() {
+            Some(s) if choices.contains(&s) => Some(s.to_string()),
+            Some(other) => {
+                let owned: Vec<String> = choices.iter().map(|s| s.to_string()).collect();
+                let help = match closest(other, &owned) {
+                    Some(s) => format!("did you mean \"{s}\"? choices: {}", choices.join(", ")),
+                    None => format!("choices: {}", choices.join(", ")),
+                };
+                self.error(
+                    entry.span(),
+                    &name,
+                    format!("unknown {what} \"{other}\""),
+                    Some(help),
+                );
+                None
+            }
+            None => {
+                self.type_error(&entry, "a string");
+                None
+            }
+        }
+    }
+
+    /// `solver.factorization` if it is one of `refused`, with its span.
+    fn refused_factorization(
+        &self,
+        root: &dyn TableLike,
+        refused: &[&str],
+    ) -> Option<(Option<Range<usize>>, String)> {
+        let solver = root.get("solver")?.as_table_like()?;
+        let (_, item) = solver.get_key_value("factorization")?;
+        let name = item.as_str()?;
+        refused
+            .contains(&name)
+            .then(|| (item.span(), name.to_string()))
+    }
+
+    pub(super) fn darcy(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+        scope: &Scope,
+    ) -> Option<Problem> {
+        let mass = self
+            .choice(
+                table,
+                "method",
+                DARCY_METHODS,
+                "flux mass method",
+                header,
+                None,
+            )
+            .map(|m| match m.as_str() {
+                "mimetic" => FluxMass::Mimetic,
+                "dec-barycentric" => FluxMass::Dec(DualKind::Barycentric),
+                _ => FluxMass::Dec(DualKind::Circumcentric),
+            });
+        let permeability = self.coefficient(table, "permeability", scope);
+        let source = match self.entry(table, "problem", "source") {
+            Some(_) => self.expression_at(table, "problem", "source", scope),
+            None => scope.parse("0").ok(),
+        };
+        let boundary = self.boundary(root, scope, Conditions::Darcy);
+        if let Some((span, name)) = self.refused_factorization(root, &["llt", "cholesky"]) {
+            self.error(
+                span,
+                "solver.factorization",
+                format!("the Darcy saddle-point matrix [[M, −∂], [−∂ᵀ, 0]] is indefinite: {name} (LLᵀ) cannot factorise it"),
+                Some("leave it out (LDLᵀ in a saddle-point-safe order), or use \"ldlt\", \"lblt\" or \"lu\"".into()),
+            );
+        }
+        Some(Problem::Darcy(DarcySpec {
+            mass: mass?,
+            permeability: permeability?,
+            source: source?,
+            boundary,
+        }))
+    }
+
+    pub(super) fn maxwell(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+    ) -> Option<Problem> {
+        let dual = self
+            .choice(
+                table,
+                "method",
+                MAXWELL_METHODS,
+                "Hodge star (dual)",
+                header.clone(),
+                None,
+            )
+            .map(|m| match m.as_str() {
+                "dec-barycentric" => DualKind::Barycentric,
+                _ => DualKind::Circumcentric,
+            });
+        let mass = self
+            .choice(
+                table,
+                "mass",
+                MAXWELL_MASSES,
+                "edge mass",
+                None,
+                Some("hodge"),
+            )
+            .map(|m| match m.as_str() {
+                "whitney" => Mass::Whitney,
+                _ => Mass::Hodge,
+            });
+        let modes = match self.entry(table, "problem", "modes") {
+            None => {
+                self.error(
+                    header,
+                    "problem.modes",
+                    "missing: how many resonant modes to compute",
+                    Some("e.g. modes = 6".into()),
+                );
+                None
+            }
+            Some(e) => match e.item.as_value() {
+                Some(Value::Integer(n)) if *n.value() >= 1 => Some(*n.value() as usize),
+                Some(Value::Integer(n)) => {
+                    self.error(
+                        e.span(),
+                        "problem.modes",
+                        format!("at least one mode, found {}", n.value()),
+                        None,
+                    );
+                    None
+                }
+                _ => {
+                    self.type_error(&e, "an integer");
+                    None
+                }
+            },
+        };
+        if let Some((k, _)) = root.get_key_value("boundary") {
+            self.error(
+                k.span(),
+                "boundary",
+                "a cavity's walls are perfect conductors (tangential E = 0 on the whole boundary): it takes no [[boundary]] conditions",
+                Some("remove the [[boundary]] tables".into()),
+            );
+        }
+        if let Some((span, name)) = self.refused_factorization(root, &["ldlt", "lblt", "lu"]) {
+            self.error(
+                span,
+                "solver.factorization",
+                format!("the cavity's shift-invert uses LLᵀ of the positive definite K − σM; \"{name}\" is not used"),
+                Some("remove solver.factorization".into()),
+            );
+        }
+        Some(Problem::Maxwell(MaxwellSpec {
+            dual: dual?,
+            mass: mass?,
+            modes: modes?,
+        }))
+    }
+
+    /// A list of constant numbers or constant expressions (`exact.eigenvalues`).
+    pub(super) fn constant_list(
+        &mut self,
+        entry: &super::Entry,
+        scope: &Scope,
+    ) -> Option<Vec<f64>> {
+        let Some(array) = entry.item.as_array() else {
+            self.type_error(entry, "an array of numbers or constant expressions");
+            return None;
+        };
+        let mut values = Vec::with_capacity(array.len());
+        let mut ok = true;
+        for (i, v) in array.iter().enumerate() {
+            let name = format!("{}[{i}]", entry.name);
+            let item = Item::Value(v.clone());
+            match self.expression_of(&item, &name, v.span(), scope) {
+                Some(e) if e.is_constant() => {
+                    let x = e.eval(&[], 0.0);
+                    if x.is_finite() {
+                        values.push(x);
+                    } else {
+                        self.error(v.span(), &name, format!("not finite: {x}"), None);
+                        ok = false;
+                    }
+                }
+                Some(_) => {
+                    self.error(
+                        v.span(),
+                        &name,
+                        "an eigenvalue is a number: it may not depend on x, y, z or t",
+                        None,
+                    );
+                    ok = false;
+                }
+                None => ok = false,
+            }
+        }
+        if ok && values.windows(2).any(|w| w[1] < w[0]) {
+            self.error(
+                entry.span(),
+                &entry.name,
+                "eigenvalues must be given in ascending order (they are compared with the computed ones in order)",
+                None,
+            );
+            ok = false;
+        }
+        ok.then_some(values)
+    }
+}

@@ -1,0 +1,477 @@
+//! Transient heat, mixed Darcy and Maxwell cavity cases run through the
+//! `hasse` binary: the shipped cases converge at the orders theory gives,
+//! the cavity's eigenvalues equal the closed-form values of the Yee-type
+//! grid, the output holds the time series and the modes, and bad
+//! problem-kind input is refused with the key named.
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hasse(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hasse"))
+        .args(args)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .output()
+        .expect("the hasse binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hasse-cli-physics-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Run `hasse run case` with overrides, output off; the summary.
+fn run(case: &str, sets: &[String]) -> String {
+    let mut args = vec!["run".to_string(), case.to_string()];
+    args.extend(["--set".into(), "output.write=false".into()]);
+    for s in sets {
+        args.extend(["--set".into(), s.clone()]);
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let out = hasse(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "hasse {args:?} failed ({:?}):\n{stdout}\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// The number after `label` on the summary line starting with `line`.
+fn reported(stdout: &str, line: &str, label: &str) -> f64 {
+    let text = stdout
+        .lines()
+        .find(|l| l.starts_with(line))
+        .unwrap_or_else(|| panic!("no `{line}` line in\n{stdout}"));
+    let start = text
+        .find(label)
+        .unwrap_or_else(|| panic!("no {label} in {text}"))
+        + label.len();
+    text[start..]
+        .trim_start()
+        .split([',', ' ', ')'])
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap_or_else(|e| panic!("{text}: {e}"))
+}
+
+fn order(e_coarse: f64, e_fine: f64, ratio: f64) -> f64 {
+    (e_coarse / e_fine).ln() / ratio.ln()
+}
+
+// ---------------------------------------------------------------- heat
+
+#[test]
+fn heat_square_converges_at_second_order_in_space() {
+    // dt small enough that the Crank–Nicolson error (≈ 1e-6 here) is far
+    // below the spatial one on these meshes.
+    let errors: Vec<f64> = [8, 16, 32]
+        .iter()
+        .map(|n| {
+            let out = run(
+                "cases/heat-square.toml",
+                &[format!("mesh.n=[{n},{n}]"), "time.dt=0.00125".into()],
+            );
+            reported(&out, "error", "L2")
+        })
+        .collect();
+    println!("heat-square, P1 + CN, n = 8, 16, 32: {errors:?}");
+    for pair in errors.windows(2) {
+        let p = order(pair[0], pair[1], 2.0);
+        assert!((p - 2.0).abs() <= 0.15, "spatial order {p}: {errors:?}");
+    }
+}
+
+/// u = (x + 2y) e^{−t} is linear in space, so the two-point flux with
+/// boundary faces at half-cell distance and the midpoint source are exact
+/// and the only error left is the time scheme's: order 1 for backward
+/// Euler, 2 for Crank–Nicolson.
+const LINEAR_IN_SPACE: &str = r#"
+[mesh]
+generator = "rectangle"
+n = [6, 6]
+
+[problem]
+kind = "heat"
+method = "fv"
+source = "-(x + 2*y) * exp(-t)"
+initial = "x + 2*y"
+
+[[boundary]]
+tag = "boundary"
+type = "dirichlet"
+value = "(x + 2*y) * exp(-t)"
+
+[time]
+dt = 0.1
+end = 1.0
+
+[exact]
+solution = "(x + 2*y) * exp(-t)"
+
+[output]
+write = false
+"#;
+
+#[test]
+fn heat_time_orders_are_one_and_two() {
+    let dir = scratch("time-orders");
+    let case = dir.join("linear.toml");
+    std::fs::write(&case, LINEAR_IN_SPACE).unwrap();
+    let case = case.to_str().unwrap();
+    for (scheme, expected) in [("backward-euler", 1.0), ("crank-nicolson", 2.0)] {
+        let errors: Vec<f64> = [0.1, 0.05, 0.025, 0.0125]
+            .iter()
+            .map(|dt| {
+                let out = run(
+                    case,
+                    &[format!("time.dt={dt}"), format!("time.scheme=\"{scheme}\"")],
+                );
+                reported(&out, "error", "L2")
+            })
+            .collect();
+        println!("{scheme}: {errors:?}");
+        for pair in errors.windows(2) {
+            let p = order(pair[0], pair[1], 2.0);
+            assert!(
+                (p - expected).abs() <= 0.15,
+                "{scheme}: order {p}, errors {errors:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn heat_output_is_a_time_series_from_the_initial_field() {
+    let dir = scratch("heat-output");
+    let stem = dir.join("heat");
+    let out = hasse(&[
+        "run",
+        "cases/heat-square.toml",
+        "--set",
+        "mesh.n=[8,8]",
+        "-o",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let printed_max = reported(&stdout, "error", "max");
+    let file = hdf5::File::open(stem.with_extension("h5")).unwrap();
+    // 20 steps of 0.005 saving every 2nd: t = 0, 0.01, …, 0.1.
+    let times: Vec<f64> = file.attr("times").unwrap().read_raw().unwrap();
+    assert_eq!(times.len(), 11);
+    for (k, t) in times.iter().enumerate() {
+        assert!((t - 0.01 * k as f64).abs() < 1e-12, "{times:?}");
+    }
+    let vertices: Vec<f64> = file.dataset("mesh/vertices").unwrap().read_raw().unwrap();
+    let u0: Vec<f64> = file.dataset("steps/0/u").unwrap().read_raw().unwrap();
+    assert_eq!(u0.len(), 81);
+    for (v, u) in u0.iter().enumerate() {
+        let (x, y) = (vertices[3 * v], vertices[3 * v + 1]);
+        let want = (PI * x).sin() * (PI * y).sin();
+        assert!((u - want).abs() < 1e-14, "vertex {v}: {u} vs {want}");
+    }
+    // The last level's error field is the one summarised on stdout, and
+    // the boundary vertices carry the Dirichlet value t (x + y) exactly.
+    let last: Vec<f64> = file.dataset("steps/10/u").unwrap().read_raw().unwrap();
+    let error: Vec<f64> = file.dataset("steps/10/error").unwrap().read_raw().unwrap();
+    let max = error.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    assert!((max - printed_max).abs() <= 1e-6 * printed_max);
+    for (v, u) in last.iter().enumerate() {
+        let (x, y) = (vertices[3 * v], vertices[3 * v + 1]);
+        if x == 0.0 || y == 0.0 || x == 1.0 || y == 1.0 {
+            assert!((u - 0.1 * (x + y)).abs() < 1e-14, "vertex {v}");
+        }
+    }
+}
+
+// ---------------------------------------------------------------- darcy
+
+#[test]
+fn darcy_layered_converges_and_conserves_mass() {
+    let (mut pressure, mut flux) = (vec![], vec![]);
+    for n in [8, 16, 32, 64] {
+        let out = run("cases/darcy-layered.toml", &[format!("mesh.n=[{n},{n}]")]);
+        pressure.push(reported(&out, "error", "L2"));
+        flux.push(reported(&out, "flux error", "L2"));
+        // Every cell's net outflow equals ∫f to rounding.
+        let relative = reported(&out, "mass", "relative");
+        assert!(relative < 1e-11, "n = {n}: conservation {relative}\n{out}");
+    }
+    println!("darcy-layered: pressure {pressure:?}, flux {flux:?}");
+    let p = order(pressure[0], pressure[3], 8.0);
+    let u = order(flux[0], flux[3], 8.0);
+    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}: {pressure:?}");
+    assert!(u >= 1.0 - 0.15, "flux order {u}: {flux:?}");
+}
+
+#[test]
+fn darcy_methods_all_run_on_the_layered_case() {
+    for method in ["mimetic", "dec-barycentric"] {
+        let out = run(
+            "cases/darcy-layered.toml",
+            &[format!("problem.method=\"{method}\"")],
+        );
+        let l2 = reported(&out, "error", "L2");
+        // The pressure reaches 5·10³ on the right layer; the mimetic
+        // figure on this mesh is 0.89 (second order from 8² to 64²).
+        assert!(l2 < 2.0, "{method}: {l2}\n{out}");
+    }
+}
+
+// ---------------------------------------------------------------- maxwell
+
+/// Parse the mode table: (ω², relative error or None) per mode.
+fn modes(stdout: &str) -> Vec<(f64, Option<f64>)> {
+    let start = stdout
+        .lines()
+        .position(|l| l.starts_with("modes"))
+        .unwrap_or_else(|| panic!("no mode table in\n{stdout}"));
+    stdout
+        .lines()
+        .skip(start + 1)
+        .take_while(|l| l.starts_with("    "))
+        .map(|l| {
+            let parts: Vec<&str> = l.split_whitespace().collect();
+            (parts[1].parse().unwrap(), parts[4].parse().ok())
+        })
+        .collect()
+}
+
+/// ω² of the uniform-grid cavity with the barycentric Hodge star (the Yee
+/// scheme): Σ over the mode's indices of (4/h²) sin²(mπh/2).
+fn yee(indices: &[usize], h: f64) -> f64 {
+    indices
+        .iter()
+        .map(|&m| 4.0 / (h * h) * (m as f64 * PI * h / 2.0).sin().powi(2))
+        .sum()
+}
+
+#[test]
+fn maxwell_square_modes_are_the_yee_values() {
+    let out = run("cases/maxwell-square.toml", &["mesh.n=[16,16]".into()]);
+    let got = modes(&out);
+    let h = 1.0 / 16.0;
+    let want = [
+        yee(&[1, 0], h),
+        yee(&[0, 1], h),
+        yee(&[1, 1], h),
+        yee(&[2, 0], h),
+        yee(&[0, 2], h),
+        yee(&[2, 1], h),
+        yee(&[1, 2], h),
+    ];
+    assert_eq!(got.len(), 7, "{out}");
+    for (k, ((value, _), w)) in got.iter().zip(want).enumerate() {
+        assert!(
+            (value - w).abs() <= 1e-8 * w,
+            "mode {}: {value} vs {w}",
+            k + 1
+        );
+    }
+}
+
+#[test]
+fn maxwell_square_converges_at_second_order_without_spurious_modes() {
+    let coarse = modes(&run(
+        "cases/maxwell-square.toml",
+        &["mesh.n=[16,16]".into()],
+    ));
+    let fine = modes(&run("cases/maxwell-square.toml", &[]));
+    for (k, (c, f)) in coarse.iter().zip(&fine).enumerate() {
+        let (ec, ef) = (c.1.unwrap(), f.1.unwrap());
+        let p = order(ec, ef, 2.0);
+        assert!((p - 2.0).abs() <= 0.15, "mode {}: order {p}", k + 1);
+        // The relative error is small: no spurious mode slipped in.
+        assert!(ef < 5e-3, "mode {}: {ef}", k + 1);
+    }
+}
+
+#[test]
+fn maxwell_modes_vanish_on_the_walls() {
+    let dir = scratch("maxwell-output");
+    let stem = dir.join("cavity");
+    let out = hasse(&[
+        "run",
+        "cases/maxwell-square.toml",
+        "--set",
+        "mesh.n=[8,8]",
+        "--set",
+        "problem.modes=3",
+        "-o",
+        stem.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{out:?}");
+    let file = hdf5::File::open(stem.with_extension("h5")).unwrap();
+    // The wall edges of an 8×8 grid: 32 of 144.
+    let walls: Vec<u64> = file
+        .dataset("mesh/tags/boundary")
+        .unwrap()
+        .read_raw()
+        .unwrap();
+    assert_eq!(walls.len(), 32);
+    for k in 1..=3 {
+        let e: Vec<f64> = file
+            .dataset(&format!("steps/0/mode_{k}"))
+            .unwrap()
+            .read_raw()
+            .unwrap();
+        assert_eq!(e.len(), 144);
+        assert!(walls.iter().all(|&w| e[w as usize] == 0.0));
+        assert!(e.iter().any(|v| v.abs() > 1e-3));
+    }
+}
+
+#[test]
+fn maxwell_cube_modes_are_the_yee_values() {
+    let out = run("cases/maxwell-cube.toml", &[]);
+    let got = modes(&out);
+    let h = 1.0 / 8.0;
+    // (1,1,0) in three orientations, then (1,1,1) with two polarisations.
+    let want = [
+        yee(&[1, 1], h),
+        yee(&[1, 1], h),
+        yee(&[1, 1], h),
+        yee(&[1, 1, 1], h),
+        yee(&[1, 1, 1], h),
+    ];
+    assert_eq!(got.len(), 5, "{out}");
+    for (k, ((value, _), w)) in got.iter().zip(want).enumerate() {
+        assert!(
+            (value - w).abs() <= 1e-8 * w,
+            "mode {}: {value} vs {w}",
+            k + 1
+        );
+    }
+}
+
+// ---------------------------------------------------------------- bad input
+
+/// Write `text` as a case, run it, expect exit code `code` and every
+/// fragment in stderr.
+fn refused(name: &str, text: &str, code: i32, fragments: &[&str]) {
+    let dir = scratch("bad");
+    let case = dir.join(format!("{name}.toml"));
+    std::fs::write(&case, text).unwrap();
+    let out = hasse(&["run", case.to_str().unwrap(), "--set", "output.write=false"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(code), "{name}:\n{stderr}");
+    for f in fragments {
+        assert!(stderr.contains(f), "{name}: no `{f}` in\n{stderr}");
+    }
+}
+
+const HEAT: &str = r#"[mesh]
+generator = "rectangle"
+n = [4, 4]
+
+[problem]
+kind = "heat"
+method = "fe"
+initial = "x"
+
+[time]
+dt = 0.1
+steps = 3
+"#;
+
+#[test]
+fn bad_problem_kind_input_names_the_key() {
+    refused(
+        "dt",
+        &HEAT.replace("dt = 0.1", "dt = -0.1"),
+        2,
+        &["dt.toml:11:6: `time.dt`", "positive"],
+    );
+    refused(
+        "no-time",
+        &HEAT.replace("[time]\ndt = 0.1\nsteps = 3\n", ""),
+        2,
+        &["`time`", "no [time] table"],
+    );
+    refused(
+        "end",
+        &HEAT.replace("steps = 3", "end = 0.25"),
+        2,
+        &["`time.end`", "not a whole number of steps"],
+    );
+    refused(
+        "mimetic-heat",
+        &HEAT.replace("\"fe\"", "\"fv-mimetic\""),
+        2,
+        &["`problem.method`", "half-face"],
+    );
+    refused(
+        "robin-in-time",
+        &format!("{HEAT}\n[[boundary]]\ntag = \"boundary\"\ntype = \"robin\"\nalpha = \"1 + t\"\nvalue = 0\n"),
+        2,
+        &["`boundary[0].alpha`", "may not depend on t"],
+    );
+    refused(
+        "kind",
+        &HEAT.replace("\"heat\"", "\"maxwel\""),
+        2,
+        &[
+            "unknown problem kind \"maxwel\"",
+            "did you mean \"maxwell\"",
+        ],
+    );
+    refused(
+        "darcy-llt",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"darcy\"\nmethod = \"mimetic\"\n[[boundary]]\ntag = \"boundary\"\ntype = \"pressure\"\nvalue = 0\n[solver]\nfactorization = \"llt\"\n",
+        2,
+        &["`solver.factorization`", "indefinite"],
+    );
+    refused(
+        "darcy-dirichlet",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"darcy\"\nmethod = \"mimetic\"\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n",
+        2,
+        &["`boundary[0].type`", "\"pressure\""],
+    );
+    refused(
+        "darcy-unbalanced",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"darcy\"\nmethod = \"mimetic\"\nsource = 1\n",
+        2,
+        &["no pressure is prescribed", "add a \"pressure\" boundary"],
+    );
+    let cavity = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"maxwell\"\nmethod = \"dec-barycentric\"\nmodes = 50\n";
+    // 4×4: 24 interior edges, 9 interior vertices: 15 physical modes.
+    refused(
+        "modes",
+        cavity,
+        2,
+        &["problem.modes = 50", "only 15 physical modes"],
+    );
+    refused(
+        "cavity-boundary",
+        &format!("{cavity}[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n"),
+        2,
+        &["`boundary`", "perfect conductors"],
+    );
+    refused(
+        "eigen-order",
+        &format!(
+            "{}\n[exact]\neigenvalues = [2, 1]\n",
+            cavity.replace("50", "2")
+        ),
+        2,
+        &["`exact.eigenvalues`", "ascending"],
+    );
+    refused(
+        "refine-heat",
+        &format!("{HEAT}\n[refine]\nsteps = 1\n"),
+        2,
+        &["`refine`", "diffusion problems"],
+    );
+    refused(
+        "wrong-key",
+        &HEAT.replace("initial = \"x\"", "initial = \"x\"\npermeability = 2"),
+        2,
+        &["`problem.permeability`", "not used by kind = \"heat\""],
+    );
+}
