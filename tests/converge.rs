@@ -305,7 +305,7 @@ fn bad_studies_exit_2_and_write_nothing() {
         ),
         (
             vec!["converge", "cases/torus.toml", "--levels", "2", "-o", o],
-            "needs a diffusion problem",
+            "on a diffusion problem; this case is kind = \"gradient\"",
         ),
         (
             vec![
