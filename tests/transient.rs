@@ -301,3 +301,44 @@ fn time_series_feed_the_output_writer() {
         Err(HeatError::TimeStep { .. })
     ));
 }
+
+/// Time-varying data are re-evaluated on the first assembly's operator
+/// (`Diffusion::data`): the right-hand side and the fixed values must be
+/// those of a full assembly at that time, for every boundary kind and for
+/// nodal, cell-centred and hybrid unknowns.
+#[test]
+fn data_on_the_kept_operator_equal_a_full_assembly() {
+    let mesh = rectangle(5, 4, [0.0, 1.0], [0.0, 0.8]).unwrap();
+    let varying = |scale: f64| -> TimeFn {
+        TimeFn::Varying(Arc::new(move |x: &[f64], t: f64| {
+            scale * (1.0 + t) * (x[0] + 2.0 * x[1] * x[1]) + t.sin()
+        }))
+    };
+    for method in [Method::Fe, Method::Fv, Method::FvMimetic, Method::Fd] {
+        let heat = Heat::new(method, unit(), 0.1)
+            .with_source(varying(3.0))
+            .with_boundary("xmin", HeatBoundary::Dirichlet(varying(1.0)))
+            .with_boundary("xmax", HeatBoundary::Neumann(varying(-0.5)))
+            .with_boundary(
+                "ymin",
+                HeatBoundary::Robin {
+                    alpha: Arc::new(|x: &[f64]| 2.0 + x[0]),
+                    value: varying(0.7),
+                },
+            );
+        let first = heat.at(0.0).assemble(&mesh).unwrap();
+        for t in [0.25, 1.5] {
+            let full = heat.at(t).assemble(&mesh).unwrap();
+            let (rhs, fixed) = heat.at(t).data(&mesh, &first).unwrap();
+            let scale = full.rhs.iter().fold(0.0f64, |m, b| m.max(b.abs()));
+            assert!(scale > 0.1, "{method:?}: the data must matter");
+            for (i, (a, b)) in rhs.iter().zip(&full.rhs).enumerate() {
+                assert!(
+                    (a - b).abs() <= 1e-14 * scale,
+                    "{method:?}, t = {t}, unknown {i}: {a} vs {b}"
+                );
+            }
+            assert_eq!(fixed, full.fixed, "{method:?}, t = {t}");
+        }
+    }
+}

@@ -289,11 +289,48 @@ pub struct Assembled {
     /// Cell points of [`Method::Fv`] when they are not the centroids.
     pub cell_points: Option<Vec<f64>>,
     pub assembly_seconds: f64,
+    /// What [`Diffusion::data`] needs to redo only the data part.
+    layout: DataLayout,
 }
 
+/// The parts of an assembly that the data (source, boundary values) do
+/// not change.
+#[derive(Clone, Debug)]
+struct DataLayout {
+    faces: Faces,
+    /// Ω's diagonal on boundary face rows (cell-centred methods).
+    cell_diagonal: Vec<Option<f64>>,
+}
+
+/// The boundary's contribution to an assembly.
+struct BoundaryData {
+    fixed: Vec<Option<f64>>,
+    /// Ghost rows: (unknown, weight, ghost value) appended to A and Ω.
+    ghosts: Vec<(usize, f64, f64)>,
+    /// Cell-centred boundary faces whose own row changes weight or value.
+    face_weight: Vec<Option<f64>>,
+    face_value: Vec<f64>,
+    /// Cell-centred Neumann faces carry no row weight; their flux (along
+    /// the face's orientation) is the data's, −s g |F|.
+    neumann_flux: Vec<f64>,
+}
+
+#[derive(Clone, Debug)]
 struct Faces {
     /// Condition index applied to each boundary (n−1)-cell, if any.
     condition: Vec<Option<usize>>,
+}
+
+/// Ω's diagonal entries on the rows that have one (summed over blocks).
+fn diagonal_of(metric: &BlockMetric, rows: usize) -> Vec<Option<f64>> {
+    let mut diag = vec![None; rows];
+    for b in 0..metric.block_count() {
+        let (r, s, w) = metric.block(b);
+        if r.len() == 1 && r == s {
+            diag[r[0]] = Some(diag[r[0]].unwrap_or(0.0) + w[0]);
+        }
+    }
+    diag
 }
 
 fn evaluate(f: &ScalarFn, x: &[f64], what: &'static str) -> Result<f64, DiffusionError> {
@@ -417,15 +454,11 @@ impl Diffusion {
     pub fn assemble(&self, complex: &Complex) -> Result<Assembled, DiffusionError> {
         let started = Instant::now();
         let n = complex.dim();
-        let d = complex.embedding_dim();
         let tensors = self.tensors(complex)?;
         let faces = self.boundary_faces(complex)?;
         let location = self.location();
         let cells = complex.cell_count(n);
         let face_count = complex.cell_count(n - 1);
-        let face_area = complex.measure(n - 1);
-        let face_centre = complex.centroid(n - 1);
-        let x_face = |f: usize| &face_centre[f * d..(f + 1) * d];
         let cell_points = self.cell_points(complex)?;
 
         let (incidence, metric, unknowns) = match self.method {
@@ -465,126 +498,31 @@ impl Diffusion {
             });
         }
 
-        let mut rhs = vec![0.0; unknowns];
-        let mut fixed: Vec<Option<f64>> = vec![None; unknowns];
-        // Ghost rows: (unknown, weight, ghost value) appended to A and Ω.
-        let mut ghosts: Vec<(usize, f64, f64)> = Vec::new();
-        // Cell-centred boundary faces whose own row changes weight or value.
-        let mut face_weight: Vec<Option<f64>> = vec![None; flux_rows];
-        let mut face_value = vec![0.0; flux_rows];
-        // Cell-centred Neumann faces carry no row weight; their flux (along
-        // the face's orientation) is the data's, −s g |F|.
-        let mut neumann_flux = vec![0.0; flux_rows];
-
-        // Sources.
-        match self.method {
-            Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x))?,
-            Method::Dec(kind) => rhs = dec::load(complex, kind, &|x| (self.source)(x))?,
-            _ => {
-                let volume = complex.measure(n);
-                let centre = complex.centroid(n);
-                for c in 0..cells {
-                    rhs[c] +=
-                        evaluate(&self.source, &centre[c * d..(c + 1) * d], "source")? * volume[c];
-                }
-            }
-        }
-        if rhs.iter().any(|v| !v.is_finite()) {
-            return Err(DiffusionError::NonFinite {
-                what: "source",
-                location: vec![],
-            });
-        }
-
-        // Boundary conditions.
         let top = complex.boundary(n);
-        let diagonal_of = |metric: &BlockMetric| -> Vec<Option<f64>> {
-            let mut diag = vec![None; flux_rows];
-            for b in 0..metric.block_count() {
-                let (r, s, w) = metric.block(b);
-                if r.len() == 1 && r == s {
-                    diag[r[0]] = Some(diag[r[0]].unwrap_or(0.0) + w[0]);
-                }
-            }
-            diag
-        };
         let cell_diagonal = match location {
-            Location::CellCentred => diagonal_of(&metric),
+            Location::CellCentred => diagonal_of(&metric, flux_rows),
             _ => Vec::new(),
         };
-        for f in 0..face_count {
-            let Some(k) = faces.condition[f] else {
-                continue;
-            };
-            let bc = &self.boundary[k];
-            let area = face_area[f];
-            let xf = x_face(f);
-            match location {
-                Location::Nodal => {
-                    let verts = complex.cell_vertices(n - 1, f);
-                    let share = area / verts.len() as f64;
-                    for &v in verts {
-                        let xv = complex.vertices().point(v);
-                        apply_at_unknown(bc, f, v, xv, share, &mut fixed, &mut rhs, &mut ghosts)?;
-                    }
-                }
-                Location::Hybrid => {
-                    apply_at_unknown(
-                        bc,
-                        f,
-                        cells + f,
-                        xf,
-                        area,
-                        &mut fixed,
-                        &mut rhs,
-                        &mut ghosts,
-                    )?;
-                }
-                Location::CellCentred => {
-                    let (cell, sign) = top
-                        .outer_view(f)
-                        .and_then(|r| r.iter().next().map(|(c, &s)| (c, f64::from(s))))
-                        .ok_or(DiffusionError::InteriorFace {
-                            tag: bc.tag.clone(),
-                            face: f,
-                        })?;
-                    let sigma = cell_diagonal[f].ok_or(DiffusionError::Unsupported {
-                        method: self.method.name(),
-                        what: "boundary conditions with a non-diagonal boundary metric",
-                    })?;
-                    // The ghost value sits where the two-point flux measures
-                    // the gradient: the foot of the perpendicular from the
-                    // cell point to the face (the centroid's foot is taken
-                    // as the face centroid, as on a box).
-                    let foot: Vec<f64> = match &cell_points {
-                        None => xf.to_vec(),
-                        Some(points) => {
-                            let p = &points[cell * d..(cell + 1) * d];
-                            let normal = &complex.normal()[f * d..(f + 1) * d];
-                            let s = fv::signed_distance(xf, p, normal, sign as i8);
-                            (0..d).map(|a| p[a] + s * sign * normal[a]).collect()
-                        }
-                    };
-                    let xg = foot.as_slice();
-                    match &bc.kind {
-                        BoundaryKind::Dirichlet(g) => {
-                            face_value[f] = sign * evaluate(g, xg, "Dirichlet value")?
-                        }
-                        BoundaryKind::Neumann(g) => {
-                            face_weight[f] = Some(0.0);
-                            let outward = evaluate(g, xf, "Neumann value")? * area;
-                            rhs[cell] += outward;
-                            neumann_flux[f] = -sign * outward;
-                        }
-                        BoundaryKind::Robin { alpha, value } => {
-                            let a = robin_alpha(bc, f, alpha, xg)?;
-                            face_weight[f] = Some(sigma * a * area / (sigma + a * area));
-                            face_value[f] = sign * evaluate(value, xg, "Robin value")? / a;
-                        }
-                    }
-                }
-            }
-        }
+        let layout = DataLayout {
+            faces,
+            cell_diagonal,
+        };
+        let mut rhs = self.source_load(complex, unknowns)?;
+        let BoundaryData {
+            fixed,
+            ghosts,
+            mut face_weight,
+            face_value,
+            neumann_flux,
+        } = self.boundary_data(
+            complex,
+            location,
+            &layout,
+            &cell_points,
+            flux_rows,
+            &mut rhs,
+        )?;
+        let faces = &layout.faces;
         if location == Location::CellCentred {
             // Boundary faces without a condition are homogeneous Neumann.
             for (f, weight) in face_weight.iter_mut().enumerate().take(face_count) {
@@ -651,7 +589,174 @@ impl Diffusion {
             neumann_flux,
             cell_points,
             assembly_seconds,
+            layout,
         })
+    }
+
+    /// The source's load on the unknowns.
+    fn source_load(&self, complex: &Complex, unknowns: usize) -> Result<Vec<f64>, DiffusionError> {
+        let n = complex.dim();
+        let d = complex.embedding_dim();
+        let cells = complex.cell_count(n);
+        let mut rhs = vec![0.0; unknowns];
+        match self.method {
+            Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x))?,
+            Method::Dec(kind) => rhs = dec::load(complex, kind, &|x| (self.source)(x))?,
+            _ => {
+                let volume = complex.measure(n);
+                let centre = complex.centroid(n);
+                for c in 0..cells {
+                    rhs[c] +=
+                        evaluate(&self.source, &centre[c * d..(c + 1) * d], "source")? * volume[c];
+                }
+            }
+        }
+        if rhs.iter().any(|v| !v.is_finite()) {
+            return Err(DiffusionError::NonFinite {
+                what: "source",
+                location: vec![],
+            });
+        }
+
+        Ok(rhs)
+    }
+
+    /// Boundary values and data on the faces of `layout`: Dirichlet values
+    /// of fixed unknowns, ghost rows, and the Neumann and Robin data added
+    /// to `rhs`.
+    fn boundary_data(
+        &self,
+        complex: &Complex,
+        location: Location,
+        layout: &DataLayout,
+        cell_points: &Option<Vec<f64>>,
+        flux_rows: usize,
+        rhs: &mut [f64],
+    ) -> Result<BoundaryData, DiffusionError> {
+        let n = complex.dim();
+        let d = complex.embedding_dim();
+        let cells = complex.cell_count(n);
+        let unknowns = rhs.len();
+        let face_count = complex.cell_count(n - 1);
+        let face_area = complex.measure(n - 1);
+        let face_centre = complex.centroid(n - 1);
+        let x_face = |f: usize| &face_centre[f * d..(f + 1) * d];
+        let top = complex.boundary(n);
+        let (faces, cell_diagonal) = (&layout.faces, &layout.cell_diagonal);
+        let mut fixed: Vec<Option<f64>> = vec![None; unknowns];
+        let mut ghosts: Vec<(usize, f64, f64)> = Vec::new();
+        let mut face_weight: Vec<Option<f64>> = vec![None; flux_rows];
+        let mut face_value = vec![0.0; flux_rows];
+        let mut neumann_flux = vec![0.0; flux_rows];
+        for f in 0..face_count {
+            let Some(k) = faces.condition[f] else {
+                continue;
+            };
+            let bc = &self.boundary[k];
+            let area = face_area[f];
+            let xf = x_face(f);
+            match location {
+                Location::Nodal => {
+                    let verts = complex.cell_vertices(n - 1, f);
+                    let share = area / verts.len() as f64;
+                    for &v in verts {
+                        let xv = complex.vertices().point(v);
+                        apply_at_unknown(bc, f, v, xv, share, &mut fixed, rhs, &mut ghosts)?;
+                    }
+                }
+                Location::Hybrid => {
+                    apply_at_unknown(bc, f, cells + f, xf, area, &mut fixed, rhs, &mut ghosts)?;
+                }
+                Location::CellCentred => {
+                    let (cell, sign) = top
+                        .outer_view(f)
+                        .and_then(|r| r.iter().next().map(|(c, &s)| (c, f64::from(s))))
+                        .ok_or(DiffusionError::InteriorFace {
+                            tag: bc.tag.clone(),
+                            face: f,
+                        })?;
+                    let sigma = cell_diagonal[f].ok_or(DiffusionError::Unsupported {
+                        method: self.method.name(),
+                        what: "boundary conditions with a non-diagonal boundary metric",
+                    })?;
+                    // The ghost value sits where the two-point flux measures
+                    // the gradient: the foot of the perpendicular from the
+                    // cell point to the face (the centroid's foot is taken
+                    // as the face centroid, as on a box).
+                    let foot: Vec<f64> = match &cell_points {
+                        None => xf.to_vec(),
+                        Some(points) => {
+                            let p = &points[cell * d..(cell + 1) * d];
+                            let normal = &complex.normal()[f * d..(f + 1) * d];
+                            let s = fv::signed_distance(xf, p, normal, sign as i8);
+                            (0..d).map(|a| p[a] + s * sign * normal[a]).collect()
+                        }
+                    };
+                    let xg = foot.as_slice();
+                    match &bc.kind {
+                        BoundaryKind::Dirichlet(g) => {
+                            face_value[f] = sign * evaluate(g, xg, "Dirichlet value")?
+                        }
+                        BoundaryKind::Neumann(g) => {
+                            face_weight[f] = Some(0.0);
+                            let outward = evaluate(g, xf, "Neumann value")? * area;
+                            rhs[cell] += outward;
+                            neumann_flux[f] = -sign * outward;
+                        }
+                        BoundaryKind::Robin { alpha, value } => {
+                            let a = robin_alpha(bc, f, alpha, xg)?;
+                            face_weight[f] = Some(sigma * a * area / (sigma + a * area));
+                            face_value[f] = sign * evaluate(value, xg, "Robin value")? / a;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(BoundaryData {
+            fixed,
+            ghosts,
+            face_weight,
+            face_value,
+            neumann_flux,
+        })
+    }
+
+    /// The right-hand side and fixed values of this problem on the
+    /// operator of `assembled`, without rebuilding Ω or M: for data that
+    /// change (a time-dependent source or boundary value) on a problem
+    /// whose method, conductivity, boundary tags and kinds and Robin α are
+    /// those `assembled` was made with.
+    pub fn data(
+        &self,
+        complex: &Complex,
+        assembled: &Assembled,
+    ) -> Result<(Vec<f64>, Vec<Option<f64>>), DiffusionError> {
+        let unknowns = assembled.rhs.len();
+        let mut rhs = self.source_load(complex, unknowns)?;
+        let boundary = self.boundary_data(
+            complex,
+            assembled.location,
+            &assembled.layout,
+            &assembled.cell_points,
+            assembled.flux_rows,
+            &mut rhs,
+        )?;
+        let mut ghost_values = boundary.face_value;
+        ghost_values.extend(boundary.ghosts.iter().map(|g| g.2));
+        if ghost_values.len() != assembled.ghost_values.len() {
+            return Err(DiffusionError::Unsupported {
+                method: self.method.name(),
+                what: "new data with other boundary kinds than the assembled operator's",
+            });
+        }
+        if ghost_values.iter().any(|&v| v != 0.0) {
+            let canonical = &assembled.canonical;
+            let lifted = canonical.sum_transpose(&canonical.metric().apply(&ghost_values));
+            for (b, l) in rhs.iter_mut().zip(lifted) {
+                *b += l;
+            }
+        }
+        Ok((rhs, boundary.fixed))
     }
 
     /// Assemble and solve on `complex`.
@@ -668,6 +773,7 @@ impl Diffusion {
             neumann_flux,
             cell_points,
             assembly_seconds,
+            ..
         } = self.assemble(complex)?;
         let unknowns = rhs.len();
         let mut neumann_imbalance = 0.0;

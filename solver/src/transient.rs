@@ -17,8 +17,8 @@
 //! order, L-stable), θ = ½ Crank–Nicolson (second order, A-stable).
 
 use crate::diffusion::{
-    lumped_vertex_volumes, Assembled, BoundaryKind, Conductivity, Diffusion, DiffusionError,
-    Location, Method, ScalarFn,
+    lumped_vertex_volumes, BoundaryKind, Conductivity, Diffusion, DiffusionError, Location, Method,
+    ScalarFn,
 };
 use crate::linear::{DirectSolver, Factorization, SolveError};
 use crate::output::{Cochain, Step};
@@ -357,7 +357,8 @@ impl Heat {
         for step in 1..=steps {
             let t = t0 + step as f64 * dt;
             if vary {
-                let Assembled { rhs, fixed, .. } = self.at(t).assemble(complex)?;
+                // Only the data change: Ω, M and the boundary layout are kept.
+                let (rhs, fixed) = self.at(t).data(complex, &first)?;
                 b_new = rhs;
                 fixed_new = fixed;
             }
