@@ -210,6 +210,28 @@ fn darcy_layered_converges_and_conserves_mass() {
     assert!(u >= 1.0 - 0.15, "flux order {u}: {flux:?}");
 }
 
+/// The same layered pressure in 3D (it does not depend on z): hexahedra
+/// with the mimetic mass, second order for the pressure again.
+#[test]
+fn darcy_layered_converges_in_3d() {
+    let mut pressure = vec![];
+    for n in [4, 8, 16] {
+        let out = run(
+            "cases/darcy-layered.toml",
+            &[
+                "mesh.generator=\"box\"".into(),
+                format!("mesh.n=[{n},{n},{n}]"),
+            ],
+        );
+        pressure.push(reported(&out, "error", "L2"));
+        let relative = reported(&out, "mass", "relative");
+        assert!(relative < 1e-11, "n = {n}: conservation {relative}\n{out}");
+    }
+    println!("darcy-layered 3D: pressure {pressure:?}");
+    let p = order(pressure[0], pressure[2], 4.0);
+    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}: {pressure:?}");
+}
+
 #[test]
 fn darcy_methods_all_run_on_the_layered_case() {
     for method in ["mimetic", "dec-barycentric"] {
