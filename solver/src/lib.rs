@@ -11,6 +11,7 @@ pub mod converge;
 pub mod darcy;
 pub mod diffusion;
 pub mod eigen;
+pub mod elasticity;
 pub mod info;
 pub mod iterative;
 pub mod linear;

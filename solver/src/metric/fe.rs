@@ -489,14 +489,14 @@ fn p1_weights(top: &Topology, c: usize, k: &Tensor) -> Result<Local, MetricError
         .map(Local::Diagonal)
 }
 
-/// Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the edges of cell `c`; `kc` is indexed by
-/// the cell's sorted vertex list.
-fn edge_block(
+/// The sorted edges of cell `c` and the pseudo-inverse A_c⁺ (cell vertices
+/// × cell edges, vertices in the cell's sorted order) of its local edge
+/// incidence, signs from the global ∂₁.
+pub(crate) fn edge_pseudo_inverse(
     top: &Topology,
     c: usize,
-    kc: &DMatrix<f64>,
     method: &'static str,
-) -> Result<Local, MetricError> {
+) -> Result<(Vec<usize>, DMatrix<f64>), MetricError> {
     let vertices = top.complex.cell_vertices(top.n, c);
     let edges = top.edges_of(c);
     let mut a = DMatrix::zeros(edges.len(), vertices.len());
@@ -512,6 +512,18 @@ fn edge_block(
                 needs: "a cell whose edge incidence has a pseudo-inverse",
                 cell: c,
             })?;
+    Ok((edges, pinv))
+}
+
+/// Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the edges of cell `c`; `kc` is indexed by
+/// the cell's sorted vertex list.
+fn edge_block(
+    top: &Topology,
+    c: usize,
+    kc: &DMatrix<f64>,
+    method: &'static str,
+) -> Result<Local, MetricError> {
+    let (edges, pinv) = edge_pseudo_inverse(top, c, method)?;
     let omega = pinv.transpose() * kc * &pinv;
     let m = edges.len();
     // Symmetric up to rounding; made exactly so.
@@ -629,6 +641,49 @@ fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, Metr
 fn tensor_points(top: &Topology, c: usize, order: &[usize]) -> Vec<Point> {
     let vertices = top.complex.cell_vertices(top.n, c);
     order.iter().map(|&o| top.point(vertices[o])).collect()
+}
+
+/// A quadrature weight and the shape gradients at its point.
+pub(crate) type WeightedGradients = (f64, Vec<Point>);
+
+/// Quadrature weights and the physical gradients of the nodal shape
+/// functions of top cell `c` (indexed by the cell's sorted vertex list) at
+/// each point: one point of weight |c| for a P1 simplex (constant
+/// gradients), the 2ⁿ Gauss points of the isoparametric map for a Q1
+/// quadrilateral or hexahedron. `None` for a cell [`stiffness_metric`]
+/// would give the virtual element. Other nodal stiffnesses (elasticity)
+/// integrate their own bilinear forms with these.
+pub(crate) fn shape_gradients(
+    top: &Topology,
+    c: usize,
+) -> Result<Option<Vec<WeightedGradients>>, MetricError> {
+    match top.element(c, Route::ByShape)? {
+        Element::P1 => {
+            let (measure, gradients) =
+                simplex_gradients(&top.points(c), top.d).ok_or(MetricError::UnsupportedCell {
+                    method: "P1",
+                    needs: "a simplex of positive measure",
+                    cell: c,
+                })?;
+            Ok(Some(vec![(measure, gradients)]))
+        }
+        Element::Q1(order) => {
+            let points = q1_points(&tensor_points(top, c, &order), top.n, c)?;
+            Ok(Some(
+                points
+                    .into_iter()
+                    .map(|q| {
+                        let mut sorted = vec![[0.0; 3]; order.len()];
+                        for (l, g) in q.gradients.into_iter().enumerate() {
+                            sorted[order[l]] = g;
+                        }
+                        (q.weight, sorted)
+                    })
+                    .collect(),
+            ))
+        }
+        Element::Vem => Ok(None),
+    }
 }
 
 fn q1_stiffness(
