@@ -353,6 +353,7 @@ fn describe_problem(case: &Case) -> String {
         ),
         Problem::Darcy(d) => format!("darcy, flux mass {:?}", d.mass),
         Problem::Maxwell(m) => format!("maxwell, {} modes, dual {:?}", m.modes, m.dual),
+        Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
     }
 }
 

@@ -39,6 +39,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 mod darcy;
+mod elasticity;
 mod heat;
 mod maxwell;
 
@@ -116,6 +117,7 @@ pub fn solve(
         Problem::Heat(spec) => heat::solve(case, spec, complex, phase),
         Problem::Darcy(spec) => darcy::solve(case, spec, complex, phase),
         Problem::Maxwell(spec) => maxwell::solve(case, spec, complex, phase),
+        Problem::Elasticity(spec) => elasticity::solve(case, spec, complex, phase),
     }
 }
 

@@ -165,6 +165,50 @@ pub struct MaxwellSpec {
     pub modes: usize,
 }
 
+/// The material of an elasticity problem.
+#[derive(Clone, Debug)]
+pub enum MaterialSpec {
+    Lame {
+        lambda: Expression,
+        mu: Expression,
+    },
+    Young {
+        young: Expression,
+        poisson: Expression,
+    },
+}
+
+/// A boundary condition of an elasticity problem.
+#[derive(Clone, Debug)]
+pub enum ElasticBoundaryKind {
+    /// u = g (all components), or u_a = g for one component a.
+    Displacement {
+        component: Option<usize>,
+        value: Vec<Expression>,
+    },
+    /// σ n = t.
+    Traction(Vec<Expression>),
+}
+
+/// A tagged elasticity boundary condition.
+#[derive(Clone, Debug)]
+pub struct ElasticBoundarySpec {
+    pub tag: String,
+    pub kind: ElasticBoundaryKind,
+    pub(crate) tag_span: Option<Range<usize>>,
+    pub(crate) key: String,
+}
+
+/// Linear elasticity −∇·σ(u) = f, displacement on vertices.
+#[derive(Clone, Debug)]
+pub struct ElasticitySpec {
+    pub material: MaterialSpec,
+    /// f, one expression per coordinate.
+    pub body_force: Vec<Expression>,
+    pub plane: crate::elasticity::PlaneModel,
+    pub boundary: Vec<ElasticBoundarySpec>,
+}
+
 /// What the case solves.
 #[derive(Clone, Debug)]
 pub enum Problem {
@@ -173,6 +217,7 @@ pub enum Problem {
     Heat(HeatSpec),
     Darcy(DarcySpec),
     Maxwell(MaxwellSpec),
+    Elasticity(ElasticitySpec),
 }
 
 impl Problem {
@@ -184,16 +229,34 @@ impl Problem {
             Problem::Heat(_) => "heat",
             Problem::Darcy(_) => "darcy",
             Problem::Maxwell(_) => "maxwell",
+            Problem::Elasticity(_) => "elasticity",
         }
     }
 
-    /// The boundary conditions, whatever the kind.
+    /// The scalar boundary conditions (diffusion, heat, Darcy).
     pub fn boundary(&self) -> &[BoundarySpec] {
         match self {
             Problem::Diffusion(d) => &d.boundary,
             Problem::Heat(h) => &h.boundary,
             Problem::Darcy(d) => &d.boundary,
-            Problem::Gradient(_) | Problem::Maxwell(_) => &[],
+            Problem::Gradient(_) | Problem::Maxwell(_) | Problem::Elasticity(_) => &[],
+        }
+    }
+
+    /// (tag, where the tag is written, `boundary[i]`) of every boundary
+    /// condition, whatever the kind.
+    fn boundary_tags(&self) -> Vec<(&str, Option<Range<usize>>, &str)> {
+        match self {
+            Problem::Elasticity(e) => e
+                .boundary
+                .iter()
+                .map(|b| (b.tag.as_str(), b.tag_span.clone(), b.key.as_str()))
+                .collect(),
+            other => other
+                .boundary()
+                .iter()
+                .map(|b| (b.tag.as_str(), b.tag_span.clone(), b.key.as_str()))
+                .collect(),
         }
     }
 
@@ -203,7 +266,7 @@ impl Problem {
             Problem::Diffusion(d) => Some(&d.conductivity),
             Problem::Heat(h) => Some(&h.conductivity),
             Problem::Darcy(d) => Some(&d.permeability),
-            Problem::Gradient(_) | Problem::Maxwell(_) => None,
+            Problem::Gradient(_) | Problem::Maxwell(_) | Problem::Elasticity(_) => None,
         }
     }
 }
@@ -218,6 +281,8 @@ pub struct ExactSpec {
     pub gradient: Option<Vec<Expression>>,
     /// Exact eigenvalues, ascending (Maxwell: ω²).
     pub eigenvalues: Vec<f64>,
+    /// The exact displacement of an elasticity problem, per coordinate.
+    pub displacement: Option<Vec<Expression>>,
 }
 
 /// Linear solver settings.
@@ -336,10 +401,10 @@ impl Case {
                 .filter(|(_, t)| n > 0 && t.dim == n - 1)
                 .map(|(name, _)| name.to_string())
                 .collect();
-            for b in self.problem.boundary() {
-                match complex.tag(&b.tag) {
+            for (tag, tag_span, key) in self.problem.boundary_tags() {
+                match complex.tag(tag) {
                     None => {
-                        let help = match expr::closest(&b.tag, &available) {
+                        let help = match expr::closest(tag, &available) {
                             Some(s) => format!(
                                 "did you mean `{s}`? the mesh has: {}",
                                 available.join(", ")
@@ -351,18 +416,18 @@ impl Case {
                             None => format!("the mesh has: {}", available.join(", ")),
                         };
                         collector.error(
-                            b.tag_span.clone(),
-                            &format!("{}.tag", b.key),
-                            format!("no tag `{}` in the mesh", b.tag),
+                            tag_span.clone(),
+                            &format!("{}.tag", key),
+                            format!("no tag `{}` in the mesh", tag),
                             Some(help),
                         );
                     }
                     Some(t) if t.dim + 1 != n => collector.error(
-                        b.tag_span.clone(),
-                        &format!("{}.tag", b.key),
+                        tag_span.clone(),
+                        &format!("{}.tag", key),
                         format!(
                             "tag `{}` names {}-cells; boundary conditions need {}-cells",
-                            b.tag,
+                            tag,
                             t.dim,
                             n.saturating_sub(1)
                         ),
@@ -399,7 +464,10 @@ impl Case {
         match &self.problem {
             Problem::Diffusion(d) => Some(d.method),
             Problem::Heat(h) => Some(h.method),
-            Problem::Gradient(_) | Problem::Darcy(_) | Problem::Maxwell(_) => None,
+            Problem::Gradient(_)
+            | Problem::Darcy(_)
+            | Problem::Maxwell(_)
+            | Problem::Elasticity(_) => None,
         }
     }
 }

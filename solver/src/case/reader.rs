@@ -67,6 +67,12 @@ const PROBLEM_KEYS: &[&str] = &[
     "permeability",
     "mass",
     "modes",
+    "lambda",
+    "mu",
+    "young",
+    "poisson",
+    "body_force",
+    "plane",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -78,9 +84,13 @@ const KIND_KEYS: &[(&str, &[&str])] = &[
     ("heat", &["method", "conductivity", "source", "initial"]),
     ("darcy", &["method", "permeability", "source"]),
     ("maxwell", &["method", "mass", "modes"]),
+    (
+        "elasticity",
+        &["lambda", "mu", "young", "poisson", "body_force", "plane"],
+    ),
 ];
-const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha"];
-const EXACT_KEYS: &[&str] = &["solution", "gradient", "eigenvalues"];
+const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha", "component"];
+const EXACT_KEYS: &[&str] = &["solution", "gradient", "eigenvalues", "displacement"];
 const SOLVER_KEYS: &[&str] = &[
     "type",
     "factorization",
@@ -573,6 +583,7 @@ impl Reader {
             "heat" => self.heat(root, table, problem_entry.span(), scope),
             "darcy" => self.darcy(root, table, problem_entry.span(), scope),
             "maxwell" => self.maxwell(root, table, problem_entry.span()),
+            "elasticity" => self.elasticity(root, table, problem_entry.span(), scope),
             "gradient" => {
                 if let Some(e) = self.entry(root, "", "boundary") {
                     self.error(
@@ -839,6 +850,14 @@ impl Reader {
                 }
                 (_, None) => None,
             };
+            if let Some(e) = self.entry(table, &prefix, "component") {
+                self.error(
+                    e.key_span.clone(),
+                    &e.name,
+                    "only an elasticity displacement condition takes component",
+                    None,
+                );
+            }
             if kind_name.as_deref() != Some("robin") || conditions == Conditions::Darcy {
                 if let Some(e) = self.entry(table, &prefix, "alpha") {
                     self.error(
@@ -968,7 +987,18 @@ impl Reader {
         let (table, entry) = self.subtable(root, "", "exact")?;
         self.check_keys(table, "exact", EXACT_KEYS);
         let eigenproblem = problem_kind(root) == "maxwell";
+        let elastic = problem_kind(root) == "elasticity";
         let solution = match self.entry(table, "exact", "solution") {
+            Some(e) if elastic => {
+                self.error(
+                    e.key_span.clone(),
+                    "exact.solution",
+                    "an elasticity problem's exact solution is a vector",
+                    Some("give displacement = [\"u_x\", \"u_y\"(, \"u_z\")]".into()),
+                );
+                None
+            }
+            None if elastic => None,
             Some(e) if eigenproblem => {
                 self.error(
                     e.key_span.clone(),
@@ -1036,10 +1066,37 @@ impl Reader {
             }
             Some(e) => self.constant_list(&e, scope)?,
         };
+        let displacement = match self.entry(table, "exact", "displacement") {
+            None if elastic => {
+                self.error(
+                    entry.span(),
+                    "exact.displacement",
+                    "missing: the exact displacement, one expression per coordinate",
+                    None,
+                );
+                return None;
+            }
+            None => None,
+            Some(e) if !elastic => {
+                self.error(
+                    e.key_span.clone(),
+                    "exact.displacement",
+                    "only an elasticity problem has a displacement",
+                    Some("give `solution` instead".into()),
+                );
+                None
+            }
+            Some(e) => Some(self.expression_list(&e, scope)?),
+        };
         Some(ExactSpec {
-            solution: if eigenproblem { None } else { Some(solution?) },
+            solution: if eigenproblem || elastic {
+                None
+            } else {
+                Some(solution?)
+            },
             gradient,
             eigenvalues,
+            displacement,
         })
     }
 
