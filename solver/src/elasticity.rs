@@ -20,8 +20,8 @@
 //! ```
 //!
 //! because the kernel of A_c (a constant per component: the translations)
-//! lies in the kernel of K_c. Rotations are not in ker A_c, so Ω_c is not
-//! zero on them; A_c maps them to edge vectors that Ω_c sends to zero.
+//! lies in the kernel of K_c. Rotations are not in ker A_c: A_c maps them
+//! to nonzero edge vectors, which Ω_c sends to zero.
 //!
 //! Boundary conditions act on tagged (n−1)-cells: a prescribed displacement
 //! (all components, or one component, for rollers and symmetry planes) is

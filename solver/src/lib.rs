@@ -8,6 +8,7 @@ pub mod block;
 pub mod canonical;
 pub mod case;
 pub mod converge;
+pub mod coupled;
 pub mod darcy;
 pub mod diffusion;
 pub mod eigen;
