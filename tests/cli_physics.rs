@@ -462,6 +462,31 @@ write = false
     assert!(max < 1e-13, "{out}");
 }
 
+// ---------------------------------------------------------------- coupled
+
+#[test]
+fn coupled_reaction_converges_and_the_coupling_matters() {
+    let (mut u, mut v) = (vec![], vec![]);
+    for n in [8, 16, 32, 64] {
+        let out = run(
+            "cases/coupled-reaction.toml",
+            &[format!("mesh.n=[{n},{n}]")],
+        );
+        u.push(reported(&out, "error u", "L2"));
+        v.push(reported(&out, "error v", "L2"));
+    }
+    println!("coupled-reaction: u {u:?}, v {v:?}");
+    for (name, e) in [("u", &u), ("v", &v)] {
+        let p = order(e[0], e[3], 8.0);
+        assert!((p - 2.0).abs() <= 0.15, "{name}: order {p}, {e:?}");
+    }
+    // The sources belong to b = 2.5: solving with b = 0 misses by O(1)
+    // relative to the discretisation error.
+    let out = run("cases/coupled-reaction.toml", &["problem.b=0".into()]);
+    let uncoupled = reported(&out, "error u", "L2");
+    assert!(uncoupled > 100.0 * u[2], "{uncoupled} vs {}", u[2]);
+}
+
 // ---------------------------------------------------------------- bad input
 
 /// Write `text` as a case, run it, expect exit code `code` and every
@@ -597,6 +622,27 @@ fn bad_problem_kind_input_names_the_key() {
         "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"elasticity\"\nlambda = 1\nmu = 1\n[[boundary]]\ntag = \"xmin\"\ntype = \"dirichlet\"\nvalue = [0, 0]\n",
         2,
         &["`boundary[0].type`", "\"displacement\""],
+    );
+    let pair = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"coupled\"\na = 1\nb = 60\nc = 1\n[[field]]\nname = \"u\"\nmethod = \"fe\"\n[[field.boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n[[field]]\nname = \"v\"\nmethod = \"fe\"\nsource = 1\n[[field.boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n";
+    // a c < b²: indefinite, and LLᵀ says so (exit 1, a solve failure).
+    refused("coupled-indefinite", pair, 1, &["LLᵀ"]);
+    refused(
+        "coupled-fields",
+        &pair.replacen("[[field]]\nname = \"v\"", "[[field]]\nname = \"u\"", 1),
+        2,
+        &["`field[1].name`", "differ from the other"],
+    );
+    refused(
+        "coupled-boundary",
+        &format!("{pair}[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n"),
+        2,
+        &["`boundary`", "per field"],
+    );
+    refused(
+        "coupled-tag",
+        &pair.replacen("tag = \"boundary\"", "tag = \"bondary\"", 1),
+        2,
+        &["`field[0].boundary[0].tag`", "did you mean `boundary`"],
     );
     refused(
         "wrong-key",

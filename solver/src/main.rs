@@ -354,6 +354,13 @@ fn describe_problem(case: &Case) -> String {
         Problem::Darcy(d) => format!("darcy, flux mass {:?}", d.mass),
         Problem::Maxwell(m) => format!("maxwell, {} modes, dual {:?}", m.modes, m.dual),
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
+        Problem::Coupled(c) => format!(
+            "coupled fields {} ({}) and {} ({})",
+            c.fields[0].name,
+            c.fields[0].diffusion.method.name(),
+            c.fields[1].name,
+            c.fields[1].diffusion.method.name()
+        ),
     }
 }
 

@@ -38,6 +38,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod coupled;
 mod darcy;
 mod elasticity;
 mod heat;
@@ -118,6 +119,7 @@ pub fn solve(
         Problem::Darcy(spec) => darcy::solve(case, spec, complex, phase),
         Problem::Maxwell(spec) => maxwell::solve(case, spec, complex, phase),
         Problem::Elasticity(spec) => elasticity::solve(case, spec, complex, phase),
+        Problem::Coupled(spec) => coupled::solve(case, spec, complex, phase),
     }
 }
 

@@ -209,6 +209,25 @@ pub struct ElasticitySpec {
     pub boundary: Vec<ElasticBoundarySpec>,
 }
 
+/// One field of a coupled problem: its own diffusion operator and data.
+#[derive(Clone, Debug)]
+pub struct CoupledFieldSpec {
+    pub name: String,
+    pub diffusion: DiffusionSpec,
+    /// The exact field, when known.
+    pub exact: Option<Expression>,
+}
+
+/// Two diffusion fields coupled by linear reaction terms:
+/// −∇·(D₁∇u) + a u − b v = f, −∇·(D₂∇v) − b u + c v = g.
+#[derive(Clone, Debug)]
+pub struct CoupledSpec {
+    pub fields: [CoupledFieldSpec; 2],
+    pub a: Expression,
+    pub b: Expression,
+    pub c: Expression,
+}
+
 /// What the case solves.
 #[derive(Clone, Debug)]
 pub enum Problem {
@@ -218,6 +237,7 @@ pub enum Problem {
     Darcy(DarcySpec),
     Maxwell(MaxwellSpec),
     Elasticity(ElasticitySpec),
+    Coupled(CoupledSpec),
 }
 
 impl Problem {
@@ -230,6 +250,7 @@ impl Problem {
             Problem::Darcy(_) => "darcy",
             Problem::Maxwell(_) => "maxwell",
             Problem::Elasticity(_) => "elasticity",
+            Problem::Coupled(_) => "coupled",
         }
     }
 
@@ -239,7 +260,10 @@ impl Problem {
             Problem::Diffusion(d) => &d.boundary,
             Problem::Heat(h) => &h.boundary,
             Problem::Darcy(d) => &d.boundary,
-            Problem::Gradient(_) | Problem::Maxwell(_) | Problem::Elasticity(_) => &[],
+            Problem::Gradient(_)
+            | Problem::Maxwell(_)
+            | Problem::Elasticity(_)
+            | Problem::Coupled(_) => &[],
         }
     }
 
@@ -250,6 +274,12 @@ impl Problem {
             Problem::Elasticity(e) => e
                 .boundary
                 .iter()
+                .map(|b| (b.tag.as_str(), b.tag_span.clone(), b.key.as_str()))
+                .collect(),
+            Problem::Coupled(c) => c
+                .fields
+                .iter()
+                .flat_map(|f| &f.diffusion.boundary)
                 .map(|b| (b.tag.as_str(), b.tag_span.clone(), b.key.as_str()))
                 .collect(),
             other => other
@@ -266,7 +296,10 @@ impl Problem {
             Problem::Diffusion(d) => Some(&d.conductivity),
             Problem::Heat(h) => Some(&h.conductivity),
             Problem::Darcy(d) => Some(&d.permeability),
-            Problem::Gradient(_) | Problem::Maxwell(_) | Problem::Elasticity(_) => None,
+            Problem::Gradient(_)
+            | Problem::Maxwell(_)
+            | Problem::Elasticity(_)
+            | Problem::Coupled(_) => None,
         }
     }
 }
@@ -467,7 +500,8 @@ impl Case {
             Problem::Gradient(_)
             | Problem::Darcy(_)
             | Problem::Maxwell(_)
-            | Problem::Elasticity(_) => None,
+            | Problem::Elasticity(_)
+            | Problem::Coupled(_) => None,
         }
     }
 }

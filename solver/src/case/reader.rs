@@ -34,6 +34,7 @@ const TOP_KEYS: &[&str] = &[
     "output",
     "refine",
     "time",
+    "field",
 ];
 const MESH_KEYS: &[&str] = &[
     "generator",
@@ -73,6 +74,9 @@ const PROBLEM_KEYS: &[&str] = &[
     "poisson",
     "body_force",
     "plane",
+    "a",
+    "b",
+    "c",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -88,6 +92,7 @@ const KIND_KEYS: &[(&str, &[&str])] = &[
         "elasticity",
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],
     ),
+    ("coupled", &["a", "b", "c"]),
 ];
 const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha", "component"];
 const EXACT_KEYS: &[&str] = &["solution", "gradient", "eigenvalues", "displacement"];
@@ -584,6 +589,7 @@ impl Reader {
             "darcy" => self.darcy(root, table, problem_entry.span(), scope),
             "maxwell" => self.maxwell(root, table, problem_entry.span()),
             "elasticity" => self.elasticity(root, table, problem_entry.span(), scope),
+            "coupled" => self.coupled(root, table, problem_entry.span(), scope),
             "gradient" => {
                 if let Some(e) = self.entry(root, "", "boundary") {
                     self.error(
@@ -625,10 +631,20 @@ impl Reader {
     }
 
     fn method(&mut self, table: &dyn TableLike, header: Option<Range<usize>>) -> Option<Method> {
-        let Some(entry) = self.entry(table, "problem", "method") else {
+        self.method_in(table, "problem", header)
+    }
+
+    /// `method` of the table at `prefix` (`problem`, or `field[i]`).
+    fn method_in(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        header: Option<Range<usize>>,
+    ) -> Option<Method> {
+        let Some(entry) = self.entry(table, prefix, "method") else {
             self.error(
                 header,
-                "problem.method",
+                &join(prefix, "method"),
                 "missing: which discretisation to use",
                 Some(format!("one of {}", METHODS.join(", "))),
             );
@@ -671,7 +687,18 @@ impl Reader {
         key: &str,
         scope: &Scope,
     ) -> Option<Coefficient> {
-        let Some(entry) = self.entry(table, "problem", key) else {
+        self.coefficient_in(table, "problem", key, scope)
+    }
+
+    /// A scalar or tensor coefficient `<prefix>.<key>` (default 1).
+    fn coefficient_in(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        key: &str,
+        scope: &Scope,
+    ) -> Option<Coefficient> {
+        let Some(entry) = self.entry(table, prefix, key) else {
             return scope.parse("1").ok().map(Coefficient::Scalar);
         };
         let Some(Value::Array(rows)) = entry.item.as_value() else {
@@ -749,9 +776,21 @@ impl Reader {
         scope: &Scope,
         conditions: Conditions,
     ) -> Vec<BoundarySpec> {
+        self.boundary_in(root, "", scope, conditions)
+    }
+
+    /// The `[[boundary]]` tables under `parent` (the document, or a
+    /// `[[field]]` of a coupled problem).
+    fn boundary_in(
+        &mut self,
+        parent: &dyn TableLike,
+        parent_prefix: &str,
+        scope: &Scope,
+        conditions: Conditions,
+    ) -> Vec<BoundarySpec> {
         let names = conditions.names();
         let mut out = Vec::new();
-        let Some(entry) = self.entry(root, "", "boundary") else {
+        let Some(entry) = self.entry(parent, parent_prefix, "boundary") else {
             return out;
         };
         let Some(array) = entry.item.as_array_of_tables() else {
@@ -766,7 +805,7 @@ impl Reader {
             return out;
         };
         for (i, table) in array.iter().enumerate() {
-            let prefix = format!("boundary[{i}]");
+            let prefix = format!("{}[{i}]", join(parent_prefix, "boundary"));
             self.check_keys(table, &prefix, BOUNDARY_KEYS);
             let header = table.span();
             let tag_entry = self.entry(table, &prefix, "tag");
@@ -984,6 +1023,10 @@ impl Reader {
     }
 
     fn exact(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<ExactSpec> {
+        if problem_kind(root) == "coupled" {
+            // Exact fields go in the [[field]] tables; `coupled` says so.
+            return None;
+        }
         let (table, entry) = self.subtable(root, "", "exact")?;
         self.check_keys(table, "exact", EXACT_KEYS);
         let eigenproblem = problem_kind(root) == "maxwell";
