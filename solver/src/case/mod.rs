@@ -237,7 +237,7 @@ pub enum Problem {
     Darcy(DarcySpec),
     Maxwell(MaxwellSpec),
     Elasticity(ElasticitySpec),
-    Coupled(CoupledSpec),
+    Coupled(Box<CoupledSpec>),
 }
 
 impl Problem {

@@ -915,12 +915,12 @@ impl Reader {
         }
         let fields = self.fields(root, scope);
         let [first, second]: [CoupledFieldSpec; 2] = fields?.try_into().ok()?;
-        Some(Problem::Coupled(CoupledSpec {
+        Some(Problem::Coupled(Box::new(CoupledSpec {
             fields: [first, second],
             a: a?,
             b: b?,
             c: c?,
-        }))
+        })))
     }
 
     /// The two `[[field]]` tables of a coupled problem.
