@@ -505,7 +505,7 @@ fn duplicate_vertices(complex: &Complex) -> Result<(), MeshDefect> {
         }
     }
     let extent = (0..d).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
-    if !(extent > 0.0) {
+    if extent.is_nan() || extent <= 0.0 {
         return Ok(());
     }
     let tolerance = 1e-10 * extent;
