@@ -340,3 +340,37 @@ fn the_memory_limit_is_the_one_in_force() {
     );
     assert!(run("100000000").status.success());
 }
+
+/// A coefficient spanning 17 orders of magnitude solves, but the run warns
+/// that the system is ill-conditioned (κ ≥ max M_ii / min M_ii); a modest
+/// one does not.
+#[test]
+fn ill_conditioned_systems_are_reported() {
+    let run = |conductivity: &str| {
+        let set = format!("problem.conductivity=\"{conductivity}\"");
+        let out = hasse(
+            &[
+                "run",
+                "cases/poisson-square.toml",
+                "--set",
+                &set,
+                "--set",
+                "output.write=false",
+            ],
+            &root(),
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let stiff = run("exp(40*x)");
+    assert!(
+        stiff.contains("condition number is at least 1.9e16"),
+        "{stiff}"
+    );
+    let mild = run("1 + x");
+    assert!(!mild.contains("condition number"), "{mild}");
+}
