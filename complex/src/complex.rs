@@ -106,13 +106,14 @@ impl Complex {
                 Ok(if frame::det(n, &f.basis) > 0.0 { 1 } else { -1 })
             })
             .collect::<Result<_>>()?;
+        check_closed(&lar, &boundaries)?;
         let top_orientation = orient_top_cells(&lar, &boundaries[n - 1], ambient)?;
         let top = &mut boundaries[n - 1];
         let cols: Vec<usize> = top.indices().to_vec();
         for (value, col) in top.data_mut().iter_mut().zip(cols) {
             *value *= top_orientation[col];
         }
-        check_coherence(&boundaries[n - 1])?;
+        check_coherence(&boundaries[n - 1], n == lar.vertices().dim())?;
         Ok(Self {
             stars: (0..=n).map(|_| OnceLock::new()).collect(),
             lar,
@@ -607,9 +608,55 @@ fn enclosed_volume(lar: &Lar, by_cell: &CsMat<i8>, flags: &[i8], component: &[us
     volume
 }
 
-/// Every (n−1)-cell shared by two top cells must appear with opposite signs.
-fn check_coherence(top: &CsMat<i8>) -> Result<()> {
+/// ∂_{p−1} ∂_p = 0, column by column. The signs of a simplex's facets are
+/// combinatorial and always close up; those of other cells come from
+/// geometry, and on a twisted or self-intersecting cell (a "bow-tie" face of
+/// a hexahedron whose nodes are out of order) they need not: report the
+/// cell rather than hand out a complex that breaks ∂∂ = 0.
+fn check_closed(lar: &Lar, boundaries: &[CsMat<i8>]) -> Result<()> {
+    for p in 2..=boundaries.len() {
+        if (0..lar.cell_count(p)).all(|j| lar.cell_vertices(p, j).len() == p + 1) {
+            continue;
+        }
+        let (lower, upper) = (&boundaries[p - 2], boundaries[p - 1].to_csc());
+        let lower = lower.to_csc();
+        let mut terms: Vec<(usize, i32)> = Vec::new();
+        for (cell, column) in upper.outer_iterator().enumerate() {
+            terms.clear();
+            for (facet, &s) in column.iter() {
+                if let Some(edges) = lower.outer_view(facet) {
+                    terms.extend(edges.iter().map(|(v, &t)| (v, i32::from(s) * i32::from(t))));
+                }
+            }
+            terms.sort_unstable_by_key(|&(v, _)| v);
+            let open = terms
+                .chunk_by(|a, b| a.0 == b.0)
+                .any(|run| run.iter().map(|&(_, t)| t).sum::<i32>() != 0);
+            if open {
+                return Err(ComplexError::Invalid(format!(
+                    "{p}-cell {cell} (vertices {:?}) is twisted or self-intersecting: its {}-faces do not close up around it (∂∂ ≠ 0); check the order of its vertices",
+                    lar.cell_vertices(p, cell),
+                    p - 1
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every (n−1)-cell shared by two top cells must appear with opposite signs;
+/// when the cells fill R^n (`fills`), no face may bound more than two.
+fn check_coherence(top: &CsMat<i8>, fills: bool) -> Result<()> {
     for (face, row) in top.outer_iterator().enumerate() {
+        // Surfaces in R³ may branch (a T-junction of sheets is a valid
+        // complex); cells that fill their space can only overlap there.
+        if fills && row.nnz() > 2 {
+            return Err(ComplexError::Invalid(format!(
+                "face {face} bounds {} top cells ({:?}); in a mesh that fills its space a face bounds at most two: the cells overlap",
+                row.nnz(),
+                row.indices()
+            )));
+        }
         if row.nnz() == 2 && row.data()[0] == row.data()[1] {
             let cells: Vec<usize> = row.indices().to_vec();
             return Err(ComplexError::Invalid(format!(

@@ -246,12 +246,25 @@ fn read(bytes: &[u8], path: &Path) -> Result<Complex, GmshError> {
     let format = read_format(bytes, path)?;
 
     // mshio subtracts 1 from the node and element counts, which overflows on
-    // empty sections: report those before handing the file over.
-    if section_counts(bytes, format, "$Nodes").is_some_and(|c| c == 0) {
-        return Err(empty(path, "the $Nodes section lists no nodes"));
-    }
-    if section_counts(bytes, format, "$Elements").is_some_and(|c| c == 0) {
-        return Err(empty(path, "the $Elements section lists no elements"));
+    // empty sections, and computes max − min of the tag ranges, which
+    // overflows when a range is inverted (panics in checked builds): report
+    // those before handing the file over. Every line that opens such a
+    // section is checked, since a damaged file may have several.
+    for (section, what) in [("$Nodes", "node"), ("$Elements", "element")] {
+        for [_, count, min, max] in section_headers(bytes, format, section) {
+            if count == 0 {
+                return Err(empty(
+                    path,
+                    &format!("the {section} section lists no {what}s"),
+                ));
+            }
+            if max < min {
+                return Err(parse_error(
+                    path,
+                    format!("the {section} header gives the {what} tags as {min}..{max}: the largest is below the smallest; {REEXPORT}"),
+                ));
+            }
+        }
     }
 
     let parsed = std::panic::catch_unwind(|| {
@@ -756,11 +769,25 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// The second number of a section header (number of nodes or elements).
-fn section_counts(bytes: &[u8], format: Format, section: &str) -> Option<u64> {
-    let mut r = Reader::at(bytes, format, section)?;
-    r.size_t()?;
-    r.size_t()
+/// The four numbers heading each `$Nodes` or `$Elements` line of the file:
+/// blocks, count, smallest tag, largest tag.
+fn section_headers(bytes: &[u8], format: Format, section: &str) -> Vec<[u64; 4]> {
+    let mut headers = Vec::new();
+    let mut from = 0;
+    while let Some((line, body)) = bytes.get(from..).and_then(|rest| find_line(rest, section)) {
+        let mut r = Reader {
+            bytes,
+            pos: from + body,
+            format,
+        };
+        if let (Some(a), Some(b), Some(c), Some(d)) =
+            (r.size_t(), r.size_t(), r.size_t(), r.size_t())
+        {
+            headers.push([a, b, c, d]);
+        }
+        from += line + 1;
+    }
+    headers
 }
 
 /// Node tags in file order, read from the `$Nodes` section directly (mshio

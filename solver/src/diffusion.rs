@@ -194,6 +194,18 @@ pub enum DiffusionError {
     IncompatibleNeumann { imbalance: f64, relative: f64 },
     #[error("pure Neumann problem on a disconnected domain ({components} parts): give every part a Dirichlet or Robin boundary")]
     Disconnected { components: usize },
+    #[error("the domain has {parts} disconnected parts and the part holding {what} {unknown} (at {point:?}) has no Dirichlet or Robin boundary: its solution is fixed only up to a constant and the system is singular; put a Dirichlet or Robin condition on a boundary tag of every part, or mesh the parts separately")]
+    FloatingPart {
+        parts: usize,
+        what: &'static str,
+        unknown: usize,
+        point: Vec<f64>,
+    },
+    #[error("conductivity at {point:?}: {source}; check the conductivity expression there")]
+    Coefficient {
+        point: Vec<f64>,
+        source: MetricError,
+    },
     #[error("the {method} metric is not symmetric, but {factorization} needs a symmetric positive definite system; use Factorization::Lu for a non-symmetric Ω")]
     NotSymmetric {
         method: &'static str,
@@ -235,6 +247,35 @@ pub struct Solution {
     pub cell_points: Option<Vec<f64>>,
     /// Iterations and residuals when solved iteratively.
     pub iterations: Option<CgReport>,
+    /// A lower bound on the condition number of the solved (reduced)
+    /// system: for a symmetric positive definite M, λ_max ≥ max M_ii and
+    /// λ_min ≤ min M_ii, so κ(M) ≥ max M_ii / min M_ii. Free to compute,
+    /// and large when coefficients or cell sizes span many orders.
+    pub condition_bound: f64,
+}
+
+/// max M_ii / min M_ii over the unknowns not held fixed (see
+/// [`Solution::condition_bound`]); infinite when a diagonal entry is zero.
+pub fn diagonal_condition_bound(matrix: &SparseColMat<usize, f64>, fixed: &[Option<f64>]) -> f64 {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for c in 0..matrix.ncols() {
+        if fixed.get(c).is_some_and(Option::is_some) {
+            continue;
+        }
+        let range = matrix.col_range(c);
+        let diagonal = matrix.row_idx()[range.clone()]
+            .iter()
+            .zip(&matrix.val()[range])
+            .find(|(&r, _)| r == c)
+            .map_or(0.0, |(_, &v)| v.abs());
+        lo = lo.min(diagonal);
+        hi = hi.max(diagonal);
+    }
+    if hi == 0.0 {
+        1.0
+    } else {
+        hi / lo
+    }
 }
 
 impl Solution {
@@ -391,7 +432,15 @@ impl Diffusion {
                 }
             })
             .collect();
-        metric::check_tensors(&tensors, complex.cell_count(n), d)?;
+        metric::check_tensors(&tensors, complex.cell_count(n), d).map_err(|e| match e {
+            MetricError::NotPositive { cell, .. } | MetricError::NonFinite { cell } => {
+                DiffusionError::Coefficient {
+                    point: centroids[cell * d..(cell + 1) * d].to_vec(),
+                    source: e,
+                }
+            }
+            other => other.into(),
+        })?;
         Ok(tensors)
     }
 
@@ -807,6 +856,10 @@ impl Diffusion {
             fixed[0] = Some(0.0);
         }
 
+        if !pure_neumann {
+            check_anchored(complex, location, &matrix, &fixed)?;
+        }
+        let condition_bound = diagonal_condition_bound(&matrix, &fixed);
         let (mut values, report, iterations) = solve_with_fixed(
             &matrix,
             &rhs,
@@ -842,6 +895,7 @@ impl Diffusion {
             pure_neumann,
             neumann_imbalance,
             cell_points,
+            condition_bound,
         })
     }
 
@@ -890,6 +944,99 @@ impl Diffusion {
             }
         }
     }
+}
+
+/// Every connected part of the free unknowns must be tied to a Dirichlet
+/// value or a Robin/ghost row, or M is singular there. On a part C of the
+/// graph of M that is tied to nothing, M·1 vanishes on C (constants are the
+/// kernel of AᵀΩA); a tie shows as a row sum over C of the order of the
+/// diagonal. This finds the floating part before the factorisation fails
+/// with a message that cannot say where.
+fn check_anchored(
+    complex: &Complex,
+    location: Location,
+    matrix: &SparseColMat<usize, f64>,
+    fixed: &[Option<f64>],
+) -> Result<(), DiffusionError> {
+    let size = matrix.ncols();
+    let mut parent: Vec<usize> = (0..size).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let free = |i: usize| fixed.get(i).is_none_or(Option::is_none);
+    for c in 0..size {
+        if !free(c) {
+            continue;
+        }
+        for (&r, &v) in matrix.row_idx()[matrix.col_range(c)]
+            .iter()
+            .zip(&matrix.val()[matrix.col_range(c)])
+        {
+            if r != c && v != 0.0 && free(r) {
+                let (a, b) = (root(&mut parent, r), root(&mut parent, c));
+                parent[a] = b;
+            }
+        }
+    }
+    // Per part: the largest |Σ_{j∈C} M_ij| and the largest diagonal. Rounding
+    // leaves row sums of untied rows near 1e-15 of the diagonal; a tie (a
+    // Dirichlet neighbour, a Robin or ghost weight) is of its order, unless
+    // the data itself is that close to singular.
+    let mut row_sum = vec![0.0f64; size];
+    let mut diagonal = vec![0.0f64; size];
+    for c in 0..size {
+        for (&r, &v) in matrix.row_idx()[matrix.col_range(c)]
+            .iter()
+            .zip(&matrix.val()[matrix.col_range(c)])
+        {
+            if r == c {
+                diagonal[r] = v.abs();
+            }
+            if free(r) && free(c) {
+                row_sum[r] += v;
+            }
+        }
+    }
+    let mut tie = vec![0.0f64; size];
+    let mut scale = vec![0.0f64; size];
+    let mut first = vec![usize::MAX; size];
+    for i in (0..size).filter(|&i| free(i)) {
+        let p = root(&mut parent, i);
+        if first[p] == usize::MAX {
+            first[p] = i;
+        }
+        tie[p] = tie[p].max(row_sum[i].abs());
+        scale[p] = scale[p].max(diagonal[i]);
+    }
+    for p in 0..size {
+        if first[p] == usize::MAX || tie[p] > 1e-12 * scale[p] {
+            continue;
+        }
+        let unknown = first[p];
+        let n = complex.dim();
+        let cells = complex.cell_count(n);
+        let (what, point) = match location {
+            Location::Nodal => ("vertex", complex.vertices().point(unknown).to_vec()),
+            _ if unknown < cells => ("top cell", complex.centroid_of(n, unknown).to_vec()),
+            _ => ("face", complex.centroid_of(n - 1, unknown - cells).to_vec()),
+        };
+        let unknown = match location {
+            Location::Hybrid if unknown >= cells => unknown - cells,
+            _ => unknown,
+        };
+        return Err(DiffusionError::FloatingPart {
+            // Only on this error path: homology is not free on large meshes.
+            parts: complex.betti_numbers_over(hasse_complex::Field::Z2)[0],
+            what,
+            unknown,
+            point,
+        });
+    }
+    Ok(())
 }
 
 /// α of a Robin condition at a point, which must be positive.

@@ -412,6 +412,19 @@ fn run_case(
         Ok(case) => case,
         Err(code) => return code,
     };
+    let stem = output
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| case.output.directory.join(&case.output.name));
+    if case.output.write || output.is_some() {
+        if let Err(e) = hasse_solver::output::check_writable(&stem) {
+            eprintln!(
+                "error: {}: output {}: {e}\n    help: choose a writable place with -o DIR/NAME or [output] directory",
+                path.display(),
+                stem.display()
+            );
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    }
     let progress = Progress::new(quiet, verbose);
     progress.phase("building the mesh");
     let mesh_started = std::time::Instant::now();
@@ -460,9 +473,6 @@ fn run_case(
     result.timings.insert(0, ("mesh".into(), mesh_seconds));
     let written = if case.output.write || output.is_some() {
         progress.phase("writing output");
-        let stem = output
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| case.output.directory.join(&case.output.name));
         let written = match &study {
             // A refinement writes every level, each on its own mesh.
             Some((steps, levels)) => {

@@ -233,6 +233,9 @@ fn solve_diffusion(
         ));
     }
     check_residual(case, report.relative_residual, &mut warnings)?;
+    if solution.condition_bound > 1e12 {
+        warnings.push(format!("the system's condition number is at least {:.1e} (largest / smallest diagonal entry): expect to lose about {:.0} of 16 digits; check coefficients and cell sizes that span many orders of magnitude", solution.condition_bound, solution.condition_bound.log10()));
+    }
 
     phase("post-processing");
     let post = Instant::now();

@@ -22,7 +22,44 @@
 //! ```
 
 use exmex::prelude::*;
+use exmex::{FloatOpsFactory, MatchLiteral};
 use std::sync::Arc;
+
+/// Number literals with an optional exponent (`2.5e-3`, `1E6`): exmex's own
+/// matcher stops at the `e`, so `1e-3` would parse as `1·e − 3`, and TOML
+/// numbers such as `1e-7` (which case files pass on as expression text)
+/// could not be read at all.
+#[derive(Clone, Debug)]
+pub struct ScientificNumbers;
+
+impl MatchLiteral for ScientificNumbers {
+    fn is_literal(text: &str) -> Option<&str> {
+        let bytes = text.as_bytes();
+        let digits = |from: usize| {
+            bytes[from..]
+                .iter()
+                .take_while(|b| b.is_ascii_digit())
+                .count()
+        };
+        let mut end = digits(0);
+        if bytes.get(end) == Some(&b'.') && digits(end + 1) > 0 {
+            end += 1 + digits(end + 1);
+        }
+        if end == 0 {
+            return None;
+        }
+        if matches!(bytes.get(end), Some(b'e' | b'E')) {
+            let sign = usize::from(matches!(bytes.get(end + 1), Some(b'+' | b'-')));
+            let exponent = digits(end + 1 + sign);
+            if exponent > 0 {
+                end += 1 + sign + exponent;
+            }
+        }
+        Some(&text[..end])
+    }
+}
+
+type Flat = FlatEx<f64, FloatOpsFactory<f64>, ScientificNumbers>;
 
 /// Names every expression may use without declaring them.
 pub const COORDINATES: [&str; 4] = ["x", "y", "z", "t"];
@@ -71,7 +108,7 @@ enum Slot {
 pub struct Expression {
     text: String,
     /// Boxed: exmex keeps its nodes in large inline arrays (~20 kB).
-    flat: Box<FlatEx<f64>>,
+    flat: Box<Flat>,
     /// One slot per exmex variable, in exmex's (alphabetical) order.
     slots: Vec<Slot>,
     /// True when the value depends on neither position nor time.
@@ -208,7 +245,7 @@ impl Scope {
 
     /// Parse `text` against this scope.
     pub fn parse(&self, text: &str) -> Result<Expression, ExprError> {
-        let flat = FlatEx::<f64>::parse(text).map_err(|e| ExprError::Syntax {
+        let flat = Flat::parse(text).map_err(|e| ExprError::Syntax {
             text: text.to_string(),
             message: e.msg().to_string(),
         })?;
@@ -332,6 +369,18 @@ mod tests {
         scope.add_constant("k", 1.0).unwrap();
         assert!(scope.add_constant("k", 2.0).is_err());
         assert!(scope.add_constant("inf", f64::INFINITY).is_err());
+    }
+
+    #[test]
+    fn numbers_in_scientific_notation() {
+        let scope = Scope::new();
+        let e = scope.parse("1e-320").unwrap();
+        assert_eq!(e.eval(&[], 0.0), 1e-320);
+        let e = scope.parse("2.5E+3*x + .5e1 - 3e2").unwrap();
+        assert_eq!(e.eval(&[2.0], 0.0), 5000.0 + 5.0 - 300.0);
+        // `e` alone is still Euler's number, and `2*e` its double.
+        let e = scope.parse("2*e").unwrap();
+        assert_eq!(e.eval(&[], 0.0), 2.0 * std::f64::consts::E);
     }
 
     #[test]

@@ -376,6 +376,19 @@ impl Reader {
             }
         };
         match scope.parse(&text) {
+            // A constant is evaluated once here, so NaN or ±∞ is found at its
+            // line rather than at the first point the solver samples.
+            Ok(e) if e.is_constant() && !e.eval(&[], 0.0).is_finite() => {
+                self.error(
+                    span,
+                    name,
+                    format!("`{text}` evaluates to {}", e.eval(&[], 0.0)),
+                    Some(
+                        "give a finite value (check square roots, logarithms and divisions)".into(),
+                    ),
+                );
+                None
+            }
             Ok(e) => Some(e),
             Err(e) => {
                 let help = expression_help(&e, scope);

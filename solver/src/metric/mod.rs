@@ -66,8 +66,15 @@ pub fn check_tensors(tensors: &[Tensor], cells: usize, d: usize) -> Result<(), M
         if t.iter().flatten().any(|v| !v.is_finite()) {
             return Err(MetricError::NonFinite { cell });
         }
-        // Leading principal minors > 0 (Sylvester) on the symmetric part.
-        let m = |i: usize, j: usize| 0.5 * (t[i][j] + t[j][i]);
+        // Leading principal minors > 0 (Sylvester) on the symmetric part,
+        // scaled to unit size first: the minors of a valid K = 1e-200·I
+        // would otherwise underflow to zero.
+        let scale = t[..d]
+            .iter()
+            .flat_map(|row| row[..d].iter())
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        let scale = if scale > 0.0 { scale } else { 1.0 };
+        let m = |i: usize, j: usize| 0.5 * (t[i][j] + t[j][i]) / scale;
         let minors = [
             m(0, 0),
             m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0),
@@ -76,7 +83,10 @@ pub fn check_tensors(tensors: &[Tensor], cells: usize, d: usize) -> Result<(), M
                 + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0)),
         ];
         if let Some(&bad) = minors[..d].iter().find(|&&v| v <= 0.0) {
-            return Err(MetricError::NotPositive { cell, value: bad });
+            return Err(MetricError::NotPositive {
+                cell,
+                value: bad * scale,
+            });
         }
     }
     Ok(())

@@ -406,6 +406,37 @@ pub fn write_mesh_series(stem: &Path, series: &SeriesOutput) -> Result<OutputFil
     write_levels(stem, &Levels::of_series(series))
 }
 
+/// Check, before any long computation, that output can be written under
+/// `stem`: the directory is created if missing and a probe file is created
+/// and removed in it. An unwritable place is then reported at once instead
+/// of after the solve.
+///
+/// ```
+/// use hasse_solver::output::check_writable;
+/// let dir = std::env::temp_dir().join(format!("hasse-doc-probe-{}", std::process::id()));
+/// assert!(check_writable(&dir.join("run")).is_ok());
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// // Under a regular file nothing can be created.
+/// let file = std::env::temp_dir().join(format!("hasse-doc-file-{}", std::process::id()));
+/// std::fs::write(&file, "").unwrap();
+/// assert!(check_writable(&file.join("run")).is_err());
+/// std::fs::remove_file(&file).unwrap();
+/// ```
+pub fn check_writable(stem: &Path) -> Result<(), OutputError> {
+    let dir = match stem.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| OutputError::Io { path, source }
+    };
+    std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+    let probe = dir.join(format!(".hasse-probe.tmp-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(io(&dir))?;
+    std::fs::remove_file(&probe).map_err(io(&probe))
+}
+
 /// The shared body of [`write_run`] and [`write_mesh_series`].
 fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError> {
     validate(levels)?;
