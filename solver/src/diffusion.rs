@@ -29,7 +29,7 @@ use crate::metric::{self, dec, fd, fe, fv, MetricError, Tensor};
 use crate::multigrid::{
     self, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
 };
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::SparseColMat;
 use hasse_complex::dual::DualKind;
 use hasse_complex::Complex;
 use sprs::TriMat;
@@ -938,18 +938,35 @@ pub fn solve_with_fixed(
         }
     }
     let mut reduced_rhs: Vec<f64> = free.iter().map(|&i| rhs[i]).collect();
-    let mut triplets = Vec::with_capacity(matrix.compute_nnz());
+    // The free block, column by column: renumbering keeps the order of the
+    // rows, so the CSC invariants of `matrix` carry over and no sort is
+    // needed. Without fixed unknowns the matrix is used as it is.
+    let mut col_ptr = Vec::with_capacity(free.len() + 1);
+    let mut row_idx = Vec::new();
+    let mut val = Vec::new();
+    col_ptr.push(0);
+    let all_free = free.len() == n;
     for j in 0..n {
         let range = matrix.col_range(j);
         let rows = &matrix.row_idx()[range.clone()];
         let vals = &matrix.val()[range];
-        for (&i, &v) in rows.iter().zip(vals) {
-            match (free_index[i], fixed[j]) {
-                (fi, None) if fi != usize::MAX => {
-                    triplets.push(Triplet::new(fi, free_index[j], v));
+        match fixed[j] {
+            None if all_free => {}
+            None => {
+                for (&i, &v) in rows.iter().zip(vals) {
+                    if free_index[i] != usize::MAX {
+                        row_idx.push(free_index[i]);
+                        val.push(v);
+                    }
                 }
-                (fi, Some(g)) if fi != usize::MAX => reduced_rhs[fi] -= v * g,
-                _ => {}
+                col_ptr.push(row_idx.len());
+            }
+            Some(g) => {
+                for (&i, &v) in rows.iter().zip(vals) {
+                    if free_index[i] != usize::MAX {
+                        reduced_rhs[free_index[i]] -= v * g;
+                    }
+                }
             }
         }
     }
@@ -966,8 +983,15 @@ pub fn solve_with_fixed(
         };
         return Ok((values, report, None));
     }
-    let reduced = SparseColMat::try_new_from_triplets(free.len(), free.len(), &triplets)
-        .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
+    let reduced: std::borrow::Cow<'_, SparseColMat<usize, f64>> = if all_free {
+        std::borrow::Cow::Borrowed(matrix)
+    } else {
+        let size = free.len();
+        let symbolic = faer::sparse::SymbolicSparseColMat::new_unsorted_checked(
+            size, size, col_ptr, None, row_idx,
+        );
+        std::borrow::Cow::Owned(SparseColMat::new(symbolic, val))
+    };
     let (x, report, iterations) = match iterative {
         None => {
             let (x, report) = linear::solve(&reduced, &reduced_rhs, factorization)?;
