@@ -46,6 +46,10 @@ for case in runs:
     mg_total = None if mg_setup is None else mg_setup + mg_solve
     amg_total = None if num(amg, "setup") is None else num(amg, "setup") + num(amg, "solve")
     rows.append((label, f"MG setup + CG to 1e-8 ({mg.get('iterations', '?')} it)", fmt(mg_total), f"pyamg SA-CG ({amg.get('iterations', '?')} it)", fmt(amg_total), ratio(mg_total, amg_total)))
+    pc = r.get("mg-pc", {})
+    pc_total = None if num(pc, "setup") is None else num(pc, "setup") + num(pc, "solve")
+    rows.append((label, f"  same, constant P, correction 2 ({pc.get('iterations', '?')} it)", fmt(pc_total), f"pyamg SA-CG", fmt(amg_total), ratio(pc_total, amg_total)))
+    rows.append((label, "  peak memory, constant-P run", fmt(num(pc, "peak_gib"), "GiB"), "pyamg process", fmt(num(amg, "peak_gib"), "GiB"), ratio(num(pc, "peak_gib"), num(amg, "peak_gib"))))
     e2e = None if mg_total is None else num(mg, "complex") + assembly + mg_total
     direct_e2e = None if num(direct, "factor") is None else num(direct, "complex") + assembly + num(direct, "factor") + num(direct, "solve")
     rows.append((label, "end to end MG (complex+assembly+MG)", fmt(e2e), "hasse direct end to end", fmt(direct_e2e), ratio(e2e, direct_e2e)))
