@@ -946,11 +946,11 @@ pub fn solve_with_fixed(
     let mut val = Vec::new();
     col_ptr.push(0);
     let all_free = free.len() == n;
-    for j in 0..n {
+    for (j, held) in fixed.iter().enumerate().take(n) {
         let range = matrix.col_range(j);
         let rows = &matrix.row_idx()[range.clone()];
         let vals = &matrix.val()[range];
-        match fixed[j] {
+        match *held {
             None if all_free => {}
             None => {
                 for (&i, &v) in rows.iter().zip(vals) {

@@ -260,7 +260,7 @@ impl Hierarchy {
 /// ```
 /// use hasse_solver::multigrid::{grid_prolongations, Transfer};
 /// let p = grid_prolongations(&[8, 4], Transfer::Nodal).unwrap();
-/// assert_eq!(p.len(), 2); // 8×4 → 4×2 → stop (2×1 has an axis below 2)
+/// assert_eq!(p.len(), 1); // 8×4 → 4×2, then stop: 2×1 would have an axis of one cell
 /// assert_eq!((p[0].matrix.nrows(), p[0].matrix.ncols()), (45, 15));
 /// ```
 pub fn grid_prolongations(
