@@ -1,5 +1,6 @@
 //! Krylov solvers for symmetric positive definite systems: conjugate
-//! gradients with a Jacobi (diagonal) preconditioner.
+//! gradients with a preconditioner ([`Preconditioner`]): Jacobi (diagonal)
+//! here, a multigrid V-cycle in [`crate::multigrid`].
 //!
 //! Used where an initial guess matters (re-solving on a refined mesh from
 //! the transferred coarse solution) and where a factorisation would be too
@@ -19,6 +20,7 @@
 //! ```
 
 use faer::sparse::SparseColMat;
+use rayon::prelude::*;
 
 /// Stopping rule of [`conjugate_gradient`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -63,6 +65,10 @@ pub enum CgError {
     NotPositive { index: usize, value: f64 },
     #[error("conjugate gradients: direction {iteration} has pᵀMp = {curvature:e} ≤ 0: the matrix is not positive definite")]
     Breakdown { iteration: usize, curvature: f64 },
+    #[error("preconditioned conjugate gradients: rᵀBr = {value:e} at iteration {iteration}: the preconditioner is not positive definite")]
+    Preconditioner { iteration: usize, value: f64 },
+    #[error("sparse matrix of {rows}×{cols}: row pointers or column indices out of range (at most 2³² columns)")]
+    Layout { rows: usize, cols: usize },
     #[error("conjugate gradients did not converge: relative residual {relative_residual:e} after {iterations} iterations (tolerance {tolerance:e}); raise the iteration limit or use a direct solver")]
     NotConverged {
         iterations: usize,
@@ -71,21 +77,361 @@ pub enum CgError {
     },
 }
 
-fn multiply(m: &SparseColMat<usize, f64>, x: &[f64], y: &mut [f64]) {
-    y.iter_mut().for_each(|v| *v = 0.0);
-    for (j, &xj) in x.iter().enumerate() {
-        if xj == 0.0 {
-            continue;
+/// A sparse matrix stored by rows (CSR) with 32-bit column indices: the
+/// layout of every matrix-vector product of the iterative solvers and the
+/// multigrid hierarchy. Rows are independent, so products run in parallel
+/// over rows with rayon and give the same bits for any thread count.
+///
+/// ```
+/// use hasse_solver::iterative::RowMatrix;
+/// // [[2, -1], [-1, 2]]
+/// let m = RowMatrix::from_rows(2, vec![vec![(0, 2.0), (1, -1.0)], vec![(0, -1.0), (1, 2.0)]]).unwrap();
+/// let mut y = vec![0.0; 2];
+/// m.multiply(&[1.0, 1.0], &mut y);
+/// assert_eq!(y, vec![1.0, 1.0]);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct RowMatrix {
+    nrows: usize,
+    ncols: usize,
+    ptr: Vec<usize>,
+    idx: Vec<u32>,
+    val: Vec<f64>,
+}
+
+/// Rows per parallel task: large enough that scheduling costs nothing
+/// next to the arithmetic, small enough to balance two to eight threads.
+const ROW_CHUNK: usize = 4096;
+
+impl RowMatrix {
+    /// From raw CSR arrays; checked.
+    pub fn new(
+        nrows: usize,
+        ncols: usize,
+        ptr: Vec<usize>,
+        idx: Vec<u32>,
+        val: Vec<f64>,
+    ) -> Result<Self, CgError> {
+        let bad = ptr.len() != nrows + 1
+            || ptr[0] != 0
+            || ptr.windows(2).any(|w| w[0] > w[1])
+            || ptr[nrows] != idx.len()
+            || idx.len() != val.len()
+            || idx.iter().any(|&j| j as usize >= ncols)
+            || ncols > u32::MAX as usize;
+        if bad {
+            return Err(CgError::Layout {
+                rows: nrows,
+                cols: ncols,
+            });
         }
-        let range = m.col_range(j);
-        for (&i, &v) in m.row_idx()[range.clone()].iter().zip(&m.val()[range]) {
-            y[i] += v * xj;
+        Ok(Self {
+            nrows,
+            ncols,
+            ptr,
+            idx,
+            val,
+        })
+    }
+
+    /// From lists of (column, value) per row (square, `n` × `n`).
+    pub fn from_rows(n: usize, rows: Vec<Vec<(usize, f64)>>) -> Result<Self, CgError> {
+        let mut ptr = vec![0];
+        let (mut idx, mut val) = (Vec::new(), Vec::new());
+        for row in &rows {
+            for &(j, v) in row {
+                idx.push(u32::try_from(j).map_err(|_| CgError::Layout { rows: n, cols: n })?);
+                val.push(v);
+            }
+            ptr.push(idx.len());
         }
+        Self::new(rows.len(), n, ptr, idx, val)
+    }
+
+    /// A symmetric faer matrix read by rows: its columns are its rows, so
+    /// the CSC arrays are taken as CSR ones (for a non-symmetric matrix this
+    /// is the transpose).
+    pub fn from_symmetric(matrix: &SparseColMat<usize, f64>) -> Result<Self, CgError> {
+        let n = matrix.ncols();
+        let mut ptr = Vec::with_capacity(n + 1);
+        let mut idx = Vec::with_capacity(matrix.compute_nnz());
+        let mut val = Vec::with_capacity(matrix.compute_nnz());
+        ptr.push(0);
+        for j in 0..n {
+            let range = matrix.col_range(j);
+            for (&i, &v) in matrix.row_idx()[range.clone()]
+                .iter()
+                .zip(&matrix.val()[range])
+            {
+                idx.push(u32::try_from(i).map_err(|_| CgError::Layout { rows: n, cols: n })?);
+                val.push(v);
+            }
+            ptr.push(idx.len());
+        }
+        Self::new(n, matrix.nrows(), ptr, idx, val)
+    }
+
+    pub fn nrows(&self) -> usize {
+        self.nrows
+    }
+
+    pub fn ncols(&self) -> usize {
+        self.ncols
+    }
+
+    /// Stored entries.
+    pub fn nnz(&self) -> usize {
+        self.val.len()
+    }
+
+    /// Column indices and values of row `i`.
+    pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
+        let r = self.ptr[i]..self.ptr[i + 1];
+        (&self.idx[r.clone()], &self.val[r])
+    }
+
+    /// The sum of the stored diagonal entries of each row.
+    pub fn diagonal(&self) -> Vec<f64> {
+        (0..self.nrows)
+            .into_par_iter()
+            .with_min_len(ROW_CHUNK)
+            .map(|i| {
+                let (c, v) = self.row(i);
+                c.iter()
+                    .zip(v)
+                    .filter(|(&j, _)| j as usize == i)
+                    .map(|(_, &v)| v)
+                    .sum()
+            })
+            .collect()
+    }
+
+    /// y = M x, in parallel over rows.
+    pub fn multiply(&self, x: &[f64], y: &mut [f64]) {
+        y.par_iter_mut()
+            .with_min_len(ROW_CHUNK)
+            .enumerate()
+            .for_each(|(i, yi)| {
+                let (c, v) = self.row(i);
+                *yi = c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum();
+            });
+    }
+
+    /// r = b − M x, in parallel over rows.
+    pub fn residual(&self, b: &[f64], x: &[f64], r: &mut [f64]) {
+        r.par_iter_mut()
+            .with_min_len(ROW_CHUNK)
+            .enumerate()
+            .for_each(|(i, ri)| {
+                let (c, v) = self.row(i);
+                *ri = b[i]
+                    - c.iter()
+                        .zip(v)
+                        .map(|(&j, &a)| a * x[j as usize])
+                        .sum::<f64>();
+            });
+    }
+
+    /// Mᵀ, by a counting sort over columns (rows of the result keep
+    /// increasing column order).
+    pub fn transpose(&self) -> RowMatrix {
+        let mut count = vec![0usize; self.ncols + 1];
+        for &j in &self.idx {
+            count[j as usize + 1] += 1;
+        }
+        for j in 0..self.ncols {
+            count[j + 1] += count[j];
+        }
+        let ptr = count.clone();
+        let mut next = count;
+        let mut idx = vec![0u32; self.nnz()];
+        let mut val = vec![0.0; self.nnz()];
+        for i in 0..self.nrows {
+            let (c, v) = self.row(i);
+            for (&j, &a) in c.iter().zip(v) {
+                let slot = &mut next[j as usize];
+                idx[*slot] = i as u32;
+                val[*slot] = a;
+                *slot += 1;
+            }
+        }
+        RowMatrix {
+            nrows: self.ncols,
+            ncols: self.nrows,
+            ptr,
+            idx,
+            val,
+        }
+    }
+
+    /// The product self · other (Gustavson's row-by-row algorithm), in
+    /// parallel over rows. Each entry is summed in the order of this row's
+    /// entries, whatever the thread count, so the bits do not depend on it.
+    pub fn product(&self, other: &RowMatrix) -> RowMatrix {
+        assert_eq!(
+            self.ncols, other.nrows,
+            "inner dimensions of a sparse product"
+        );
+        let width = other.ncols;
+        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..self.nrows.div_ceil(ROW_CHUNK))
+            .into_par_iter()
+            .map_init(
+                || (vec![0.0f64; width], vec![usize::MAX; width]),
+                |(acc, mark), chunk| {
+                    let rows = chunk * ROW_CHUNK..((chunk + 1) * ROW_CHUNK).min(self.nrows);
+                    let mut lengths = Vec::with_capacity(rows.len());
+                    let (mut idx, mut val) = (Vec::new(), Vec::new());
+                    for i in rows {
+                        let start = idx.len();
+                        let (c, v) = self.row(i);
+                        for (&k, &a) in c.iter().zip(v) {
+                            let (ck, vk) = other.row(k as usize);
+                            for (&j, &b) in ck.iter().zip(vk) {
+                                let j = j as usize;
+                                if mark[j] != i {
+                                    mark[j] = i;
+                                    acc[j] = 0.0;
+                                    idx.push(j as u32);
+                                }
+                                acc[j] += a * b;
+                            }
+                        }
+                        idx[start..].sort_unstable();
+                        val.extend(idx[start..].iter().map(|&j| acc[j as usize]));
+                        lengths.push(idx.len() - start);
+                    }
+                    (lengths, idx, val)
+                },
+            )
+            .collect();
+        let mut ptr = Vec::with_capacity(self.nrows + 1);
+        ptr.push(0);
+        let total: usize = chunks.iter().map(|c| c.1.len()).sum();
+        let mut idx = Vec::with_capacity(total);
+        let mut val = Vec::with_capacity(total);
+        for (lengths, i, v) in chunks {
+            for l in lengths {
+                ptr.push(ptr.last().copied().unwrap_or(0) + l);
+            }
+            idx.extend(i);
+            val.extend(v);
+        }
+        RowMatrix {
+            nrows: self.nrows,
+            ncols: width,
+            ptr,
+            idx,
+            val,
+        }
+    }
+
+    /// The matrix with rows and columns kept where `keep_rows` /
+    /// `keep_cols` say so, renumbered in order.
+    pub fn restrict(&self, keep_rows: &[bool], keep_cols: &[bool]) -> RowMatrix {
+        let mut new_col = vec![u32::MAX; self.ncols];
+        let mut k = 0u32;
+        for (j, &keep) in keep_cols.iter().enumerate() {
+            if keep {
+                new_col[j] = k;
+                k += 1;
+            }
+        }
+        let mut ptr = vec![0];
+        let (mut idx, mut val) = (Vec::new(), Vec::new());
+        for i in (0..self.nrows).filter(|&i| keep_rows[i]) {
+            let (c, v) = self.row(i);
+            for (&j, &a) in c.iter().zip(v) {
+                if new_col[j as usize] != u32::MAX {
+                    idx.push(new_col[j as usize]);
+                    val.push(a);
+                }
+            }
+            ptr.push(idx.len());
+        }
+        RowMatrix {
+            nrows: ptr.len() - 1,
+            ncols: k as usize,
+            ptr,
+            idx,
+            val,
+        }
+    }
+
+    /// The matrix as faer CSC (for the direct solve on the coarsest level).
+    pub fn to_faer(&self) -> SparseColMat<usize, f64> {
+        let triplets: Vec<faer::sparse::Triplet<usize, usize, f64>> = (0..self.nrows)
+            .flat_map(|i| {
+                let (c, v) = self.row(i);
+                c.iter()
+                    .zip(v)
+                    .map(move |(&j, &a)| faer::sparse::Triplet::new(i, j as usize, a))
+            })
+            .collect();
+        // The rows and columns were checked on construction.
+        SparseColMat::try_new_from_triplets(self.nrows, self.ncols, &triplets)
+            .expect("in-range CSR entries")
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
+/// Entries per partial sum of [`dot`]: the summation order depends on this
+/// constant only, never on the number of threads.
+const DOT_CHUNK: usize = 8192;
+
+/// aᵀb, summed in fixed chunks so the result is bit-identical for any
+/// number of threads.
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let partial: Vec<f64> = a
+        .par_chunks(DOT_CHUNK)
+        .zip(b.par_chunks(DOT_CHUNK))
+        .map(|(x, y)| x.iter().zip(y).map(|(p, q)| p * q).sum())
+        .collect();
+    partial.iter().sum()
+}
+
+/// A symmetric positive definite approximation B ≈ M⁻¹ applied to a
+/// residual. For conjugate gradients B must be symmetric positive definite
+/// and the same operator at every call.
+pub trait Preconditioner: Sync {
+    /// z = B r.
+    fn apply(&self, r: &[f64], z: &mut [f64]);
+    /// A short name for reports.
+    fn name(&self) -> &'static str;
+}
+
+/// B = diag(M)⁻¹.
+#[derive(Clone, Debug)]
+pub struct Jacobi {
+    inverse_diagonal: Vec<f64>,
+}
+
+impl Jacobi {
+    /// The inverse diagonal of `matrix`; every diagonal entry must be positive.
+    pub fn new(matrix: &RowMatrix) -> Result<Self, CgError> {
+        let diagonal = matrix.diagonal();
+        let mut inverse_diagonal = Vec::with_capacity(diagonal.len());
+        for (index, &value) in diagonal.iter().enumerate() {
+            // NaN fails too.
+            if value.is_nan() || value <= 0.0 {
+                return Err(CgError::NotPositive { index, value });
+            }
+            inverse_diagonal.push(1.0 / value);
+        }
+        Ok(Self { inverse_diagonal })
+    }
+}
+
+impl Preconditioner for Jacobi {
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        z.par_iter_mut()
+            .with_min_len(ROW_CHUNK)
+            .zip(r)
+            .zip(&self.inverse_diagonal)
+            .for_each(|((z, r), d)| *z = r * d);
+    }
+
+    fn name(&self) -> &'static str {
+        "Jacobi"
+    }
 }
 
 /// Solve M x = b (M symmetric positive definite, both triangles stored)
@@ -97,34 +443,53 @@ pub fn conjugate_gradient(
     initial: Option<&[f64]>,
     options: &CgOptions,
 ) -> Result<(Vec<f64>, CgReport), CgError> {
-    let started = std::time::Instant::now();
+    check_sizes(matrix.nrows(), matrix.ncols(), rhs, initial)?;
+    let rows = RowMatrix::from_symmetric(matrix)?;
+    let jacobi = Jacobi::new(&rows)?;
+    preconditioned_cg(&rows, rhs, initial, options, &jacobi)
+}
+
+fn check_sizes(
+    rows: usize,
+    cols: usize,
+    rhs: &[f64],
+    initial: Option<&[f64]>,
+) -> Result<(), CgError> {
     let n = rhs.len();
-    if matrix.nrows() != n || matrix.ncols() != n || initial.is_some_and(|x| x.len() != n) {
+    if rows != n || cols != n || initial.is_some_and(|x| x.len() != n) {
         return Err(CgError::Size {
-            rows: matrix.nrows(),
-            cols: matrix.ncols(),
+            rows,
+            cols,
             rhs: n,
             guess: initial.map_or(n, <[f64]>::len),
         });
     }
-    let mut inverse_diagonal = vec![0.0; n];
-    for (j, inverse) in inverse_diagonal.iter_mut().enumerate() {
-        let range = matrix.col_range(j);
-        let diagonal: f64 = matrix.row_idx()[range.clone()]
-            .iter()
-            .zip(&matrix.val()[range])
-            .filter(|(&i, _)| i == j)
-            .map(|(_, &v)| v)
-            .sum();
-        // NaN fails too.
-        if diagonal.is_nan() || diagonal <= 0.0 {
-            return Err(CgError::NotPositive {
-                index: j,
-                value: diagonal,
-            });
-        }
-        *inverse = 1.0 / diagonal;
-    }
+    Ok(())
+}
+
+/// Solve M x = b (M symmetric positive definite, stored by rows) by
+/// conjugate gradients preconditioned with `preconditioner`, from
+/// `initial` (zero if `None`). Every vector operation is parallel over
+/// entries and every inner product is summed in fixed chunks, so the
+/// iterates do not depend on the number of threads.
+///
+/// ```
+/// use hasse_solver::iterative::{preconditioned_cg, CgOptions, Jacobi, RowMatrix};
+/// let m = RowMatrix::from_rows(2, vec![vec![(0, 4.0), (1, 1.0)], vec![(0, 1.0), (1, 3.0)]]).unwrap();
+/// let jacobi = Jacobi::new(&m).unwrap();
+/// let (x, report) = preconditioned_cg(&m, &[1.0, 2.0], None, &CgOptions::default(), &jacobi).unwrap();
+/// assert!((4.0 * x[0] + x[1] - 1.0).abs() < 1e-12 && report.iterations <= 2);
+/// ```
+pub fn preconditioned_cg(
+    matrix: &RowMatrix,
+    rhs: &[f64],
+    initial: Option<&[f64]>,
+    options: &CgOptions,
+    preconditioner: &dyn Preconditioner,
+) -> Result<(Vec<f64>, CgReport), CgError> {
+    let started = std::time::Instant::now();
+    let n = rhs.len();
+    check_sizes(matrix.nrows(), matrix.ncols(), rhs, initial)?;
     let norm_b = dot(rhs, rhs).sqrt();
     let mut x = initial.map_or_else(|| vec![0.0; n], <[f64]>::to_vec);
     if norm_b == 0.0 {
@@ -137,14 +502,11 @@ pub fn conjugate_gradient(
         return Ok((vec![0.0; n], report));
     }
     let mut product = vec![0.0; n];
-    multiply(matrix, &x, &mut product);
-    let mut r: Vec<f64> = rhs.iter().zip(&product).map(|(b, mx)| b - mx).collect();
+    let mut r = vec![0.0; n];
+    matrix.residual(rhs, &x, &mut r);
     let initial_residual = dot(&r, &r).sqrt() / norm_b;
-    let mut z: Vec<f64> = r
-        .iter()
-        .zip(&inverse_diagonal)
-        .map(|(a, d)| a * d)
-        .collect();
+    let mut z = vec![0.0; n];
+    preconditioner.apply(&r, &mut z);
     let mut p = z.clone();
     let mut rz = dot(&r, &z);
     let mut iterations = 0;
@@ -157,7 +519,7 @@ pub fn conjugate_gradient(
                 tolerance: options.tolerance,
             });
         }
-        multiply(matrix, &p, &mut product);
+        matrix.multiply(&p, &mut product);
         let curvature = dot(&p, &product);
         if curvature.is_nan() || curvature <= 0.0 {
             return Err(CgError::Breakdown {
@@ -166,31 +528,34 @@ pub fn conjugate_gradient(
             });
         }
         let alpha = rz / curvature;
-        for i in 0..n {
-            x[i] += alpha * p[i];
-            r[i] -= alpha * product[i];
-        }
-        for i in 0..n {
-            z[i] = r[i] * inverse_diagonal[i];
-        }
+        x.par_iter_mut()
+            .with_min_len(ROW_CHUNK)
+            .zip(&p)
+            .for_each(|(x, p)| *x += alpha * p);
+        r.par_iter_mut()
+            .with_min_len(ROW_CHUNK)
+            .zip(&product)
+            .for_each(|(r, q)| *r -= alpha * q);
+        preconditioner.apply(&r, &mut z);
         let rz_next = dot(&r, &z);
+        if rz_next.is_nan() || (rz_next <= 0.0 && dot(&r, &r) > 0.0) {
+            return Err(CgError::Preconditioner {
+                iteration: iterations,
+                value: rz_next,
+            });
+        }
         let beta = rz_next / rz;
         rz = rz_next;
-        for i in 0..n {
-            p[i] = z[i] + beta * p[i];
-        }
+        p.par_iter_mut()
+            .with_min_len(ROW_CHUNK)
+            .zip(&z)
+            .for_each(|(p, z)| *p = z + beta * *p);
         iterations += 1;
         residual = dot(&r, &r).sqrt() / norm_b;
     }
     // The recurrence drifts from the true residual; report the true one.
-    multiply(matrix, &x, &mut product);
-    let true_residual = rhs
-        .iter()
-        .zip(&product)
-        .map(|(b, mx)| (b - mx) * (b - mx))
-        .sum::<f64>()
-        .sqrt()
-        / norm_b;
+    matrix.residual(rhs, &x, &mut product);
+    let true_residual = dot(&product, &product).sqrt() / norm_b;
     let report = CgReport {
         iterations,
         relative_residual: true_residual,

@@ -19,6 +19,7 @@ pub mod linear;
 pub mod maxwell;
 pub mod mesh_spec;
 pub mod metric;
+pub mod multigrid;
 pub mod output;
 pub mod refinement;
 pub mod run;

@@ -342,12 +342,14 @@ pub fn refine_and_solve(
         cold_problem.iterative = Some(Iterative {
             options,
             initial: None,
+            ..Iterative::default()
         });
         let cold = cold_problem.solve(&fine).map_err(solve_error)?;
         let mut warm_problem = problem.clone();
         warm_problem.iterative = Some(Iterative {
             options,
             initial: Some(guess),
+            ..Iterative::default()
         });
         let warm = warm_problem.solve(&fine).map_err(solve_error)?;
         let mut r = report(step, &fine, case, &warm, started.elapsed().as_secs_f64());

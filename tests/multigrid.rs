@@ -1,0 +1,315 @@
+//! Multigrid-preconditioned conjugate gradients: agreement with the direct
+//! solve, iteration counts that do not grow with the mesh, the algebraic
+//! fallback on unstructured meshes, SPLIT hierarchies, bit-identical
+//! results for any thread count, and reported failures.
+//!
+//! The large scaling runs (3D 32³ → 128³, 2D 64² → 1024²) are `#[ignore]`d;
+//! `scripts/multigrid-scaling` runs them in release mode and prints the
+//! counts.
+
+use hasse_complex::generate::{box3, delaunay, kuhn, rectangle, uniform_axis};
+use hasse_complex::refine::uniform;
+use hasse_complex::split::Refinement;
+use hasse_complex::Complex;
+use hasse_solver::diffusion::{
+    solve_with_fixed, BoundaryKind, Conductivity, Diffusion, DiffusionError, Iterative, Method,
+    Preconditioning,
+};
+use hasse_solver::iterative::{CgError, CgOptions};
+use hasse_solver::linear::Factorization;
+use hasse_solver::multigrid::{Hierarchy, MultigridError, MultigridOptions};
+use std::sync::Arc;
+
+/// −Δu = f on the unit square/cube with u = 0 on the boundary; f is smooth
+/// and not an eigenfunction, so every level of the hierarchy has work.
+fn poisson(method: Method) -> Diffusion {
+    Diffusion::new(
+        method,
+        Conductivity::Scalar(Arc::new(|_| 1.0)),
+        Arc::new(|x: &[f64]| x.iter().map(|v| (3.0 * v).sin() + v * v).sum()),
+    )
+    .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+}
+
+fn multigrid(hierarchy: Hierarchy, tolerance: f64, max_iterations: usize) -> Iterative {
+    Iterative {
+        options: CgOptions {
+            tolerance,
+            max_iterations,
+        },
+        initial: None,
+        preconditioner: Preconditioning::Multigrid {
+            hierarchy,
+            // A small coarsest level so that even 16³ has three levels and
+            // the counts test the cycle, not the direct solve.
+            options: MultigridOptions {
+                coarse_size: 200,
+                ..Default::default()
+            },
+        },
+    }
+}
+
+fn cube(n: usize) -> Complex {
+    box3(n, n, n, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap()
+}
+
+fn square(n: usize) -> Complex {
+    rectangle(n, n, [0.0, 1.0], [0.0, 1.0]).unwrap()
+}
+
+fn kuhn_cube(n: usize) -> Complex {
+    let x = uniform_axis(n, 0.0, 1.0).unwrap();
+    kuhn(&[x.clone(), x.clone(), x]).unwrap()
+}
+
+/// MG-CG iterations to relative residual 1e-8 on `mesh`.
+fn count(mesh: &Complex, method: Method, hierarchy: Hierarchy) -> usize {
+    let mut problem = poisson(method);
+    problem.iterative = Some(multigrid(hierarchy, 1e-8, 200));
+    let solution = problem.solve(mesh).unwrap();
+    let report = solution.iterations.unwrap();
+    assert!(report.relative_residual <= 1e-8, "{report:?}");
+    report.iterations
+}
+
+/// Counts on a sequence of grids (n cells per axis), printed for the record.
+fn grid_counts(
+    label: &str,
+    sizes: &[usize],
+    method: Method,
+    mesh: impl Fn(usize) -> Complex,
+) -> Vec<usize> {
+    let dim = mesh(2).dim();
+    let counts: Vec<usize> = sizes
+        .iter()
+        .map(|&n| {
+            count(
+                &mesh(n),
+                method,
+                Hierarchy::Grid {
+                    cells: vec![n; dim],
+                },
+            )
+        })
+        .collect();
+    println!("{label}: sizes {sizes:?} iterations {counts:?}");
+    counts
+}
+
+/// Iteration counts within ±2 of their midrange: what "independent of the
+/// mesh size" means for a fixed tolerance (the initial residual and the
+/// discrete spectrum still change a little with h).
+fn assert_mesh_independent(counts: &[usize]) {
+    let (min, max) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
+    assert!(max - min <= 4, "counts {counts:?} vary by more than ±2");
+}
+
+/// ‖x − y‖₂ / ‖y‖₂.
+fn relative_difference(x: &[f64], y: &[f64]) -> f64 {
+    let d: f64 = x.iter().zip(y).map(|(a, b)| (a - b) * (a - b)).sum();
+    let n: f64 = y.iter().map(|b| b * b).sum();
+    (d / n).sqrt()
+}
+
+/// The MG-CG solution and the direct one on the same mesh: with relative
+/// residual ≤ 1e-8 the relative error is at most κ(M)·1e-8, and κ of the
+/// Dirichlet Laplacian on these grids is ≈ 4/(π² h²) ≤ 500 (h ≥ 1/32), so
+/// 1e-5 bounds it with margin (the observed difference is far smaller).
+fn assert_matches_direct(mesh: &Complex, method: Method, hierarchy: Hierarchy) {
+    let direct = poisson(method).solve(mesh).unwrap();
+    let mut problem = poisson(method);
+    problem.iterative = Some(multigrid(hierarchy, 1e-8, 100));
+    let iterative = problem.solve(mesh).unwrap();
+    assert!(iterative.report.relative_residual <= 1e-8);
+    let difference = relative_difference(&iterative.values, &direct.values);
+    assert!(difference <= 1e-5, "MG-CG vs direct: {difference:e}");
+}
+
+#[test]
+fn fv_3d_poisson_matches_direct_and_counts_do_not_grow() {
+    assert_matches_direct(
+        &cube(32),
+        Method::Fv,
+        Hierarchy::Grid { cells: vec![32; 3] },
+    );
+    let counts = grid_counts("3D FV", &[16, 32, 64], Method::Fv, cube);
+    assert_mesh_independent(&counts);
+    // Jacobi-CG needs O(1/h) iterations: ~100 at 32³. Ten times fewer is
+    // what multigrid is for.
+    assert!(counts.iter().all(|&c| c <= 12), "{counts:?}");
+}
+
+#[test]
+fn fe_3d_poisson_matches_direct_and_counts_do_not_grow() {
+    // Q1 hexes (Galerkin of trilinear P is the rediscretised Q1 operator)
+    // and P1 on Kuhn tetrahedra (trilinear P as a non-nested transfer).
+    assert_matches_direct(
+        &cube(16),
+        Method::Fe,
+        Hierarchy::Grid { cells: vec![16; 3] },
+    );
+    assert_matches_direct(
+        &kuhn_cube(16),
+        Method::Fe,
+        Hierarchy::Grid { cells: vec![16; 3] },
+    );
+    let counts = grid_counts("3D FE P1 (Kuhn)", &[8, 16, 32], Method::Fe, kuhn_cube);
+    assert_mesh_independent(&counts);
+    assert!(counts.iter().all(|&c| c <= 12), "{counts:?}");
+}
+
+#[test]
+fn poisson_2d_counts_do_not_grow() {
+    for method in [Method::Fv, Method::Fe] {
+        let counts = grid_counts(
+            &format!("2D {}", method.name()),
+            &[64, 128, 256],
+            method,
+            square,
+        );
+        assert_mesh_independent(&counts);
+        assert!(counts.iter().all(|&c| c <= 12), "{counts:?}");
+    }
+}
+
+#[test]
+#[ignore = "3D up to 128³ and 2D up to 1024²: run in release by scripts/multigrid-scaling"]
+fn large_grid_counts_do_not_grow() {
+    let fv3 = grid_counts("3D FV", &[32, 64, 128], Method::Fv, cube);
+    let fe3 = grid_counts("3D FE Q1", &[32, 64, 128], Method::Fe, cube);
+    let fv2 = grid_counts("2D FV", &[64, 128, 256, 512, 1024], Method::Fv, square);
+    let fe2 = grid_counts("2D FE Q1", &[64, 128, 256, 512, 1024], Method::Fe, square);
+    for counts in [fv3, fe3, fv2, fe2] {
+        assert_mesh_independent(&counts);
+    }
+}
+
+/// A Delaunay triangulation of the unit square: its corners and `m`
+/// equally spaced points on each side, plus `inner` points from a fixed
+/// linear congruential sequence (reproducible, no dependency).
+fn unstructured(inner: usize, m: usize) -> Complex {
+    let mut points = Vec::with_capacity(inner + 4 * m + 4);
+    for k in 0..=m {
+        let t = k as f64 / (m + 1) as f64;
+        points.extend([[t, 0.0], [1.0, t], [1.0 - t, 1.0], [0.0, 1.0 - t]]);
+    }
+    let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        // Keep the interior points a little away from the sides.
+        0.005 + 0.99 * ((state >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    for _ in 0..inner {
+        points.push([next(), next()]);
+    }
+    delaunay(&points).unwrap()
+}
+
+#[test]
+fn amg_on_an_unstructured_triangulation_has_bounded_counts() {
+    let mut counts = Vec::new();
+    for (inner, m) in [(2_000, 45), (8_000, 90), (32_000, 180)] {
+        let mesh = unstructured(inner, m);
+        let direct = poisson(Method::Fe).solve(&mesh).unwrap();
+        let mut problem = poisson(Method::Fe);
+        problem.iterative = Some(multigrid(Hierarchy::Algebraic, 1e-8, 200));
+        let solution = problem.solve(&mesh).unwrap();
+        let report = solution.iterations.unwrap();
+        assert!(report.relative_residual <= 1e-8);
+        // κ of P1 stiffness on a quasi-uniform mesh with h ≈ 1/180 is
+        // about 10⁴, so relative residual 1e-8 bounds the error by 1e-4;
+        // the test keeps that bound (observed: far below).
+        let difference = relative_difference(&solution.values, &direct.values);
+        assert!(difference <= 1e-4, "{difference:e}");
+        counts.push(report.iterations);
+    }
+    println!("AMG on Delaunay P1: iterations {counts:?}");
+    assert_mesh_independent(&counts);
+    assert!(counts.iter().all(|&c| c <= 20), "{counts:?}");
+}
+
+#[test]
+fn split_refinements_give_the_hierarchy() {
+    // 4×4 squares refined uniformly three times by SPLIT: 32×32 cells whose
+    // numbering is SPLIT's, not the generator's.
+    let mut mesh = square(4);
+    let mut refinements: Vec<Refinement> = Vec::new();
+    for _ in 0..3 {
+        let (fine, r) = uniform(&mesh).unwrap();
+        refinements.push(r);
+        mesh = fine;
+    }
+    let list: Arc<[Refinement]> = refinements.into();
+    for method in [Method::Fv, Method::Fe] {
+        assert_matches_direct(&mesh, method, Hierarchy::Refinements(list.clone()));
+        let n = count(&mesh, method, Hierarchy::Refinements(list.clone()));
+        assert!(n <= 10, "{}: {n} iterations", method.name());
+    }
+}
+
+#[test]
+fn bits_do_not_depend_on_the_thread_count() {
+    let mesh = cube(32);
+    for (method, hierarchy) in [
+        (Method::Fv, Hierarchy::Grid { cells: vec![32; 3] }),
+        (Method::Fe, Hierarchy::Algebraic),
+    ] {
+        let system = poisson(method).assemble(&mesh).unwrap();
+        let settings = multigrid(hierarchy, 1e-10, 100);
+        let solve = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                solve_with_fixed(
+                    &system.matrix,
+                    &system.rhs,
+                    &system.fixed,
+                    Factorization::Llt,
+                    Some(&settings),
+                )
+                .unwrap()
+            })
+        };
+        let (one, _, report_one) = solve(1);
+        let (two, _, report_two) = solve(2);
+        assert_eq!(
+            report_one.unwrap().iterations,
+            report_two.unwrap().iterations
+        );
+        assert!(one
+            .iter()
+            .zip(&two)
+            .all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+}
+
+#[test]
+fn failures_are_reported() {
+    let mesh = cube(8);
+    // Too few iterations: the error carries the count and the residual.
+    let mut problem = poisson(Method::Fv);
+    problem.iterative = Some(multigrid(Hierarchy::Grid { cells: vec![8; 3] }, 1e-14, 1));
+    match problem.solve(&mesh) {
+        Err(DiffusionError::Multigrid(MultigridError::Cg(CgError::NotConverged {
+            iterations,
+            relative_residual,
+            ..
+        }))) => {
+            assert_eq!(iterations, 1);
+            assert!(relative_residual > 1e-14 && relative_residual < 1.0);
+        }
+        other => panic!("{:?}", other.map(|s| s.iterations)),
+    }
+    // A grid hierarchy that is not this mesh's.
+    let mut problem = poisson(Method::Fv);
+    problem.iterative = Some(multigrid(Hierarchy::Grid { cells: vec![16; 3] }, 1e-8, 50));
+    assert!(matches!(
+        problem.solve(&mesh),
+        Err(DiffusionError::Multigrid(MultigridError::Mismatch { .. }))
+    ));
+}
