@@ -3,7 +3,8 @@
 //! fallback on unstructured meshes, SPLIT hierarchies, bit-identical
 //! results for any thread count, and reported failures.
 //!
-//! The large scaling runs (3D 32³ → 128³, 2D 64² → 1024²) are `#[ignore]`d;
+//! The large scaling runs (3D FV 32³ → 128³, FE 16³ → 64³, 2D 64² → 1024²)
+//! are `#[ignore]`d;
 //! `scripts/multigrid-scaling` runs them in release mode and prints the
 //! counts.
 
@@ -177,7 +178,10 @@ fn poisson_2d_counts_do_not_grow() {
 #[ignore = "3D up to 128³ and 2D up to 1024²: run in release by scripts/multigrid-scaling"]
 fn large_grid_counts_do_not_grow() {
     let fv3 = grid_counts("3D FV", &[32, 64, 128], Method::Fv, cube);
-    let fe3 = grid_counts("3D FE Q1", &[32, 64, 128], Method::Fe, cube);
+    // Q1 at 128³ does not fit: its Ω holds a dense 12×12 block per hex
+    // (2.1M of them) next to the complex, and the process was killed for
+    // memory on a 23 GB machine; 64³ still shows the trend.
+    let fe3 = grid_counts("3D FE Q1", &[16, 32, 64], Method::Fe, cube);
     let fv2 = grid_counts("2D FV", &[64, 128, 256, 512, 1024], Method::Fv, square);
     let fe2 = grid_counts("2D FE Q1", &[64, 128, 256, 512, 1024], Method::Fe, square);
     for counts in [fv3, fe3, fv2, fe2] {
