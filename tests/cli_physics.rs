@@ -487,6 +487,28 @@ fn coupled_reaction_converges_and_the_coupling_matters() {
     assert!(uncoupled > 100.0 * u[2], "{uncoupled} vs {}", u[2]);
 }
 
+// ---------------------------------------------------------------- solver types
+
+/// `solver.type = "multigrid" | "amg"` solve the box-3d case to 1e-8 with
+/// a bounded number of CG iterations and the direct solve's error.
+#[test]
+fn multigrid_solver_types_match_the_direct_solution() {
+    let direct = reported(&run("cases/box-3d.toml", &[]), "error", "L2");
+    for kind in ["multigrid", "amg"] {
+        let out = run("cases/box-3d.toml", &[format!("solver.type=\"{kind}\"")]);
+        let l2 = reported(&out, "error", "L2");
+        // A relative residual of 1e-8 moves the discrete solution by far
+        // less than the printed 7 digits of a 2e-3 error.
+        assert!(
+            (l2 - direct).abs() <= 1e-6 * direct,
+            "{kind}: {l2} vs {direct}"
+        );
+        let iterations = reported(&out, "iterative", "):");
+        assert!((1.0..=15.0).contains(&iterations), "{kind}: {out}");
+        assert!(!out.contains("warning"), "{kind}: {out}");
+    }
+}
+
 // ---------------------------------------------------------------- bad input
 
 /// Write `text` as a case, run it, expect exit code `code` and every
@@ -643,6 +665,18 @@ fn bad_problem_kind_input_names_the_key() {
         &pair.replacen("tag = \"boundary\"", "tag = \"bondary\"", 1),
         2,
         &["`field[0].boundary[0].tag`", "did you mean `boundary`"],
+    );
+    refused(
+        "multigrid-unstructured",
+        "[mesh]\ngenerator = \"voronoi\"\nn = [30]\n[problem]\nmethod = \"fe\"\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n[solver]\ntype = \"multigrid\"\n",
+        2,
+        &["grid levels", "use \"amg\""],
+    );
+    refused(
+        "multigrid-heat",
+        &format!("{HEAT}\n[solver]\ntype = \"amg\"\n"),
+        2,
+        &["`solver.type`", "diffusion problems"],
     );
     refused(
         "wrong-key",

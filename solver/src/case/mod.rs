@@ -318,9 +318,27 @@ pub struct ExactSpec {
     pub displacement: Option<Vec<Expression>>,
 }
 
+/// Which linear solver a diffusion case uses (`solver.type`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SolverKind {
+    /// Sparse direct factorisation (faer).
+    #[default]
+    Direct,
+    /// CG preconditioned by a geometric multigrid V-cycle on the
+    /// generator's grid levels.
+    Multigrid,
+    /// CG preconditioned by smoothed-aggregation algebraic multigrid.
+    Amg,
+    /// [`crate::multigrid::automatic`] decides.
+    Auto,
+}
+
 /// Linear solver settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolverSpec {
+    pub kind: SolverKind,
+    /// Relative residual the multigrid-preconditioned CG stops at.
+    pub tolerance: f64,
     pub factorization: Option<Factorization>,
     /// A relative residual above this is reported as a warning.
     pub residual_warning: f64,
@@ -331,6 +349,8 @@ pub struct SolverSpec {
 impl Default for SolverSpec {
     fn default() -> Self {
         Self {
+            kind: SolverKind::Direct,
+            tolerance: 1e-8,
             factorization: None,
             residual_warning: 1e-10,
             residual_limit: 1e-6,

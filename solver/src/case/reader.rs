@@ -6,7 +6,7 @@ use super::diagnostic::{Collector, Diagnostics};
 use super::expr::{closest, ExprError, Expression, Scope};
 use super::{
     BoundaryKindSpec, BoundarySpec, Case, Coefficient, DiffusionSpec, ExactSpec, GradientMetric,
-    GradientSpec, OutputSpec, Problem, SolverSpec,
+    GradientSpec, OutputSpec, Problem, SolverKind, SolverSpec,
 };
 use crate::diffusion::Method;
 use crate::linear::Factorization;
@@ -98,6 +98,7 @@ const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha", "component"];
 const EXACT_KEYS: &[&str] = &["solution", "gradient", "eigenvalues", "displacement"];
 const SOLVER_KEYS: &[&str] = &[
     "type",
+    "tolerance",
     "factorization",
     "residual_warning",
     "residual_limit",
@@ -1163,13 +1164,44 @@ impl Reader {
         };
         self.check_keys(table, "solver", SOLVER_KEYS);
         if let Some(kind) = self.string_at(table, "solver", "type") {
-            if kind != "direct" {
+            spec.kind = match kind.as_str() {
+                "direct" => SolverKind::Direct,
+                "multigrid" => SolverKind::Multigrid,
+                "amg" => SolverKind::Amg,
+                "auto" => SolverKind::Auto,
+                other => {
+                    let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                    self.error(
+                        span,
+                        "solver.type",
+                        format!("unknown solver type \"{other}\""),
+                        Some("\"direct\" (faer LLᵀ/LDLᵀ/LU), \"multigrid\" (CG with a V-cycle on the generator's grid levels), \"amg\" (CG with smoothed aggregation, any mesh) or \"auto\"".into()),
+                    );
+                    SolverKind::Direct
+                }
+            };
+            if spec.kind != SolverKind::Direct && problem_kind(root) != "diffusion" {
                 let span = self.entry(table, "solver", "type").and_then(|e| e.span());
                 self.error(
                     span,
                     "solver.type",
-                    format!("unknown solver type \"{kind}\""),
-                    Some("\"direct\" (sparse Cholesky/LDLᵀ/LU from faer) is available".into()),
+                    format!("the iterative solvers serve diffusion problems; this case is kind = \"{}\"", problem_kind(root)),
+                    Some("remove solver.type (direct)".into()),
+                );
+            }
+        }
+        if let Some(t) = self.number_at(table, "solver", "tolerance") {
+            if t > 0.0 && t < 1.0 {
+                spec.tolerance = t;
+            } else {
+                let span = self
+                    .entry(table, "solver", "tolerance")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "solver.tolerance",
+                    format!("a relative residual in (0, 1), found {t}"),
+                    None,
                 );
             }
         }
