@@ -28,6 +28,10 @@ use hasse_solver::linear::Factorization;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+#[path = "common/orders.rs"]
+mod orders;
+use orders::order;
+
 fn exact_u(x: &[f64]) -> f64 {
     (PI * x[0]).sin() * (PI * x[1]).sin()
 }
@@ -118,16 +122,6 @@ fn errors(mesh: &Complex, method: Method, solution: &CoupledSolution) -> [f64; 2
         }
         (e2 / u2).sqrt()
     })
-}
-
-fn order(h: &[f64], e: &[f64]) -> f64 {
-    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
-    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
-    let m = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
 }
 
 fn squares(n: usize) -> Complex {

@@ -16,16 +16,9 @@ use hasse_solver::linear::Factorization;
 use hasse_solver::metric::{isotropic, MetricError, Tensor};
 use std::f64::consts::PI;
 
-/// Least-squares slope of log e against log h.
-fn order(h: &[f64], e: &[f64]) -> f64 {
-    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
-    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
-    let m = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
-}
+#[path = "common/orders.rs"]
+mod orders;
+use orders::order;
 
 /// A manufactured problem: exact pressure, exact velocity u = −K∇p, scalar
 /// K(x) and f = ∇·u, all written out by hand.

@@ -15,23 +15,16 @@ use hasse_solver::diffusion::{
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+#[path = "common/orders.rs"]
+mod orders;
+use orders::order;
+
 fn scalar(f: impl Fn(&[f64]) -> f64 + Send + Sync + 'static) -> ScalarFn {
     Arc::new(f)
 }
 
 fn vector(f: impl Fn(&[f64]) -> [f64; 3] + Send + Sync + 'static) -> VectorFn {
     Arc::new(f)
-}
-
-/// Least-squares slope of log e against log h.
-fn order(h: &[f64], e: &[f64]) -> f64 {
-    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
-    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
-    let m = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
 }
 
 /// u = sin(πx) sin(πy) + xy on the unit square; −Δu = 2π² sin sin.

@@ -26,6 +26,10 @@ use nalgebra::DMatrix;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+#[path = "common/orders.rs"]
+mod orders;
+use orders::order;
+
 const LAMBDA: f64 = 2.0;
 const MU: f64 = 1.0;
 
@@ -38,17 +42,6 @@ fn lame(lambda: f64, mu: f64) -> Material {
 
 fn no_force() -> VectorFn {
     Arc::new(|_| [0.0; 3])
-}
-
-/// Least-squares slope of log e against log h.
-fn order(h: &[f64], e: &[f64]) -> f64 {
-    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
-    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
-    let m = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
 }
 
 /// Displacement gradient G_ab = ∂u_a/∂x_b of an exact field.

@@ -429,6 +429,24 @@ fn check_residual(case: &Case, residual: f64, warnings: &mut Vec<String>) -> Res
     Ok(())
 }
 
+/// u − u_exact, its discrete L² norm with the given weights (lumped vertex
+/// volumes or cell measures) and its largest absolute value.
+pub(crate) fn weighted_errors(
+    values: &[f64],
+    exact: &[f64],
+    weights: &[f64],
+) -> (Vec<f64>, f64, f64) {
+    let difference: Vec<f64> = values.iter().zip(exact).map(|(a, b)| a - b).collect();
+    let l2 = difference
+        .iter()
+        .zip(weights)
+        .map(|(e, w)| e * e * w)
+        .sum::<f64>()
+        .sqrt();
+    let max = difference.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    (difference, l2, max)
+}
+
 /// Where the values of a `dim`-cochain are sampled: vertices or centroids.
 pub(crate) fn field_points(complex: &Complex, dim: usize) -> Vec<Vec<f64>> {
     let d = complex.embedding_dim();

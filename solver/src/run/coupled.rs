@@ -66,18 +66,7 @@ pub(super) fn solve(
         });
         if let Some(exact) = &field.exact {
             let exact_values: Vec<f64> = points.iter().map(|x| exact.eval(x, 0.0)).collect();
-            let difference: Vec<f64> = values
-                .iter()
-                .zip(&exact_values)
-                .map(|(a, b)| a - b)
-                .collect();
-            let l2 = difference
-                .iter()
-                .zip(&weights)
-                .map(|(e, w)| e * e * w)
-                .sum::<f64>()
-                .sqrt();
-            let max = difference.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+            let (difference, l2, max) = super::weighted_errors(values, &exact_values, &weights);
             notes.push((
                 format!("error {}", field.name),
                 format!("L2 {l2:.6e}, max {max:.6e}"),

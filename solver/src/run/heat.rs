@@ -127,14 +127,7 @@ pub(super) fn solve(
         }];
         if let Some(solution) = exact {
             let exact_values: Vec<f64> = points.iter().map(|x| solution.eval(x, t)).collect();
-            let difference: Vec<f64> = u.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
-            let l2 = difference
-                .iter()
-                .zip(&weights)
-                .map(|(e, w)| e * e * w)
-                .sum::<f64>()
-                .sqrt();
-            let max = difference.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+            let (difference, l2, max) = super::weighted_errors(u, &exact_values, &weights);
             level_errors.push((t, l2, max));
             fields.push(Field {
                 name: "u_exact".into(),
