@@ -4,7 +4,7 @@
 //! results for any thread count, and reported failures.
 //!
 //! The large scaling runs (3D FV 32³ → 128³, FE 16³ → 64³, 2D 64² → 1024²)
-//! are `#[ignore]`d;
+//! are ignored tests (with a reason);
 //! `scripts/multigrid-scaling` runs them in release mode and prints the
 //! counts.
 
