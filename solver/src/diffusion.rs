@@ -384,6 +384,50 @@ struct Faces {
     condition: Vec<Option<usize>>,
 }
 
+/// The index of the last tag (in `tags` order) naming each (n−1)-cell, so
+/// later conditions override earlier ones. Errors: a tag missing from the
+/// mesh, a tag of cells of another dimension, a tagged interior face.
+pub(crate) fn tagged_boundary_faces<'a>(
+    complex: &Complex,
+    tags: impl Iterator<Item = &'a str>,
+) -> Result<Vec<Option<usize>>, DiffusionError> {
+    let n = complex.dim();
+    let top = complex.boundary(n);
+    let mut condition = vec![None; complex.cell_count(n - 1)];
+    for (k, name) in tags.enumerate() {
+        let tag = complex
+            .tag(name)
+            .ok_or_else(|| DiffusionError::UnknownTag {
+                tag: name.to_string(),
+                available: {
+                    let names: Vec<&str> = complex.tags().names().collect();
+                    if names.is_empty() {
+                        "none".into()
+                    } else {
+                        names.join(", ")
+                    }
+                },
+            })?;
+        if tag.dim != n - 1 {
+            return Err(DiffusionError::TagDimension {
+                tag: name.to_string(),
+                dim: tag.dim,
+                n,
+            });
+        }
+        for &f in &tag.cells {
+            if top.outer_view(f).map_or(0, |r| r.nnz()) != 1 {
+                return Err(DiffusionError::InteriorFace {
+                    tag: name.to_string(),
+                    face: f,
+                });
+            }
+            condition[f] = Some(k);
+        }
+    }
+    Ok(condition)
+}
+
 /// Ω's diagonal entries on the rows that have one (summed over blocks).
 fn diagonal_of(metric: &BlockMetric, rows: usize) -> Vec<Option<f64>> {
     let mut diag = vec![None; rows];
@@ -518,40 +562,8 @@ impl Diffusion {
     }
 
     fn boundary_faces(&self, complex: &Complex) -> Result<Faces, DiffusionError> {
-        let n = complex.dim();
-        let top = complex.boundary(n);
-        let mut condition = vec![None; complex.cell_count(n - 1)];
-        for (k, bc) in self.boundary.iter().enumerate() {
-            let tag = complex
-                .tag(&bc.tag)
-                .ok_or_else(|| DiffusionError::UnknownTag {
-                    tag: bc.tag.clone(),
-                    available: {
-                        let names: Vec<&str> = complex.tags().names().collect();
-                        if names.is_empty() {
-                            "none".into()
-                        } else {
-                            names.join(", ")
-                        }
-                    },
-                })?;
-            if tag.dim != n - 1 {
-                return Err(DiffusionError::TagDimension {
-                    tag: bc.tag.clone(),
-                    dim: tag.dim,
-                    n,
-                });
-            }
-            for &f in &tag.cells {
-                if top.outer_view(f).map_or(0, |r| r.nnz()) != 1 {
-                    return Err(DiffusionError::InteriorFace {
-                        tag: bc.tag.clone(),
-                        face: f,
-                    });
-                }
-                condition[f] = Some(k);
-            }
-        }
+        let condition =
+            tagged_boundary_faces(complex, self.boundary.iter().map(|b| b.tag.as_str()))?;
         Ok(Faces { condition })
     }
 

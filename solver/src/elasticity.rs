@@ -470,30 +470,23 @@ impl Elasticity {
         complex: &Complex,
         d: usize,
     ) -> Result<Vec<Option<usize>>, ElasticityError> {
-        let n = complex.dim();
-        let top = complex.boundary(n);
-        let mut condition = vec![None; complex.cell_count(n - 1)];
-        for (k, (name, kind)) in self.boundary.iter().enumerate() {
-            let tag = complex
-                .tag(name)
-                .ok_or_else(|| ElasticityError::UnknownTag {
-                    tag: name.clone(),
-                    available: {
-                        let names: Vec<&str> = complex.tags().names().collect();
-                        if names.is_empty() {
-                            "none".into()
-                        } else {
-                            names.join(", ")
-                        }
-                    },
-                })?;
-            if tag.dim != n - 1 {
-                return Err(ElasticityError::TagDimension {
-                    tag: name.clone(),
-                    dim: tag.dim,
-                    n,
-                });
+        let condition = diffusion::tagged_boundary_faces(
+            complex,
+            self.boundary.iter().map(|(name, _)| name.as_str()),
+        )
+        .map_err(|e| match e {
+            DiffusionError::UnknownTag { tag, available } => {
+                ElasticityError::UnknownTag { tag, available }
             }
+            DiffusionError::TagDimension { tag, dim, n } => {
+                ElasticityError::TagDimension { tag, dim, n }
+            }
+            DiffusionError::InteriorFace { tag, face } => {
+                ElasticityError::InteriorFace { tag, face }
+            }
+            other => ElasticityError::Diffusion(other),
+        })?;
+        for (name, kind) in &self.boundary {
             if let ElasticBoundary::Component { component, .. } = kind {
                 if *component >= d {
                     return Err(ElasticityError::Component {
@@ -502,15 +495,6 @@ impl Elasticity {
                         d,
                     });
                 }
-            }
-            for &f in &tag.cells {
-                if top.outer_view(f).map_or(0, |r| r.nnz()) != 1 {
-                    return Err(ElasticityError::InteriorFace {
-                        tag: name.clone(),
-                        face: f,
-                    });
-                }
-                condition[f] = Some(k);
             }
         }
         Ok(condition)
