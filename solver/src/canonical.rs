@@ -7,10 +7,11 @@
 //! cell's edges, a user-given sparse Ω one 1×1 block per entry.
 //!
 //! Assembly is split like a sparse factorisation: the sparsity pattern of
-//! M and a scatter map from every block entry to its place in M are built
-//! once ([`Canonical::new`]); numeric assembly ([`Canonical::assemble`]) is
-//! then one pass over the block values, and can be repeated with new values
-//! of the same pattern ([`Canonical::set_metric`]).
+//! M and a scatter map from every entry of each block's local matrix
+//! A_{R_b}ᵀ W_b A_{S_b} to its place in M are built once
+//! ([`Canonical::new`]); numeric assembly ([`Canonical::assemble`]) is then
+//! one pass over the blocks, and can be repeated with new values of the
+//! same pattern ([`Canonical::set_metric`]).
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
@@ -112,6 +113,11 @@ impl BlockMetric {
     /// Add a square block over the same rows and columns.
     pub fn push_symmetric(&mut self, rows: &[usize], values: &[f64]) {
         self.push_block(rows, rows, values);
+    }
+
+    /// Append `count` rows (and columns) with no blocks yet.
+    pub fn add_rows(&mut self, count: usize) {
+        self.size += count;
     }
 
     /// Number of rows (and columns) of Ω.
@@ -232,9 +238,196 @@ pub struct Canonical {
     incidence: CsMat<i8>,
     metric: BlockMetric,
     symbolic: SymbolicSparseColMat<usize>,
-    /// Per block, the target positions in M's value array of every
-    /// (row pair, incidence pair) product, in the order `assemble` visits them.
+    /// Where each block's local matrix goes in M.
+    local: LocalPattern,
+}
+
+/// Block b of Ω touches only the unknowns in the columns of A's rows R_b
+/// (its row side) and S_b (its column side); its contribution
+/// A_{R_b}ᵀ W_b A_{S_b} is a dense matrix over those two sets. Assembly
+/// forms that small matrix and adds each of its entries once, so a dense
+/// element block (a Q1 hexahedron: 12 edge rows, 8 vertices) costs 64
+/// scatter entries, not the 576 products of every row pair with every
+/// incidence pair.
+#[derive(Clone, Debug)]
+struct LocalPattern {
+    /// Block b's row-side unknowns are `unknowns[ptr[b]..ptr[b] + rows[b]]`
+    /// and its column-side unknowns the rest up to `ptr[b + 1]`, each
+    /// sorted and distinct.
+    ptr: Vec<usize>,
+    rows: Vec<usize>,
+    unknowns: Vec<usize>,
+    /// Positions in M's value array of every local entry, block after
+    /// block, each block row-major (row side × column side).
     scatter: Vec<usize>,
+}
+
+/// `0..count` cut into a few contiguous ranges per thread, in order. Few
+/// large tasks keep the per-task buffers (a column marker of n entries, an
+/// output vector) few, since every fresh page of them costs a page fault;
+/// the results are concatenated in range order, so they do not depend on
+/// the thread count.
+fn ranges(count: usize) -> Vec<std::ops::Range<usize>> {
+    let parts = (4 * rayon::current_num_threads()).clamp(1, count.max(1));
+    let size = count.div_ceil(parts).max(1);
+    (0..count)
+        .step_by(size)
+        .map(|first| first..(first + size).min(count))
+        .collect()
+}
+
+impl LocalPattern {
+    /// The local unknown sets of every block, in block order.
+    fn new(incidence: &CsMat<i8>, metric: &BlockMetric) -> Self {
+        let row = |r: usize| &incidence.indices()[incidence.indptr().outer_inds_sz(r)];
+        let chunks: Vec<(Vec<usize>, Vec<usize>, Vec<usize>)> = ranges(metric.block_count())
+            .into_par_iter()
+            .map(|range| {
+                let (first, last) = (range.start, range.end);
+                let mut rows = Vec::with_capacity(last - first);
+                let mut lengths = Vec::with_capacity(last - first);
+                let mut unknowns = Vec::new();
+                for b in first..last {
+                    let (r, s, _) = metric.block(b);
+                    let start = unknowns.len();
+                    for (k, side) in [r, s].into_iter().enumerate() {
+                        let begin = unknowns.len();
+                        for &x in side {
+                            unknowns.extend_from_slice(row(x));
+                        }
+                        unknowns[begin..].sort_unstable();
+                        let distinct = dedup_tail(&mut unknowns, begin);
+                        if k == 0 {
+                            rows.push(distinct);
+                        }
+                    }
+                    lengths.push(unknowns.len() - start);
+                }
+                (rows, lengths, unknowns)
+            })
+            .collect();
+        let mut pattern = Self {
+            ptr: Vec::with_capacity(metric.block_count() + 1),
+            rows: Vec::with_capacity(metric.block_count()),
+            unknowns: Vec::with_capacity(chunks.iter().map(|c| c.2.len()).sum()),
+            scatter: Vec::new(),
+        };
+        pattern.ptr.push(0);
+        for (rows, lengths, unknowns) in chunks {
+            pattern.rows.extend_from_slice(&rows);
+            for l in lengths {
+                let end = pattern.ptr[pattern.ptr.len() - 1] + l;
+                pattern.ptr.push(end);
+            }
+            pattern.unknowns.extend_from_slice(&unknowns);
+        }
+        pattern
+    }
+
+    fn block_count(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// Row-side and column-side unknowns of block b.
+    fn sides(&self, b: usize) -> (&[usize], &[usize]) {
+        let start = self.ptr[b];
+        let middle = start + self.rows[b];
+        (
+            &self.unknowns[start..middle],
+            &self.unknowns[middle..self.ptr[b + 1]],
+        )
+    }
+
+    /// The sparsity pattern of M: column j holds every row-side unknown of
+    /// every block with j on its column side. Returns (column pointers,
+    /// row indices), rows sorted within each column.
+    fn matrix_pattern(&self, n: usize) -> (Vec<usize>, Vec<usize>) {
+        // Blocks by column-side unknown, in block order.
+        let mut block_ptr = vec![0usize; n + 1];
+        for b in 0..self.block_count() {
+            for &j in self.sides(b).1 {
+                block_ptr[j + 1] += 1;
+            }
+        }
+        for j in 0..n {
+            block_ptr[j + 1] += block_ptr[j];
+        }
+        let mut blocks_of = vec![0usize; block_ptr[n]];
+        let mut next = block_ptr.clone();
+        for b in 0..self.block_count() {
+            for &j in self.sides(b).1 {
+                blocks_of[next[j]] = b;
+                next[j] += 1;
+            }
+        }
+        drop(next);
+        // A column's candidates are few (a vertex's cells times their
+        // vertices), so sorting them beats an n-sized marker per task.
+        let parts: Vec<(Vec<usize>, Vec<usize>)> = ranges(n)
+            .into_par_iter()
+            .map(|range| {
+                let mut counts = Vec::with_capacity(range.len());
+                let mut rows = Vec::new();
+                for j in range {
+                    let begin = rows.len();
+                    for &b in &blocks_of[block_ptr[j]..block_ptr[j + 1]] {
+                        rows.extend_from_slice(self.sides(b).0);
+                    }
+                    rows[begin..].sort_unstable();
+                    counts.push(dedup_tail(&mut rows, begin));
+                }
+                (counts, rows)
+            })
+            .collect();
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0);
+        let mut row_idx = Vec::with_capacity(parts.iter().map(|p| p.1.len()).sum());
+        for (counts, rows) in parts {
+            for c in counts {
+                col_ptr.push(col_ptr[col_ptr.len() - 1] + c);
+            }
+            row_idx.extend_from_slice(&rows);
+        }
+        (col_ptr, row_idx)
+    }
+
+    /// Fill `scatter` for the pattern (col_ptr, row_idx).
+    fn locate(&mut self, col_ptr: &[usize], row_idx: &[usize]) {
+        let this = &*self;
+        let chunks: Vec<Vec<usize>> = ranges(this.block_count())
+            .into_par_iter()
+            .map(|range| {
+                let (first, last) = (range.start, range.end);
+                let mut out = Vec::new();
+                for b in first..last {
+                    let (left, right) = this.sides(b);
+                    for &i in left {
+                        for &j in right {
+                            let column = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+                            // Present by construction of the pattern.
+                            out.push(col_ptr[j] + column.binary_search(&i).unwrap_or(0));
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        self.scatter = chunks.concat();
+    }
+}
+
+/// Remove repeated values from the sorted `v[begin..]`; returns how many
+/// distinct values remain there.
+fn dedup_tail(v: &mut Vec<usize>, begin: usize) -> usize {
+    let mut write = begin;
+    for read in begin..v.len() {
+        if write == begin || v[read] != v[write - 1] {
+            v[write] = v[read];
+            write += 1;
+        }
+    }
+    v.truncate(write);
+    write - begin
 }
 
 impl Canonical {
@@ -254,66 +447,15 @@ impl Canonical {
         }
         metric.validate()?;
         let n = incidence.cols();
-        let row =
-            |r: usize| -> &[usize] { &incidence.indices()[incidence.indptr().outer_inds_sz(r)] };
-
-        // Every (i, j) position M receives, bucketed by column j.
-        let mut pairs: Vec<(usize, usize)> = Vec::new();
-        for b in 0..metric.block_count() {
-            let (rows, cols, _) = metric.block(b);
-            for &r in rows {
-                for &s in cols {
-                    for &i in row(r) {
-                        for &j in row(s) {
-                            pairs.push((j, i));
-                        }
-                    }
-                }
-            }
-        }
-        let mut col_ptr = vec![0usize; n + 1];
-        for &(j, _) in &pairs {
-            col_ptr[j + 1] += 1;
-        }
-        for j in 0..n {
-            col_ptr[j + 1] += col_ptr[j];
-        }
-        let mut bucketed = vec![0usize; pairs.len()];
-        let mut next = col_ptr.clone();
-        for &(j, i) in &pairs {
-            bucketed[next[j]] = i;
-            next[j] += 1;
-        }
-        let columns: Vec<Vec<usize>> = (0..n)
-            .into_par_iter()
-            .map(|j| {
-                let mut c = bucketed[col_ptr[j]..col_ptr[j + 1]].to_vec();
-                c.sort_unstable();
-                c.dedup();
-                c
-            })
-            .collect();
-        let mut final_ptr = Vec::with_capacity(n + 1);
-        final_ptr.push(0);
-        let mut row_idx = Vec::with_capacity(columns.iter().map(Vec::len).sum());
-        for c in &columns {
-            row_idx.extend_from_slice(c);
-            final_ptr.push(row_idx.len());
-        }
-        let scatter: Vec<usize> = pairs
-            .par_iter()
-            .map(|&(j, i)| {
-                let col = &row_idx[final_ptr[j]..final_ptr[j + 1]];
-                // Present by construction.
-                final_ptr[j] + col.binary_search(&i).unwrap_or(0)
-            })
-            .collect();
-        let symbolic = SymbolicSparseColMat::new_checked(n, n, final_ptr, None, row_idx);
+        let mut local = LocalPattern::new(&incidence, &metric);
+        let (col_ptr, row_idx) = local.matrix_pattern(n);
+        local.locate(&col_ptr, &row_idx);
+        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         Ok(Self {
             incidence,
             metric,
             symbolic,
-            scatter,
+            local,
         })
     }
 
@@ -349,6 +491,10 @@ impl Canonical {
     }
 
     /// M = Aᵀ Ω A (full symmetric storage when Ω is symmetric).
+    ///
+    /// Each block's dense A_Rᵀ W A_S is formed first and then added to M,
+    /// block after block, so the sums (and so the bits) are the same for
+    /// any thread count.
     pub fn assemble(&self) -> SparseColMat<usize, f64> {
         let mut values = vec![0.0; self.nonzeros()];
         let a = &self.incidence;
@@ -356,22 +502,43 @@ impl Canonical {
             let range = a.indptr().outer_inds_sz(r);
             (&a.indices()[range.clone()], &a.data()[range])
         };
+        let local = &self.local;
+        // W A_S (|R| × |U_S|) and then A_Rᵀ (W A_S) (|U_R| × |U_S|).
+        let mut half = Vec::new();
+        let mut dense = Vec::new();
         let mut k = 0;
         for b in 0..self.metric.block_count() {
             let (rows, cols, w) = self.metric.block(b);
-            for (ri, &r) in rows.iter().enumerate() {
-                let (_, ar) = row(r);
-                for (si, &s) in cols.iter().enumerate() {
-                    let weight = w[ri * cols.len() + si];
-                    let (_, as_) = row(s);
-                    for &x in ar {
-                        for &y in as_ {
-                            values[self.scatter[k]] += f64::from(x) * weight * f64::from(y);
-                            k += 1;
-                        }
+            let (left, right) = local.sides(b);
+            let (p, q) = (left.len(), right.len());
+            half.clear();
+            half.resize(rows.len() * q, 0.0);
+            for (si, &s) in cols.iter().enumerate() {
+                let (unknowns, signs) = row(s);
+                for (&j, &sign) in unknowns.iter().zip(signs) {
+                    let jl = position(right, j);
+                    let sign = f64::from(sign);
+                    for ri in 0..rows.len() {
+                        half[ri * q + jl] += w[ri * cols.len() + si] * sign;
                     }
                 }
             }
+            dense.clear();
+            dense.resize(p * q, 0.0);
+            for (ri, &r) in rows.iter().enumerate() {
+                let (unknowns, signs) = row(r);
+                for (&i, &sign) in unknowns.iter().zip(signs) {
+                    let il = position(left, i);
+                    let sign = f64::from(sign);
+                    for jl in 0..q {
+                        dense[il * q + jl] += sign * half[ri * q + jl];
+                    }
+                }
+            }
+            for (&place, &v) in local.scatter[k..k + p * q].iter().zip(&dense) {
+                values[place] += v;
+            }
+            k += p * q;
         }
         SparseColMat::new(self.symbolic.clone(), values)
     }
@@ -404,6 +571,11 @@ impl Canonical {
     pub fn apply(&self, u: &[f64]) -> Vec<f64> {
         self.sum_transpose(&self.flux(u))
     }
+}
+
+/// Index of `x` in the short sorted list `list` (it is there).
+fn position(list: &[usize], x: usize) -> usize {
+    list.iter().position(|&y| y == x).unwrap_or(0)
 }
 
 /// Theorem 1 of the thesis: when A has trivial kernel, any matrix M of the

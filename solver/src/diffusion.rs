@@ -32,6 +32,7 @@ use crate::multigrid::{
 use faer::sparse::SparseColMat;
 use hasse_complex::dual::DualKind;
 use hasse_complex::Complex;
+use rayon::prelude::*;
 use sprs::TriMat;
 use std::sync::Arc;
 use std::time::Instant;
@@ -541,6 +542,7 @@ impl Diffusion {
         let d = complex.embedding_dim();
         let centroids = complex.centroid(n);
         let tensors: Vec<Tensor> = (0..complex.cell_count(n))
+            .into_par_iter()
             .map(|c| {
                 let x = &centroids[c * d..(c + 1) * d];
                 match &self.conductivity {
@@ -667,19 +669,21 @@ impl Diffusion {
         }
 
         // A and Ω with the boundary changes and the ghost rows.
-        let mut metric_final = BlockMetric::new(flux_rows + ghosts.len());
-        for b in 0..metric.block_count() {
-            let (r, s, w) = metric.block(b);
+        let mut metric_final = metric;
+        let mut replaced = vec![false; flux_rows];
+        for b in 0..metric_final.block_count() {
+            let (r, s, _) = metric_final.block(b);
             if r.len() == 1 && r == s {
-                if let Some(weight) = face_weight[r[0]] {
+                let row = r[0];
+                if let Some(weight) = face_weight[row] {
                     // The row's whole diagonal is replaced once, by its first block.
-                    let first = (0..b).all(|e| metric.block(e).0 != r || metric.block(e).1 != s);
-                    metric_final.push_block(r, s, &[if first { weight } else { 0.0 }]);
-                    continue;
+                    let first = !replaced[row];
+                    replaced[row] = true;
+                    metric_final.block_values_mut(b)[0] = if first { weight } else { 0.0 };
                 }
             }
-            metric_final.push_block(r, s, w);
         }
+        metric_final.add_rows(ghosts.len());
         let mut ghost_values = face_value.clone();
         let incidence = if ghosts.is_empty() {
             incidence
@@ -739,9 +743,19 @@ impl Diffusion {
             _ => {
                 let volume = complex.measure(n);
                 let centre = complex.centroid(n);
-                for c in 0..cells {
-                    rhs[c] +=
-                        evaluate(&self.source, &centre[c * d..(c + 1) * d], "source")? * volume[c];
+                let at = |c: usize| &centre[c * d..(c + 1) * d];
+                let values: Vec<f64> = (0..cells)
+                    .into_par_iter()
+                    .map(|c| (self.source)(at(c)))
+                    .collect();
+                // The first bad cell in cell order, whatever the threads did.
+                for (c, &v) in values.iter().enumerate() {
+                    let v = if v.is_finite() {
+                        v
+                    } else {
+                        evaluate(&self.source, at(c), "source")?
+                    };
+                    rhs[c] += v * volume[c];
                 }
             }
         }

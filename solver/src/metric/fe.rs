@@ -499,11 +499,24 @@ pub(crate) fn edge_pseudo_inverse(
 ) -> Result<(Vec<usize>, DMatrix<f64>), MetricError> {
     let vertices = top.complex.cell_vertices(top.n, c);
     let edges = top.edges_of(c);
-    let mut a = DMatrix::zeros(edges.len(), vertices.len());
-    for (r, &e) in edges.iter().enumerate() {
+    // A_c is pure topology: the vertex count and each edge's local (tail,
+    // head). Cells with the same local incidence (every cell of a
+    // structured grid, up to a few orientation patterns) share A_c⁺, so it
+    // is computed once per pattern and thread.
+    let mut key = Vec::with_capacity(1 + 2 * edges.len());
+    key.push(vertices.len());
+    for &e in &edges {
         let (t, h) = top.local_ends(e, vertices, c)?;
-        a[(r, t)] = -1.0;
-        a[(r, h)] = 1.0;
+        key.extend([t, h]);
+    }
+    let cached = PSEUDO_INVERSES.with(|cache| cache.borrow().get(&key).cloned());
+    if let Some(pinv) = cached {
+        return Ok((edges, pinv));
+    }
+    let mut a = DMatrix::zeros(edges.len(), vertices.len());
+    for (r, ends) in key[1..].chunks_exact(2).enumerate() {
+        a[(r, ends[0])] = -1.0;
+        a[(r, ends[1])] = 1.0;
     }
     let pinv =
         a.pseudo_inverse(PSEUDO_INVERSE_TOLERANCE)
@@ -512,7 +525,25 @@ pub(crate) fn edge_pseudo_inverse(
                 needs: "a cell whose edge incidence has a pseudo-inverse",
                 cell: c,
             })?;
+    PSEUDO_INVERSES.with(|cache| {
+        let mut cache = cache.borrow_mut();
+        // Unstructured polytopal meshes have few repeats: bound the memory.
+        if cache.len() >= PSEUDO_INVERSE_CACHE_SIZE {
+            cache.clear();
+        }
+        cache.insert(key, pinv.clone());
+    });
     Ok((edges, pinv))
+}
+
+/// Most local incidence patterns kept per thread.
+const PSEUDO_INVERSE_CACHE_SIZE: usize = 1024;
+
+thread_local! {
+    /// A_c⁺ by local incidence pattern (vertex count, then the local tail
+    /// and head of each edge in the cell's edge order).
+    static PSEUDO_INVERSES: std::cell::RefCell<std::collections::HashMap<Vec<usize>, DMatrix<f64>>> =
+        std::cell::RefCell::new(std::collections::HashMap::new());
 }
 
 /// Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the edges of cell `c`; `kc` is indexed by
