@@ -238,8 +238,9 @@ pub struct Canonical {
     incidence: CsMat<i8>,
     metric: BlockMetric,
     symbolic: SymbolicSparseColMat<usize>,
-    /// Where each block's local matrix goes in M.
-    local: LocalPattern,
+    /// Where each block's local matrix goes in M (boxed: it is large and
+    /// `Canonical` sits in enums next to small variants).
+    local: Box<LocalPattern>,
 }
 
 /// Block b of Ω touches only the unknowns in the columns of A's rows R_b
@@ -455,7 +456,7 @@ impl Canonical {
             incidence,
             metric,
             symbolic,
-            local,
+            local: Box::new(local),
         })
     }
 
