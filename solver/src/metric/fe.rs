@@ -622,50 +622,109 @@ struct GaussPoint {
 /// Gauss points (2 per axis, weight 1 each on [−1, 1]^n) of a Q1 cell with
 /// corners `x` in tensor order.
 fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, MetricError> {
-    let g = 1.0 / 3f64.sqrt();
     let bad = MetricError::UnsupportedCell {
         method: "Q1",
         needs: "a quadrilateral or hexahedron whose isoparametric map keeps one orientation (convex, not inverted)",
         cell,
     };
+    let reference = q1_reference(n);
     let mut out = Vec::with_capacity(1 << n);
     let mut orientation = 0.0;
-    for q in 0..1usize << n {
-        let xi: Vec<f64> = (0..n).map(|a| g * corner_sign(q, a)).collect();
-        let (values, reference) = q1_shape(&xi, n);
-        let jacobian = DMatrix::<f64>::from_fn(n, n, |i, a| {
-            x.iter().zip(&reference).map(|(xl, gl)| xl[i] * gl[a]).sum()
-        });
-        let det = jacobian.determinant();
-        if det.is_nan() || det == 0.0 || det * orientation < 0.0 {
+    for (values, shape_gradients) in reference {
+        let mut jacobian = [[0.0; 3]; 3];
+        for (xl, gl) in x.iter().zip(shape_gradients) {
+            for (i, row) in jacobian.iter_mut().enumerate().take(n) {
+                for (a, entry) in row.iter_mut().enumerate().take(n) {
+                    *entry += xl[i] * gl[a];
+                }
+            }
+        }
+        let (det, inverse) = determinant_and_inverse(&jacobian, n);
+        if det.is_nan() || det == 0.0 || det * orientation < 0.0 || !det.is_finite() {
             return Err(bad);
         }
         orientation = det.signum();
-        let inverse = jacobian.try_inverse().ok_or_else(|| bad.clone())?;
-        let gradients = reference
+        // ∇φ = J⁻ᵀ ∇̂φ.
+        let gradients = shape_gradients
             .iter()
             .map(|r| {
                 let mut p = [0.0; 3];
                 for (i, pi) in p.iter_mut().enumerate().take(n) {
-                    *pi = (0..n).map(|a| inverse[(a, i)] * r[a]).sum();
+                    *pi = (0..n).map(|a| inverse[a][i] * r[a]).sum();
                 }
                 p
             })
             .collect();
         let mut point = [0.0; 3];
-        for (xl, &v) in x.iter().zip(&values) {
+        for (xl, &v) in x.iter().zip(values) {
             for i in 0..n {
                 point[i] += v * xl[i];
             }
         }
         out.push(GaussPoint {
             weight: det.abs(),
-            values,
+            values: values.clone(),
             gradients,
             point,
         });
     }
     Ok(out)
+}
+
+/// Shape values and reference gradients at the 2ⁿ Gauss points of
+/// [−1, 1]^n: the same for every cell, so computed once per dimension.
+type Q1Reference = Vec<(Vec<f64>, Vec<Point>)>;
+
+fn q1_reference(n: usize) -> &'static Q1Reference {
+    static REFERENCE: [std::sync::OnceLock<Q1Reference>; 4] = [
+        std::sync::OnceLock::new(),
+        std::sync::OnceLock::new(),
+        std::sync::OnceLock::new(),
+        std::sync::OnceLock::new(),
+    ];
+    REFERENCE[n.min(3)].get_or_init(|| {
+        let g = 1.0 / 3f64.sqrt();
+        (0..1usize << n)
+            .map(|q| {
+                let xi: Vec<f64> = (0..n).map(|a| g * corner_sign(q, a)).collect();
+                q1_shape(&xi, n)
+            })
+            .collect()
+    })
+}
+
+/// det J and J⁻¹ of the leading n×n block (n ≤ 3), by cofactors; the
+/// inverse is meaningless when det J = 0 (the caller refuses those cells).
+fn determinant_and_inverse(j: &[[f64; 3]; 3], n: usize) -> (f64, [[f64; 3]; 3]) {
+    let mut inverse = [[0.0; 3]; 3];
+    match n {
+        1 => {
+            inverse[0][0] = 1.0 / j[0][0];
+            (j[0][0], inverse)
+        }
+        2 => {
+            let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+            inverse[0][0] = j[1][1] / det;
+            inverse[0][1] = -j[0][1] / det;
+            inverse[1][0] = -j[1][0] / det;
+            inverse[1][1] = j[0][0] / det;
+            (det, inverse)
+        }
+        _ => {
+            let cofactor = |r: usize, c: usize| {
+                let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+                let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+                j[r1][c1] * j[r2][c2] - j[r1][c2] * j[r2][c1]
+            };
+            let det = (0..3).map(|c| j[0][c] * cofactor(0, c)).sum::<f64>();
+            for (r, row) in inverse.iter_mut().enumerate() {
+                for (c, entry) in row.iter_mut().enumerate() {
+                    *entry = cofactor(c, r) / det;
+                }
+            }
+            (det, inverse)
+        }
+    }
 }
 
 /// Corners of cell `c` in tensor order.
