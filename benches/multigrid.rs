@@ -352,12 +352,16 @@ fn main() {
                     failed += 1;
                     let stderr = String::from_utf8_lossy(&out.stderr);
                     eprintln!("{stderr}");
-                    // The panic message, not the backtrace hint after it.
-                    let reason = stderr
-                        .lines()
-                        .rev()
-                        .find(|l| !l.starts_with("note:") && !l.trim().is_empty())
-                        .unwrap_or("");
+                    // The panic message (the line after "panicked at"), not
+                    // the backtrace after it; an abort (out of memory) says
+                    // why on its first line.
+                    let lines: Vec<&str> = stderr.lines().collect();
+                    let reason = lines
+                        .iter()
+                        .position(|l| l.contains("panicked at"))
+                        .and_then(|i| lines.get(i + 1))
+                        .or(lines.first())
+                        .map_or("no output", |l| l.trim());
                     println!("RESULT {case} {p} failed: {reason}");
                 }
             }
@@ -402,11 +406,11 @@ impl Xorshift {
 }
 
 /// A side×side grid on the unit square with every point moved by up to
-/// ±0.35 h per coordinate: no two points come closer than 0.3 h, so the
-/// triangulation has no slivers, yet its connectivity is irregular
-/// (valences 4 to 8). Boundary points only move along their side, and the
-/// corners stay, so the hull is the square and its vertices are exactly
-/// those with a coordinate 0 or 1.
+/// ±0.35 h per coordinate: no two points come closer than 0.3 h and no
+/// disc of radius h is empty, so the Delaunay triangles are well shaped,
+/// yet the connectivity is irregular. Boundary points only move along
+/// their side and the corners stay, so the hull is the square and its
+/// vertices are exactly those with a coordinate 0 or 1.
 fn jittered_points(side: usize) -> Vec<[f64; 2]> {
     let h = 1.0 / (side - 1) as f64;
     let mut rng = Xorshift(0x9E37_79B9_7F4A_7C15);
