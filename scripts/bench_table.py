@@ -1,7 +1,9 @@
 """Turn the `RESULT case phase key=value ...` lines of benches/multigrid.rs
 and scripts/pyamg_baseline.py (stdin) into one table: hasse next to its
 baseline, with the ratio hasse / baseline (below 1: hasse is faster or
-smaller)."""
+smaller). Structured cases (phases mg, mg-pc, direct, plain) and Delaunay
+cases (phases amg, dec, direct, plain, check) get their own rows; a failed
+phase shows as — in its rows."""
 import sys
 from collections import defaultdict
 
@@ -32,9 +34,62 @@ def ratio(a, b):
     return "—" if a is None or b is None or b == 0 else f"{a / b:.2f}"
 
 
+def it(d):
+    """Iterations and final relative residual of a run, for a row label."""
+    return f"{d.get('iterations', '?')} it, r={d.get('residual', '?')}"
+
+
+def add(*parts):
+    """Sum of the parts, or None when one is missing."""
+    return None if any(p is None for p in parts) else sum(parts)
+
+
+def delaunay_rows(label, r):
+    """Nodal P1 on a Delaunay mesh (phases amg, dec, direct, plain, check and
+    pyamg): the FE assembly, DEC assembly and LLᵀ next to the hand-built
+    matrix and faer's own LLᵀ, AMG-CG next to pyamg."""
+    fe, dec, direct, plain, amg, check = (
+        r.get(p, {}) for p in ("amg", "dec", "direct", "plain", "pyamg", "check")
+    )
+    out = []
+    complex_s = num(fe, "complex") or num(direct, "complex")
+    out.append((label, f"complex: generate::delaunay ({fe.get('triangles', '?')} triangles)", fmt(complex_s), "(no baseline: spade is not a bench dependency)", "—", "—"))
+    for name, run in (("FE", fe), ("DEC", dec)):
+        out.append((label, f"{name} assembly (Ω, AᵀΩA, b)", fmt(num(run, "assembly")), "plain P1 triplets", fmt(num(plain, "assembly")), ratio(num(run, "assembly"), num(plain, "assembly"))))
+    if check:
+        agreement = f"FE {check.get('fe_vs_plain', '?')}, DEC {check.get('dec_vs_plain', '?')}, u {check.get('solution_vs_plain', '?')}"
+        out.append((label, "  max rel. difference to the plain system", agreement, f"plain P1, nnz {check.get('nnz', '?')}", "—", "—"))
+    out.append((label, "LLᵀ analysis+factorisation (FE)", fmt(num(direct, "factor")), "faer LLᵀ, plain matrix", fmt(num(plain, "factor")), ratio(num(direct, "factor"), num(plain, "factor"))))
+    out.append((label, f"LLᵀ solve (r={direct.get('residual', '?')})", fmt(num(direct, "solve")), f"faer LLᵀ (r={plain.get('residual', '?')})", fmt(num(plain, "solve")), ratio(num(direct, "solve"), num(plain, "solve"))))
+    amg_total = add(num(amg, "setup"), num(amg, "solve"))
+    for name, run in (("FE", fe), ("DEC", dec)):
+        total = add(num(run, "setup"), num(run, "solve"))
+        out.append((label, f"{name} SA-AMG setup + CG to 1e-8 ({it(run)})", fmt(total), f"pyamg SA-CG ({it(amg)})", fmt(amg_total), ratio(total, amg_total)))
+    out.append((label, "  AMG setup alone (FE)", fmt(num(fe, "setup")), "pyamg setup", fmt(num(amg, "setup")), ratio(num(fe, "setup"), num(amg, "setup"))))
+    out.append((label, "  CG iterations alone (FE)", fmt(num(fe, "solve")), "pyamg solve", fmt(num(amg, "solve")), ratio(num(fe, "solve"), num(amg, "solve"))))
+    # The solve-alone peaks are read with the complex dropped (the process
+    # holds M and b as pyamg's does); the whole-run peaks include the complex.
+    for what, key in (("AMG-CG (FE) alone", "solve_peak_gib"), ("whole FE AMG run", "peak_gib")):
+        out.append((label, f"peak memory, {what}", fmt(num(fe, key), "GiB"), "pyamg process", fmt(num(amg, "peak_gib"), "GiB"), ratio(num(fe, key), num(amg, "peak_gib"))))
+    for what, key in (("LLᵀ alone", "solve_peak_gib"), ("whole direct run", "peak_gib")):
+        out.append((label, f"peak memory, {what}", fmt(num(direct, key), "GiB"), "plain build+LLᵀ process", fmt(num(plain, "peak_gib"), "GiB"), ratio(num(direct, key), num(plain, "peak_gib"))))
+    e2e = add(complex_s, num(fe, "assembly"), num(fe, "setup"), num(fe, "solve"))
+    direct_e2e = add(num(direct, "complex"), num(direct, "assembly"), num(direct, "factor"), num(direct, "solve"))
+    out.append((label, "end to end AMG (complex+FE assembly+AMG-CG)", fmt(e2e), "hasse direct end to end", fmt(direct_e2e), ratio(e2e, direct_e2e)))
+    hasse_direct = add(num(direct, "assembly"), num(direct, "factor"), num(direct, "solve"))
+    plain_total = add(num(plain, "assembly"), num(plain, "factor"), num(plain, "solve"))
+    out.append((label, "FE assembly + LLᵀ + solve", fmt(hasse_direct), "plain build+LLᵀ+solve", fmt(plain_total), ratio(hasse_direct, plain_total)))
+    return out
+
+
 rows = []
 for case in runs:
     r = runs[case]
+    if "amg" in r or "check" in r:
+        fe, direct, plain = (r.get(p, {}) for p in ("amg", "direct", "plain"))
+        n = fe.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or "?"
+        rows += delaunay_rows(f"{case} ({n})", r)
+        continue
     mg, direct, plain, amg = (r.get(p, {}) for p in ("mg", "direct", "plain", "pyamg"))
     n = mg.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or "?"
     label = f"{case} ({n})"
@@ -65,3 +120,9 @@ print(line(head))
 print("  ".join("-" * w for w in widths))
 for r in rows:
     print(line(r))
+
+failed = [(case, phase, f["failed"]) for case in runs for phase, f in runs[case].items() if "failed" in f]
+if failed:
+    print("\nfailed phases:")
+    for case, phase, why in failed:
+        print(f"  {case} {phase} {why}")
