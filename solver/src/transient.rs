@@ -145,6 +145,20 @@ pub struct History {
     pub steps: usize,
 }
 
+/// What [`Heat::run_observed`] reports while it runs.
+#[derive(Clone, Copy, Debug)]
+pub enum HeatEvent<'a> {
+    /// Saved level `index` (0 is t₀) at `time`, with all unknowns as in
+    /// [`History::fields`]; told before the step's [`HeatEvent::Step`].
+    Level {
+        index: usize,
+        time: f64,
+        field: &'a [f64],
+    },
+    /// Step number `n` (1-based) has been taken.
+    Step(usize),
+}
+
 impl History {
     /// The saved levels as output steps, one cochain `name` each.
     pub fn steps(&self, name: &str) -> Vec<Step> {
@@ -268,6 +282,45 @@ impl Heat {
         save_every: usize,
         progress: &mut dyn FnMut(usize),
     ) -> Result<History, HeatError> {
+        self.run_observed(complex, initial, steps, save_every, &mut |event| {
+            if let HeatEvent::Step(step) = event {
+                progress(step);
+            }
+        })
+    }
+
+    /// As [`run`](Self::run), telling `observe` each saved level as soon as
+    /// it is computed and each step as it is taken, so a caller can write
+    /// levels while the run goes on (an interrupted run then keeps them).
+    /// The levels it is told are those of the returned [`History`], in
+    /// order; a failed run has told the ones completed before the failure.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::diffusion::{Conductivity, Method};
+    /// use hasse_solver::transient::{Heat, HeatEvent};
+    /// use std::sync::Arc;
+    /// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let heat = Heat::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), 0.01);
+    /// let mut seen = Vec::new();
+    /// let history = heat
+    ///     .run_observed(&mesh, &|x| x[0], 4, 2, &mut |event| {
+    ///         if let HeatEvent::Level { index, time, field } = event {
+    ///             seen.push((index, time, field.len()));
+    ///         }
+    ///     })
+    ///     .unwrap();
+    /// assert_eq!(seen.len(), history.times.len()); // t = 0, 0.02, 0.04
+    /// assert_eq!(seen[2], (2, history.times[2], 25));
+    /// ```
+    pub fn run_observed(
+        &self,
+        complex: &Complex,
+        initial: &dyn Fn(&[f64]) -> f64,
+        steps: usize,
+        save_every: usize,
+        observe: &mut dyn FnMut(HeatEvent<'_>),
+    ) -> Result<History, HeatError> {
         self.check()?;
         let n = complex.dim();
         let d = complex.embedding_dim();
@@ -347,6 +400,11 @@ impl Heat {
         let vary = self.data_vary();
         let mut times = vec![t0];
         let mut fields = vec![u.clone()];
+        observe(HeatEvent::Level {
+            index: 0,
+            time: t0,
+            field: &u,
+        });
         let mut b_old = first.rhs.clone();
         let mut fixed_new: Vec<Option<f64>> = first.fixed.clone();
         let mut b_new = first.rhs.clone();
@@ -399,10 +457,15 @@ impl Heat {
                 std::mem::swap(&mut b_old, &mut b_new);
             }
             if step == steps || (save_every > 0 && step % save_every == 0) {
+                observe(HeatEvent::Level {
+                    index: times.len(),
+                    time: t,
+                    field: &u,
+                });
                 times.push(t);
                 fields.push(u.clone());
             }
-            progress(step);
+            observe(HeatEvent::Step(step));
         }
         let per_step = |seconds: f64| {
             if steps > 0 {
