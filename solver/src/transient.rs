@@ -137,7 +137,8 @@ pub struct History {
     pub fields: Vec<Vec<f64>>,
     /// Symbolic analysis plus numeric factorisation of M/Δt + θK, seconds.
     pub factorization_seconds: f64,
-    /// Mean seconds per step (right-hand side, data and solve).
+    /// Mean seconds per step (right-hand side, data and solve; not the time
+    /// spent in the observer of [`Heat::run_observed`]).
     pub seconds_per_step: f64,
     /// The part of `seconds_per_step` spent in the triangular solves.
     pub solve_seconds_per_step: f64,
@@ -411,6 +412,9 @@ impl Heat {
         let mut rhs = vec![0.0; free.len()];
         let mut ku = vec![0.0; unknowns];
         let mut solve_seconds = 0.0;
+        // The observer may write output or draw progress: its time is the
+        // caller's, not the scheme's.
+        let mut observed_seconds = 0.0;
         let started = Instant::now();
         for step in 1..=steps {
             let t = t0 + step as f64 * dt;
@@ -440,9 +444,34 @@ impl Heat {
                 // The fixed pattern is the tags', the same at every time.
                 rhs[fi] -= v * fixed_new[j].unwrap_or(0.0);
             }
+            // An unstable θ < ½ overflows, in the right-hand side or in the
+            // solve. The matrix was factorised, so a non-finite solution
+            // (which the solve reports as a singular matrix) is overflow too.
+            let overflow = |rhs: &[f64]| {
+                let k = rhs
+                    .iter()
+                    .position(|v| !v.is_finite())
+                    .or_else(|| {
+                        (0..rhs.len()).max_by(|&a, &b| rhs[a].abs().total_cmp(&rhs[b].abs()))
+                    })
+                    .unwrap_or(0);
+                let i = free[k];
+                HeatError::NonFinite {
+                    what: "temperature",
+                    location: points[i * d..(i + 1) * d].to_vec(),
+                    time: t,
+                }
+            };
+            if rhs.iter().any(|v| !v.is_finite()) {
+                return Err(overflow(&rhs));
+            }
             if let Some(factor) = &factor {
                 let solving = Instant::now();
-                let x = factor.solve(&rhs)?;
+                let x = match factor.solve(&rhs) {
+                    Ok(x) => x,
+                    Err(SolveError::Singular { .. }) => return Err(overflow(&rhs)),
+                    Err(e) => return Err(e.into()),
+                };
                 solve_seconds += solving.elapsed().as_secs_f64();
                 for (k, &i) in free.iter().enumerate() {
                     u[i] = x[k];
@@ -457,15 +486,19 @@ impl Heat {
                 std::mem::swap(&mut b_old, &mut b_new);
             }
             if step == steps || (save_every > 0 && step % save_every == 0) {
+                let observing = Instant::now();
                 observe(HeatEvent::Level {
                     index: times.len(),
                     time: t,
                     field: &u,
                 });
+                observed_seconds += observing.elapsed().as_secs_f64();
                 times.push(t);
                 fields.push(u.clone());
             }
+            let observing = Instant::now();
             observe(HeatEvent::Step(step));
+            observed_seconds += observing.elapsed().as_secs_f64();
         }
         let per_step = |seconds: f64| {
             if steps > 0 {
@@ -474,7 +507,7 @@ impl Heat {
                 0.0
             }
         };
-        let seconds_per_step = per_step(started.elapsed().as_secs_f64());
+        let seconds_per_step = per_step(started.elapsed().as_secs_f64() - observed_seconds);
         Ok(History {
             location,
             degree: if location == Location::Nodal { 0 } else { n },
@@ -540,6 +573,35 @@ mod tests {
             hybrid.run(&mesh, &*one, 1, 1),
             Err(HeatError::Unsupported { .. })
         ));
+    }
+
+    #[test]
+    fn an_unstable_scheme_reports_the_overflow_and_the_levels_before_it() {
+        // Forward Euler with Δt far above h²/4: each step multiplies the
+        // highest mode by about 1 − Δt λ_max ≈ −100, so it overflows.
+        let mesh = rectangle(8, 8, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let h = heat(0.05, 0.0).with_boundary(
+            "boundary",
+            HeatBoundary::Dirichlet(TimeFn::Steady(Arc::new(|_| 0.0))),
+        );
+        let initial = |x: &[f64]| x[0] * (1.0 - x[0]) * x[1] * (1.0 - x[1]);
+        let mut levels = Vec::new();
+        let result = h.run_observed(&mesh, &initial, 1000, 10, &mut |event| {
+            if let HeatEvent::Level { time, field, .. } = event {
+                assert!(field.iter().all(|v| v.is_finite()));
+                levels.push(time);
+            }
+        });
+        let Err(HeatError::NonFinite {
+            what: "temperature",
+            time,
+            ..
+        }) = result
+        else {
+            panic!("expected a non-finite temperature, got {result:?}");
+        };
+        assert!(levels.len() >= 2 && time > *levels.last().unwrap());
+        assert!(time < 1000.0 * 0.05);
     }
 
     #[test]

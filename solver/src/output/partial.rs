@@ -341,10 +341,310 @@ fn mesh_levels<'l>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hasse_complex::generate::rectangle;
+    use hasse_complex::{TopCells, Vertices};
+    use hdf5::types::{TypeDescriptor, VarLenUnicode};
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("hasse-partial-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        names
+    }
+
+    /// Level j of the test series: u = x + 10 t at the vertices, q = edge
+    /// id + t on the edges (a degree the partial document does not show).
+    fn level(k: &Complex, t: f64) -> Step {
+        let u = (0..k.cell_count(0))
+            .map(|v| k.vertices().point(v)[0] + 10.0 * t)
+            .collect();
+        let q = (0..k.cell_count(1)).map(|e| e as f64 + t).collect();
+        Step {
+            time: t,
+            cochains: vec![
+                Cochain::new("u", 0, u).with_units("K").with_method("fe"),
+                Cochain::new("q", 1, q).with_description("edge values"),
+            ],
+        }
+    }
+
+    const TIMES: [f64; 3] = [0.0, 0.25, 0.5];
+
+    fn read_f64(path: &Path, dataset: &str) -> Vec<f64> {
+        let f = hdf5::File::open(path).unwrap();
+        f.dataset(dataset).unwrap().read_raw::<f64>().unwrap()
+    }
+
+    #[test]
+    fn a_dropped_writer_leaves_every_completed_level_readable() {
+        let k = rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+        let dir = scratch("dropped");
+        let stem = dir.join("heat");
+        {
+            let provenance = Provenance::new(serde_json::json!({"case": "test"}));
+            let mut partial = PartialOutput::create(&stem, &k, &provenance).unwrap();
+            assert!(!partial.removed_stale());
+            for t in TIMES {
+                partial.push(&level(&k, t)).unwrap();
+            }
+            assert_eq!(partial.times(), TIMES);
+            // Times must increase over the pushes; nothing is written then.
+            assert!(matches!(
+                partial.push(&level(&k, 0.5)),
+                Err(OutputError::Time { step: 3, .. })
+            ));
+        }
+        assert_eq!(names(&dir), ["heat.partial", "heat.partial.xdmf"]);
+        assert_eq!(
+            names(&dir.join("heat.partial")),
+            ["level-0.h5", "level-1.h5", "level-2.h5", "mesh.h5"]
+        );
+        let xml = std::fs::read_to_string(dir.join("heat.partial.xdmf")).unwrap();
+        assert_eq!(xml.matches("CollectionType=\"Temporal\"").count(), 1);
+        for (j, t) in TIMES.iter().enumerate() {
+            assert_eq!(xml.matches(&format!("<Time Value=\"{t:?}\"/>")).count(), 1);
+            assert!(xml.contains(&format!(
+                "Format=\"HDF\">heat.partial/level-{j}.h5:/steps/{j}/u</DataItem>"
+            )));
+        }
+        assert_eq!(
+            xml.matches(">heat.partial/mesh.h5:/mesh/vertices<").count(),
+            3
+        );
+        assert_eq!(
+            xml.matches(">heat.partial/mesh.h5:/xdmf/2/topology<")
+                .count(),
+            3
+        );
+        assert!(!xml.contains("Name=\"q\""));
+
+        // The level files hold the values pushed, the mesh file the mesh.
+        let partial_dir = dir.join("heat.partial");
+        for (j, &t) in TIMES.iter().enumerate() {
+            let file = partial_dir.join(format!("level-{j}.h5"));
+            let expected = level(&k, t);
+            for c in &expected.cochains {
+                assert_eq!(read_f64(&file, &format!("steps/{j}/{}", c.name)), c.values);
+            }
+            let f = hdf5::File::open(&file).unwrap();
+            let time: f64 = f.attr("time").unwrap().read_scalar().unwrap();
+            assert_eq!(time, t);
+            let units: VarLenUnicode = f
+                .dataset(&format!("steps/{j}/u"))
+                .unwrap()
+                .attr("units")
+                .unwrap()
+                .read_scalar()
+                .unwrap();
+            assert_eq!(units.as_str(), "K");
+        }
+        let vertices = read_f64(&partial_dir.join("mesh.h5"), "mesh/vertices");
+        assert_eq!(vertices.len(), 3 * 12);
+        assert_eq!(
+            &vertices[3 * 5..3 * 6],
+            k.vertices()
+                .point(5)
+                .iter()
+                .chain(&[0.0])
+                .copied()
+                .collect::<Vec<_>>()
+                .as_slice()
+        );
+
+        // The next run under this stem starts by removing them.
+        let provenance = Provenance::new(serde_json::Value::Null);
+        let next = PartialOutput::create(&stem, &k, &provenance).unwrap();
+        assert!(next.removed_stale());
+        assert!(next.is_empty());
+        assert_eq!(names(&dir), ["heat.partial"]);
+        assert_eq!(names(&partial_dir), ["mesh.h5"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Every dataset under `a` equals the one under `b` at the same path.
+    fn assert_same_datasets(a: &hdf5::Group, b: &hdf5::Group) {
+        let (mut na, mut nb) = (a.member_names().unwrap(), b.member_names().unwrap());
+        na.sort();
+        nb.sort();
+        assert_eq!(na, nb, "members of {}", a.name());
+        for name in na {
+            if let Ok(ga) = a.group(&name) {
+                assert_same_datasets(&ga, &b.group(&name).unwrap());
+                continue;
+            }
+            let (da, db) = (a.dataset(&name).unwrap(), b.dataset(&name).unwrap());
+            let what = da.name();
+            match da.dtype().unwrap().to_descriptor().unwrap() {
+                TypeDescriptor::Float(_) => assert_eq!(
+                    da.read_raw::<f64>().unwrap(),
+                    db.read_raw::<f64>().unwrap(),
+                    "{what}"
+                ),
+                TypeDescriptor::Unsigned(_) => assert_eq!(
+                    da.read_raw::<u64>().unwrap(),
+                    db.read_raw::<u64>().unwrap(),
+                    "{what}"
+                ),
+                TypeDescriptor::Integer(_) => assert_eq!(
+                    da.read_raw::<i64>().unwrap(),
+                    db.read_raw::<i64>().unwrap(),
+                    "{what}"
+                ),
+                TypeDescriptor::VarLenUnicode => assert_eq!(
+                    da.read_scalar::<VarLenUnicode>().unwrap(),
+                    db.read_scalar::<VarLenUnicode>().unwrap(),
+                    "{what}"
+                ),
+                other => panic!("{what}: unexpected type {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn finishing_writes_what_write_run_writes_and_removes_the_partial_files() {
+        let k = rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+        let dir = scratch("finished");
+        let run = RunOutput {
+            complex: &k,
+            steps: TIMES.iter().map(|&t| level(&k, t)).collect(),
+            provenance: Provenance::new(serde_json::json!({"case": "test"})),
+        };
+        let reference = write_run(&dir.join("reference"), &run).unwrap();
+
+        // A run with other levels than the streamed ones is refused, and
+        // the partial output stays.
+        let mut partial = PartialOutput::create(&dir.join("other"), &k, &run.provenance).unwrap();
+        for step in &run.steps {
+            partial.push(step).unwrap();
+        }
+        let short = RunOutput {
+            complex: &k,
+            steps: run.steps[..2].to_vec(),
+            provenance: run.provenance.clone(),
+        };
+        assert!(matches!(
+            partial.finish(&short),
+            Err(OutputError::Partial { .. })
+        ));
+        assert!(!dir.join("other.h5").exists());
+        assert!(remove_partial(&dir.join("other")).unwrap());
+
+        let mut partial =
+            PartialOutput::create(&dir.join("streamed"), &k, &run.provenance).unwrap();
+        for step in &run.steps {
+            partial.push(step).unwrap();
+        }
+        let files = partial.finish(&run).unwrap();
+
+        assert_eq!(
+            names(&dir),
+            [
+                "reference.edges.xdmf",
+                "reference.h5",
+                "reference.xdmf",
+                "streamed.edges.xdmf",
+                "streamed.h5",
+                "streamed.xdmf"
+            ]
+        );
+        let (a, b) = (
+            hdf5::File::open(&files.hdf5).unwrap(),
+            hdf5::File::open(&reference.hdf5).unwrap(),
+        );
+        assert_same_datasets(&a, &b);
+        let times = |f: &hdf5::File| f.attr("times").unwrap().read_raw::<f64>().unwrap();
+        assert_eq!(times(&a), TIMES);
+        assert_eq!(times(&b), TIMES);
+        let xdmf =
+            |path: &Path, stem: &str| std::fs::read_to_string(path).unwrap().replace(stem, "STEM");
+        assert_eq!(
+            xdmf(&files.xdmf, "streamed"),
+            xdmf(&reference.xdmf, "reference")
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn split_polyhedra_keep_their_expanded_values_in_the_level_files() {
+        // A cube cut into two triangular prisms, which XDMF gets as tetrahedra.
+        let v = Vertices::from_points(&[
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [0.0, 1.0, 1.0],
+        ])
+        .unwrap();
+        let prism = |a: usize, b: usize, c: usize| {
+            vec![
+                vec![a, b, c],
+                vec![a + 4, b + 4, c + 4],
+                vec![a, b, b + 4, a + 4],
+                vec![b, c, c + 4, b + 4],
+                vec![c, a, a + 4, c + 4],
+            ]
+        };
+        let k = Complex::build(v, TopCells::polyhedra([prism(0, 1, 2), prism(0, 2, 3)])).unwrap();
+        let dir = scratch("prisms");
+        let provenance = Provenance::new(serde_json::Value::Null);
+        let mut partial = PartialOutput::create(&dir.join("p"), &k, &provenance).unwrap();
+        for (j, t) in [1.0, 2.0].into_iter().enumerate() {
+            let values = vec![10.0 * t, 20.0 * t];
+            partial
+                .push(&Step {
+                    time: t,
+                    cochains: vec![Cochain::new("c", 3, values.clone())],
+                })
+                .unwrap();
+            let file = dir.join("p.partial").join(format!("level-{j}.h5"));
+            let ids = hdf5::File::open(dir.join("p.partial").join("mesh.h5"))
+                .unwrap()
+                .dataset("xdmf/3/cell_ids")
+                .unwrap()
+                .read_raw::<u64>()
+                .unwrap();
+            let expected: Vec<f64> = ids.iter().map(|&c| values[c as usize]).collect();
+            assert_eq!(read_f64(&file, &format!("xdmf/3/steps/{j}/c")), expected);
+        }
+        let xml = std::fs::read_to_string(partial.xdmf()).unwrap();
+        assert!(xml.contains(">p.partial/level-1.h5:/xdmf/3/steps/1/c<"));
+        assert!(xml.contains(">p.partial/mesh.h5:/xdmf/3/topology<"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn foreign_files_in_the_partial_directory_are_kept() {
+        let dir = scratch("foreign");
+        std::fs::create_dir_all(dir.join("run.partial")).unwrap();
+        std::fs::write(dir.join("run.partial").join("level-0.h5"), "").unwrap();
+        std::fs::write(dir.join("run.partial").join("notes.txt"), "mine").unwrap();
+        assert!(matches!(
+            remove_partial(&dir.join("run")),
+            Err(OutputError::Io { .. })
+        ));
+        assert_eq!(names(&dir.join("run.partial")), ["notes.txt"]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn only_partial_files_are_recognised() {
-        for ours in ["mesh.h5", "level-0.h5", "level-12.h5", ".level-3.h5.tmp-1-2"] {
+        for ours in [
+            "mesh.h5",
+            "level-0.h5",
+            "level-12.h5",
+            ".level-3.h5.tmp-1-2",
+        ] {
             assert!(is_partial_file(ours), "{ours}");
         }
         for theirs in ["level-.h5", "level-1a.h5", "notes.txt", "mesh.h5.bak"] {

@@ -44,8 +44,13 @@ fn heat_problem(case: &Case, spec: &HeatSpec) -> Heat {
     heat
 }
 
-fn run_error(e: HeatError) -> RunError {
+fn run_error(e: HeatError, theta: f64) -> RunError {
     match e {
+        HeatError::NonFinite {
+            what: "temperature",
+            location,
+            time,
+        } => RunError::Solve(unstable(&format!("at {location:?}"), time, theta)),
         HeatError::Solve(e) => RunError::Solve(format!(
             "factorising M/Δt + θK: {e} (the matrix is symmetric positive definite for θ > 0 with K ≥ 0; check solver.factorization)"
         )),
@@ -63,6 +68,13 @@ fn run_error(e: HeatError) -> RunError {
         HeatError::StartTime { .. } => RunError::Input(format!("time.start: {e}")),
         other => RunError::Input(other.to_string()),
     }
+}
+
+/// An explicit-leaning θ < ½ with too large a step grows without bound.
+fn unstable(place: &str, t: f64, theta: f64) -> String {
+    format!(
+        "the temperature is not finite {place} at t = {t}: the θ-scheme with θ = {theta} is only conditionally stable; use θ ≥ 0.5 or a smaller time.dt"
+    )
 }
 
 pub(super) fn solve(
@@ -106,6 +118,7 @@ pub(super) fn solve_streaming<'a>(
     let mut series = Vec::new();
     let mut level_errors = Vec::new();
     let mut post_seconds = 0.0;
+    let mut stream_seconds = 0.0;
     // Progress on long runs: at most ~100 updates, each a phase message.
     let report_every = (time.steps / 100).max(1);
     let history = heat
@@ -146,7 +159,9 @@ pub(super) fn solve_streaming<'a>(
                     }
                     post_seconds += post.elapsed().as_secs_f64();
                     if let Some(stream) = stream.as_deref_mut() {
+                        let writing = Instant::now();
                         stream.level(complex, t, &fields, Some(method), phase);
+                        stream_seconds += writing.elapsed().as_secs_f64();
                     }
                     series.push((t, fields));
                 }
@@ -167,14 +182,14 @@ pub(super) fn solve_streaming<'a>(
                 }
             },
         )
-        .map_err(run_error)?;
+        .map_err(|e| run_error(e, time.theta))?;
     let total = started.elapsed().as_secs_f64();
-    // An explicit-leaning θ < ½ with too large a step grows without bound.
     for (t, field) in history.times.iter().zip(&history.fields) {
         if let Some(i) = field.iter().position(|v| !v.is_finite()) {
-            return Err(RunError::Solve(format!(
-                "the temperature is not finite at unknown {i} at t = {t}: the θ-scheme with θ = {} is only conditionally stable; use θ ≥ 0.5 or a smaller time.dt",
-                time.theta
+            return Err(RunError::Solve(unstable(
+                &format!("at unknown {i}"),
+                *t,
+                time.theta,
             )));
         }
     }
@@ -217,7 +232,7 @@ pub(super) fn solve_streaming<'a>(
             1e3 * history.solve_seconds_per_step,
         ),
     )];
-    let timings = vec![
+    let mut timings = vec![
         ("factorisation".to_string(), history.factorization_seconds),
         (
             "time stepping".to_string(),
@@ -229,6 +244,9 @@ pub(super) fn solve_streaming<'a>(
         ),
         ("assembly + stepping".to_string(), total),
     ];
+    if stream.is_some() {
+        timings.insert(3, ("partial output".to_string(), stream_seconds));
+    }
     Ok(RunResult {
         problem: "heat".into(),
         method: Some(spec.method.name().into()),
