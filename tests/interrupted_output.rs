@@ -363,13 +363,11 @@ save_every = 20
     );
     assert!(!stderr.contains("no output written"), "{stderr}");
     // Every listed level is finite; the first non-finite one is not listed.
-    for j in 0..times.len() {
-        let u = read_f64(
-            &dir.join(format!("out.partial/level-{j}.h5")),
-            &format!("steps/{j}/u"),
-        );
+    for (j, &t) in times.iter().enumerate() {
+        let level = dir.join(format!("out.partial/level-{j}.h5"));
+        let u = read_f64(&level, &format!("steps/{j}/u"));
         assert!(u.iter().all(|v| v.is_finite()), "level {j}");
-        assert!((times[j] - j as f64).abs() < 1e-12);
+        assert!((t - j as f64).abs() < 1e-12, "level {j}: t = {t}");
     }
     assert!(!names(&dir).contains(&"out.h5".to_string()));
     std::fs::remove_dir_all(&dir).unwrap();

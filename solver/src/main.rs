@@ -531,7 +531,7 @@ fn run_case(
         }
         println!(
             "mesh       {} (cells per dimension {:?})",
-            complex_kind(&complex),
+            complex_kind(complex),
             complex.cell_counts()
         );
         if let Some((steps, _)) = &study {

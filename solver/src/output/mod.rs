@@ -37,6 +37,17 @@
 //! `mesh`. In the XDMF files, the k-th grid of the temporal collection
 //! reads its geometry and topology from `/steps/<k>/mesh`.
 //!
+//! # Partial output of a running series ([`PartialOutput`])
+//!
+//! A time series can also be written level by level while it is computed:
+//! `<stem>.partial/mesh.h5` (a run file without steps), one
+//! `<stem>.partial/level-<k>.h5` per completed level (`/steps/<k>` as
+//! above, plus root attrs `step` and `time`), and `<stem>.partial.xdmf`,
+//! rewritten after each level, whose k-th grid reads the mesh file and
+//! level k's file. Each file is renamed into place complete, so a killed
+//! run leaves every listed level readable; [`PartialOutput::finish`]
+//! writes the final output with [`write_run`] and then removes them.
+//!
 //! # XDMF (`<stem>.xdmf`, `<stem>.edges.xdmf`, `<stem>.faces.xdmf`)
 //!
 //! ParaView and VisIt ignore `Center="Edge"`/`"Face"`, so each cochain
