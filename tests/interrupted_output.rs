@@ -372,3 +372,37 @@ save_every = 20
     assert!(!names(&dir).contains(&"out.h5".to_string()));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_file_in_the_way_of_the_partial_output_costs_a_warning_not_the_run() {
+    let dir: PathBuf =
+        std::env::temp_dir().join(format!("hasse-partial-blocked-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // Not ours to remove, and no directory can be made under its name.
+    std::fs::write(dir.join("out.partial"), "someone's notes").unwrap();
+    let out = hasse(&[
+        "run",
+        "cases/heat-square.toml",
+        "--set",
+        "mesh.n=[8,8]",
+        "-o",
+        dir.join("out").to_str().unwrap(),
+    ])
+    .output()
+    .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("warning    the partial output stopped early:")
+            && stdout
+                .contains("the output is complete, but the partial output could not be removed"),
+        "{stdout}"
+    );
+    assert_eq!(names(&dir), ["out.h5", "out.partial", "out.xdmf"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("out.partial")).unwrap(),
+        "someone's notes"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -508,7 +508,7 @@ fn run_case(
                     Ok(files)
                 })
             }
-            (None, Some(stream)) => stream.finish(complex, &result),
+            (None, Some(stream)) => stream.finish(complex, &mut result),
             (None, None) => run::write_output(&case, complex, &result, &stem),
         };
         match written {

@@ -841,11 +841,11 @@ pub fn solve_streaming<'a>(
 /// let complex = case.build_mesh().unwrap();
 /// let dir = std::env::temp_dir().join(format!("hasse-doc-stream-{}", std::process::id()));
 /// let mut stream = run::LevelStream::new(&case, &dir.join("cool"));
-/// let result = run::solve_streaming(&case, &complex, Some(&mut stream), &mut |_| {}).unwrap();
+/// let mut result = run::solve_streaming(&case, &complex, Some(&mut stream), &mut |_| {}).unwrap();
 /// // Every saved level is in the partial output until the final one is written.
 /// assert_eq!(stream.partial().unwrap().len(), result.series.len());
 /// assert!(dir.join("cool.partial.xdmf").exists());
-/// let files = stream.finish(&complex, &result).unwrap();
+/// let files = stream.finish(&complex, &mut result).unwrap();
 /// assert!(files.xdmf.exists() && !dir.join("cool.partial.xdmf").exists());
 /// std::fs::remove_dir_all(&dir).unwrap();
 /// ```
@@ -960,22 +960,26 @@ impl<'a> LevelStream<'a> {
 
     /// Write the final output of `result` (as [`write_output`]) and then
     /// remove the partial output of the stem, this run's or an earlier
-    /// one's. On an error the partial output stays.
+    /// one's. On an error the partial output stays. Once the final output
+    /// is in place, a failure to remove the partial output does not undo
+    /// it: it becomes a warning of `result`.
     pub fn finish(
         self,
         complex: &Complex,
-        result: &RunResult,
+        result: &mut RunResult,
     ) -> Result<crate::output::OutputFiles, crate::output::OutputError> {
         let run = run_output(self.case, complex, result);
-        match self.partial {
-            // The partial output holds every level: finishing it checks
-            // that the final output has the same ones.
-            Some(partial) if !self.closed => partial.finish(&run),
-            _ => {
-                let files = crate::output::write_run(&self.stem, &run)?;
-                crate::output::remove_partial(&self.stem)?;
-                Ok(files)
-            }
+        if let (Some(partial), false) = (&self.partial, self.closed) {
+            // The partial output holds every level: the final one must
+            // have the same.
+            partial.check_run(&run)?;
         }
+        let files = crate::output::write_run(&self.stem, &run)?;
+        if let Err(e) = crate::output::remove_partial(&self.stem) {
+            result.warnings.push(format!(
+                "the output is complete, but the partial output could not be removed: {e}"
+            ));
+        }
+        Ok(files)
     }
 }

@@ -264,7 +264,8 @@ pub struct OutputFiles {
 
 /// Why an output could not be written. Nothing is left under the final
 /// file names when any of these is returned, except for an [`Io`] error on
-/// removing a stale degree file of an older output, which happens only
+/// removing a stale degree file of an older output, or the partial output
+/// ([`PartialOutput::finish`], [`remove_partial`]), which happens only
 /// after the new output is complete and in place.
 ///
 /// [`Io`]: OutputError::Io

@@ -263,6 +263,15 @@ impl<'a> PartialOutput<'a> {
     /// otherwise, before anything is written). On an error of the final
     /// write the partial output stays.
     pub fn finish(self, run: &RunOutput) -> Result<OutputFiles, OutputError> {
+        self.check_run(run)?;
+        let files = write_run(&self.stem, run)?;
+        remove_partial(&self.stem)?;
+        Ok(files)
+    }
+
+    /// The check of [`finish`](Self::finish): `run` has the pushed levels
+    /// on a complex like this one.
+    pub fn check_run(&self, run: &RunOutput) -> Result<(), OutputError> {
         let mismatch = |reason: String| OutputError::Partial {
             path: self.paths.xdmf.clone(),
             reason,
@@ -281,9 +290,7 @@ impl<'a> PartialOutput<'a> {
                 self.times()
             )));
         }
-        let files = write_run(&self.stem, run)?;
-        remove_partial(&self.stem)?;
-        Ok(files)
+        Ok(())
     }
 
     /// `<stem>.partial.xdmf`, the document of the completed levels (absent
