@@ -437,24 +437,41 @@ fn run_case(
         }
     };
     let mesh_seconds = mesh_started.elapsed().as_secs_f64();
+    let writing = case.output.write || output.is_some();
+    // A transient run writes each saved level as it completes to a partial
+    // output, so that an interrupted or failed run keeps them.
+    let mut stream = writing.then(|| run::LevelStream::new(&case, &stem));
     // With a [refine] table the case is solved, refined and re-solved; the
     // output holds the final mesh and its solution.
-    let (complex, study, result) = match &case.refine {
+    let (refined, study, result) = match &case.refine {
         None => {
-            let result = run::solve(&case, &complex, &mut |name| progress.phase(name));
-            (complex, None, result)
+            let result = run::solve_streaming(&case, &complex, stream.as_mut(), &mut |name| {
+                progress.phase(name)
+            });
+            (None, None, result)
         }
         Some(spec) => {
             match refinement::refine_and_solve(&case, &complex, spec, &mut |name| {
                 progress.phase(name)
             }) {
                 Ok(study) => (
-                    study.complex,
+                    Some(study.complex),
                     Some((study.steps, study.levels)),
                     Ok(study.result),
                 ),
-                Err(e) => (complex, None, Err(e)),
+                Err(e) => (None, None, Err(e)),
             }
+        }
+    };
+    let complex = refined.as_ref().unwrap_or(&complex);
+    // What an error leaves: the completed levels of a transient run, or nothing.
+    let left_behind = |stream: Option<&run::LevelStream>| {
+        if let Some(e) = stream.and_then(run::LevelStream::stopped) {
+            eprintln!("warning: the partial output stopped early: {e}");
+        }
+        match stream.and_then(run::LevelStream::readable) {
+            Some(readable) => eprintln!("{readable}"),
+            None => eprintln!("no output written"),
         }
     };
     let mut result = match result {
@@ -462,7 +479,7 @@ fn run_case(
         Err(e) => {
             progress.finish();
             eprintln!("error: {}: {e}", path.display());
-            eprintln!("no output written");
+            left_behind(stream.as_ref());
             return ExitCode::from(if e.is_input() {
                 EXIT_BAD_INPUT
             } else {
@@ -471,23 +488,35 @@ fn run_case(
         }
     };
     result.timings.insert(0, ("mesh".into(), mesh_seconds));
-    let written = if case.output.write || output.is_some() {
+    let written = if writing {
         progress.phase("writing output");
-        let written = match &study {
+        if let Some(e) = stream.as_ref().and_then(run::LevelStream::stopped) {
+            result
+                .warnings
+                .push(format!("the partial output stopped early: {e}"));
+        }
+        let readable = stream.as_ref().and_then(run::LevelStream::readable);
+        let written = match (&study, stream.take()) {
             // A refinement writes every level, each on its own mesh.
-            Some((steps, levels)) => {
-                let mut report = result.report_json(&complex);
+            (Some((steps, levels)), _) => {
+                let mut report = result.report_json(complex);
                 report["refinement"] = refinement::steps_json(steps);
-                run::write_levels(&case, levels, report, &stem)
+                // The partial output of an earlier transient run under
+                // this stem is stale once this output is in place.
+                run::write_levels(&case, levels, report, &stem).and_then(|files| {
+                    hasse_solver::output::remove_partial(&stem)?;
+                    Ok(files)
+                })
             }
-            None => run::write_output(&case, &complex, &result, &stem),
+            (None, Some(stream)) => stream.finish(complex, &mut result),
+            (None, None) => run::write_output(&case, complex, &result, &stem),
         };
         match written {
             Ok(files) => Some(files),
             Err(e) => {
                 progress.finish();
                 eprintln!("error: writing output: {e}");
-                eprintln!("no output written");
+                eprintln!("{}", readable.unwrap_or_else(|| "no output written".into()));
                 return ExitCode::from(EXIT_SOLVE_FAILED);
             }
         }
@@ -502,7 +531,7 @@ fn run_case(
         }
         println!(
             "mesh       {} (cells per dimension {:?})",
-            complex_kind(&complex),
+            complex_kind(complex),
             complex.cell_counts()
         );
         if let Some((steps, _)) = &study {

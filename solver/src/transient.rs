@@ -137,12 +137,27 @@ pub struct History {
     pub fields: Vec<Vec<f64>>,
     /// Symbolic analysis plus numeric factorisation of M/Δt + θK, seconds.
     pub factorization_seconds: f64,
-    /// Mean seconds per step (right-hand side, data and solve).
+    /// Mean seconds per step (right-hand side, data and solve; not the time
+    /// spent in the observer of [`Heat::run_observed`]).
     pub seconds_per_step: f64,
     /// The part of `seconds_per_step` spent in the triangular solves.
     pub solve_seconds_per_step: f64,
     /// Steps taken.
     pub steps: usize,
+}
+
+/// What [`Heat::run_observed`] reports while it runs.
+#[derive(Clone, Copy, Debug)]
+pub enum HeatEvent<'a> {
+    /// Saved level `index` (0 is t₀) at `time`, with all unknowns as in
+    /// [`History::fields`]; told before the step's [`HeatEvent::Step`].
+    Level {
+        index: usize,
+        time: f64,
+        field: &'a [f64],
+    },
+    /// Step number `n` (1-based) has been taken.
+    Step(usize),
 }
 
 impl History {
@@ -268,6 +283,45 @@ impl Heat {
         save_every: usize,
         progress: &mut dyn FnMut(usize),
     ) -> Result<History, HeatError> {
+        self.run_observed(complex, initial, steps, save_every, &mut |event| {
+            if let HeatEvent::Step(step) = event {
+                progress(step);
+            }
+        })
+    }
+
+    /// As [`run`](Self::run), telling `observe` each saved level as soon as
+    /// it is computed and each step as it is taken, so a caller can write
+    /// levels while the run goes on (an interrupted run then keeps them).
+    /// The levels it is told are those of the returned [`History`], in
+    /// order; a failed run has told the ones completed before the failure.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::diffusion::{Conductivity, Method};
+    /// use hasse_solver::transient::{Heat, HeatEvent};
+    /// use std::sync::Arc;
+    /// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let heat = Heat::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), 0.01);
+    /// let mut seen = Vec::new();
+    /// let history = heat
+    ///     .run_observed(&mesh, &|x| x[0], 4, 2, &mut |event| {
+    ///         if let HeatEvent::Level { index, time, field } = event {
+    ///             seen.push((index, time, field.len()));
+    ///         }
+    ///     })
+    ///     .unwrap();
+    /// assert_eq!(seen.len(), history.times.len()); // t = 0, 0.02, 0.04
+    /// assert_eq!(seen[2], (2, history.times[2], 25));
+    /// ```
+    pub fn run_observed(
+        &self,
+        complex: &Complex,
+        initial: &dyn Fn(&[f64]) -> f64,
+        steps: usize,
+        save_every: usize,
+        observe: &mut dyn FnMut(HeatEvent<'_>),
+    ) -> Result<History, HeatError> {
         self.check()?;
         let n = complex.dim();
         let d = complex.embedding_dim();
@@ -347,12 +401,20 @@ impl Heat {
         let vary = self.data_vary();
         let mut times = vec![t0];
         let mut fields = vec![u.clone()];
+        observe(HeatEvent::Level {
+            index: 0,
+            time: t0,
+            field: &u,
+        });
         let mut b_old = first.rhs.clone();
         let mut fixed_new: Vec<Option<f64>> = first.fixed.clone();
         let mut b_new = first.rhs.clone();
         let mut rhs = vec![0.0; free.len()];
         let mut ku = vec![0.0; unknowns];
         let mut solve_seconds = 0.0;
+        // The observer may write output or draw progress: its time is the
+        // caller's, not the scheme's.
+        let mut observed_seconds = 0.0;
         let started = Instant::now();
         for step in 1..=steps {
             let t = t0 + step as f64 * dt;
@@ -382,9 +444,34 @@ impl Heat {
                 // The fixed pattern is the tags', the same at every time.
                 rhs[fi] -= v * fixed_new[j].unwrap_or(0.0);
             }
+            // An unstable θ < ½ overflows, in the right-hand side or in the
+            // solve. The matrix was factorised, so a non-finite solution
+            // (which the solve reports as a singular matrix) is overflow too.
+            let overflow = |rhs: &[f64]| {
+                let k = rhs
+                    .iter()
+                    .position(|v| !v.is_finite())
+                    .or_else(|| {
+                        (0..rhs.len()).max_by(|&a, &b| rhs[a].abs().total_cmp(&rhs[b].abs()))
+                    })
+                    .unwrap_or(0);
+                let i = free[k];
+                HeatError::NonFinite {
+                    what: "temperature",
+                    location: points[i * d..(i + 1) * d].to_vec(),
+                    time: t,
+                }
+            };
+            if rhs.iter().any(|v| !v.is_finite()) {
+                return Err(overflow(&rhs));
+            }
             if let Some(factor) = &factor {
                 let solving = Instant::now();
-                let x = factor.solve(&rhs)?;
+                let x = match factor.solve(&rhs) {
+                    Ok(x) => x,
+                    Err(SolveError::Singular { .. }) => return Err(overflow(&rhs)),
+                    Err(e) => return Err(e.into()),
+                };
                 solve_seconds += solving.elapsed().as_secs_f64();
                 for (k, &i) in free.iter().enumerate() {
                     u[i] = x[k];
@@ -399,10 +486,19 @@ impl Heat {
                 std::mem::swap(&mut b_old, &mut b_new);
             }
             if step == steps || (save_every > 0 && step % save_every == 0) {
+                let observing = Instant::now();
+                observe(HeatEvent::Level {
+                    index: times.len(),
+                    time: t,
+                    field: &u,
+                });
+                observed_seconds += observing.elapsed().as_secs_f64();
                 times.push(t);
                 fields.push(u.clone());
             }
-            progress(step);
+            let observing = Instant::now();
+            observe(HeatEvent::Step(step));
+            observed_seconds += observing.elapsed().as_secs_f64();
         }
         let per_step = |seconds: f64| {
             if steps > 0 {
@@ -411,7 +507,7 @@ impl Heat {
                 0.0
             }
         };
-        let seconds_per_step = per_step(started.elapsed().as_secs_f64());
+        let seconds_per_step = per_step(started.elapsed().as_secs_f64() - observed_seconds);
         Ok(History {
             location,
             degree: if location == Location::Nodal { 0 } else { n },
@@ -477,6 +573,35 @@ mod tests {
             hybrid.run(&mesh, &*one, 1, 1),
             Err(HeatError::Unsupported { .. })
         ));
+    }
+
+    #[test]
+    fn an_unstable_scheme_reports_the_overflow_and_the_levels_before_it() {
+        // Forward Euler with Δt far above h²/4: each step multiplies the
+        // highest mode by about 1 − Δt λ_max ≈ −100, so it overflows.
+        let mesh = rectangle(8, 8, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let h = heat(0.05, 0.0).with_boundary(
+            "boundary",
+            HeatBoundary::Dirichlet(TimeFn::Steady(Arc::new(|_| 0.0))),
+        );
+        let initial = |x: &[f64]| x[0] * (1.0 - x[0]) * x[1] * (1.0 - x[1]);
+        let mut levels = Vec::new();
+        let result = h.run_observed(&mesh, &initial, 1000, 10, &mut |event| {
+            if let HeatEvent::Level { time, field, .. } = event {
+                assert!(field.iter().all(|v| v.is_finite()));
+                levels.push(time);
+            }
+        });
+        let Err(HeatError::NonFinite {
+            what: "temperature",
+            time,
+            ..
+        }) = result
+        else {
+            panic!("expected a non-finite temperature, got {result:?}");
+        };
+        assert!(levels.len() >= 2 && time > *levels.last().unwrap());
+        assert!(time < 1000.0 * 0.05);
     }
 
     #[test]

@@ -2,7 +2,7 @@
 
 use super::topology::GridTopology;
 use super::xdmf::{center, Center};
-use super::{Levels, MeshAt, OutputError};
+use super::{Level, Levels, MeshAt, OutputError};
 use hasse_complex::Complex;
 use hdf5::types::VarLenUnicode;
 use hdf5::{Group, H5Type, Location};
@@ -178,22 +178,7 @@ fn write_contents(
     // The steps first: in a series each mesh lives inside its step's group.
     let steps = w.group(root, "steps")?;
     for (k, step) in levels.steps.iter().enumerate() {
-        let g = w.group(&steps, &k.to_string())?;
-        w.scalar_attr(&g, "time", step.time)?;
-        for c in step.cochains {
-            w.vector(&g, &c.name, &c.values)?;
-            let ds = g.dataset(&c.name).at(w.path)?;
-            w.scalar_attr(&ds, "dim", c.dim as u64)?;
-            for (key, value) in [
-                ("units", &c.units),
-                ("method", &c.method),
-                ("description", &c.description),
-            ] {
-                if let Some(value) = value {
-                    w.string_attr(&ds, key, value)?;
-                }
-            }
-        }
+        write_step(w, &steps, k, step)?;
     }
 
     for (mesh, grids) in levels.meshes.iter().zip(grids) {
@@ -212,6 +197,84 @@ fn write_contents(
         w.string_dataset(&prov, "case_text", text)?;
     }
     w.string_dataset(&prov, "report", &p.report.to_string())
+}
+
+/// Level `k` into group `steps/<k>`: attr `time`, one dataset per cochain.
+fn write_step(w: &Writer, steps: &Group, k: usize, step: &Level) -> Result<(), OutputError> {
+    let g = w.group(steps, &k.to_string())?;
+    w.scalar_attr(&g, "time", step.time)?;
+    for c in step.cochains {
+        w.vector(&g, &c.name, &c.values)?;
+        let ds = g.dataset(&c.name).at(w.path)?;
+        w.scalar_attr(&ds, "dim", c.dim as u64)?;
+        for (key, value) in [
+            ("units", &c.units),
+            ("method", &c.method),
+            ("description", &c.description),
+        ] {
+            if let Some(value) = value {
+                w.string_attr(&ds, key, value)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Write the h5 file of one level of a partial output at `path` (a
+/// temporary name): root attrs `format` = `"hasse-output-level"`,
+/// `format_version`, `step` (k) and `time`, the group `/steps/<k>` as in a
+/// run file, and for split cells the expanded cochains
+/// `/<xdmf_group>/<p>/steps/<k>/<name>`, so the XDMF paths of a run file
+/// stay valid, only the file changes. `grids` are the XDMF grids of the
+/// level's mesh.
+pub(crate) fn write_level(
+    path: &Path,
+    levels: &Levels,
+    grids: &[GridTopology],
+    k: usize,
+    step: &Level,
+) -> Result<(), OutputError> {
+    let file = hdf5::File::create(path).at(path)?;
+    let w = Writer { path };
+    w.string_attr(&file, "format", "hasse-output-level")?;
+    w.scalar_attr(&file, "format_version", FORMAT_VERSION)?;
+    w.scalar_attr(&file, "step", k as u64)?;
+    w.scalar_attr(&file, "time", step.time)?;
+    write_step(&w, &w.group(&file, "steps")?, k, step)?;
+    let split: Vec<(&GridTopology, &Vec<u64>)> = grids
+        .iter()
+        .filter_map(|g| Some((g, g.cell_ids.as_ref()?)))
+        .collect();
+    if !split.is_empty() {
+        let xdmf = w.group(&file, &levels.meshes[step.mesh].xdmf_group)?;
+        for (grid, cell_ids) in split {
+            let g = w.group(&xdmf, &grid.degree.to_string())?;
+            let g = w.group(&w.group(&g, "steps")?, &k.to_string())?;
+            write_expanded(&w, &g, grid, cell_ids, levels.dim(), step)?;
+        }
+    }
+    file.flush().at(path)?;
+    file.close().at(path)
+}
+
+/// The cell cochains of `step` on a grid whose elements are pieces of
+/// cells (`cell_ids`), one value per element, into group `g`.
+fn write_expanded(
+    w: &Writer,
+    g: &Group,
+    grid: &GridTopology,
+    cell_ids: &[u64],
+    n: usize,
+    step: &Level,
+) -> Result<(), OutputError> {
+    for c in step.cochains {
+        if center(grid, n, c) != Some(Center::Cell) {
+            continue;
+        }
+        let values: Vec<f64> = cell_ids.iter().map(|&i| c.values[i as usize]).collect();
+        w.vector(g, &c.name, &values)?;
+    }
+    Ok(())
 }
 
 /// One complex into group `mesh` (`/mesh`, or `/steps/<k>/mesh`): attrs
@@ -291,13 +354,7 @@ fn write_xdmf_arrays(
         let expanded = w.group(&g, "steps")?;
         for &k in &mesh.steps {
             let sg = w.group(&expanded, &k.to_string())?;
-            for c in levels.steps[k].cochains {
-                if center(grid, n, c) != Some(Center::Cell) {
-                    continue;
-                }
-                let values: Vec<f64> = cell_ids.iter().map(|&i| c.values[i as usize]).collect();
-                w.vector(&sg, &c.name, &values)?;
-            }
+            write_expanded(w, &sg, grid, cell_ids, n, &levels.steps[k])?;
         }
     }
     Ok(())

@@ -37,6 +37,17 @@
 //! `mesh`. In the XDMF files, the k-th grid of the temporal collection
 //! reads its geometry and topology from `/steps/<k>/mesh`.
 //!
+//! # Partial output of a running series ([`PartialOutput`])
+//!
+//! A time series can also be written level by level while it is computed:
+//! `<stem>.partial/mesh.h5` (a run file without steps), one
+//! `<stem>.partial/level-<k>.h5` per completed level (`/steps/<k>` as
+//! above, plus root attrs `step` and `time`), and `<stem>.partial.xdmf`,
+//! rewritten after each level, whose k-th grid reads the mesh file and
+//! level k's file. Each file is renamed into place complete, so a killed
+//! run leaves every listed level readable; [`PartialOutput::finish`]
+//! writes the final output with [`write_run`] and then removes them.
+//!
 //! # XDMF (`<stem>.xdmf`, `<stem>.edges.xdmf`, `<stem>.faces.xdmf`)
 //!
 //! ParaView and VisIt ignore `Center="Edge"`/`"Face"`, so each cochain
@@ -66,8 +77,11 @@
 //! can (`cases/OUTPUT.md`).
 
 mod hdf5_file;
+mod partial;
 mod topology;
 mod xdmf;
+
+pub use partial::{remove_partial, PartialOutput};
 
 use hasse_complex::Complex;
 use std::collections::HashSet;
@@ -250,7 +264,8 @@ pub struct OutputFiles {
 
 /// Why an output could not be written. Nothing is left under the final
 /// file names when any of these is returned, except for an [`Io`] error on
-/// removing a stale degree file of an older output, which happens only
+/// removing a stale degree file of an older output, or the partial output
+/// ([`PartialOutput::finish`], [`remove_partial`]), which happens only
 /// after the new output is complete and in place.
 ///
 /// [`Io`]: OutputError::Io
@@ -326,6 +341,10 @@ pub enum OutputError {
     /// A provenance or metadata string cannot be stored (e.g. it contains NUL).
     #[error("{field} cannot be stored as an HDF5 string: {reason}")]
     Text { field: String, reason: String },
+    /// [`PartialOutput::finish`] was given a run that is not the series it
+    /// streamed (other times or another complex); nothing was written.
+    #[error("{path}: {reason}")]
+    Partial { path: PathBuf, reason: String },
     /// The reader-order connectivity of some cell could not be rebuilt.
     #[error("cannot write the XDMF cells: {message}")]
     Topology { message: String },
@@ -437,9 +456,9 @@ pub fn check_writable(stem: &Path) -> Result<(), OutputError> {
     std::fs::remove_file(&probe).map_err(io(&probe))
 }
 
-/// The shared body of [`write_run`] and [`write_mesh_series`].
-fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError> {
-    validate(levels)?;
+/// The directory of `stem` (`.` when it has none) and its file name, which
+/// every output file name starts with.
+fn split_stem(stem: &Path) -> Result<(PathBuf, String), OutputError> {
     let stem_error = |reason| OutputError::Stem {
         path: stem.to_path_buf(),
         reason,
@@ -460,14 +479,71 @@ fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    Ok((dir, file_name))
+}
+
+/// A tag unique per process and per call, so concurrent writers of the
+/// same stem never share a temporary.
+fn temporary_tag() -> String {
+    static CALLS: AtomicU64 = AtomicU64::new(0);
+    format!(
+        "{}-{}",
+        std::process::id(),
+        CALLS.fetch_add(1, Ordering::Relaxed)
+    )
+}
+
+/// The temporary that becomes `path`: in the same directory, so that the
+/// rename is atomic, and hidden, so that listings and globs skip it.
+fn temporary(path: &Path, tag: &str) -> PathBuf {
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!(".{name}.tmp-{tag}"))
+}
+
+/// Whether a file name is one of [`temporary`]'s.
+fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && name.contains(".tmp-")
+}
+
+/// Write one file under a temporary name with `write`, make it durable
+/// and rename it to `path`: readers see the old file or the complete new
+/// one, never a part, and an error leaves nothing behind.
+fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    let mut temps = Temporaries(vec![temporary(path, &temporary_tag())]);
+    write(&temps.0[0])?;
+    sync(&temps.0[0])?;
+    rename(&temps.0[0], path)?;
+    temps.0.clear();
+    Ok(())
+}
+
+fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    std::fs::write(path, text).map_err(|source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn create_dir(dir: &Path) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
+/// The shared body of [`write_run`] and [`write_mesh_series`].
+fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError> {
+    validate(levels)?;
+    let (dir, file_name) = split_stem(stem)?;
     let degrees = xdmf::degrees(levels);
     let grids = xdmf::grids(levels, &degrees)?;
 
-    std::fs::create_dir_all(&dir).map_err(|source| OutputError::Io {
-        path: dir.clone(),
-        source,
-    })?;
+    create_dir(&dir)?;
     let h5_name = format!("{file_name}.h5");
+    let files = xdmf::Files::one(&h5_name);
     let n = levels.dim();
     let final_h5 = dir.join(&h5_name);
     let final_xdmf = dir.join(format!("{file_name}.xdmf"));
@@ -476,7 +552,7 @@ fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError
     let mut extra_xdmf = Vec::new();
     let mut documents = Vec::new();
     for (i, &p) in degrees.iter().enumerate() {
-        let text = xdmf::document(levels, &grids, i, &h5_name);
+        let text = xdmf::document(levels, &grids, i, &files);
         if i == 0 {
             documents.push((final_xdmf.clone(), text));
         } else {
@@ -490,28 +566,14 @@ fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError
     // so once it appears the whole output is in place.
     documents.rotate_left(1);
 
-    // Unique per process and per call, so concurrent writers of the same
-    // stem never share a temporary.
-    static CALLS: AtomicU64 = AtomicU64::new(0);
-    let tag = format!(
-        "{}-{}",
-        std::process::id(),
-        CALLS.fetch_add(1, Ordering::Relaxed)
-    );
-    let temp = |path: &Path| {
-        let name = path.file_name().unwrap_or_default().to_string_lossy();
-        dir.join(format!(".{name}.tmp-{tag}"))
-    };
+    let tag = temporary_tag();
     let mut finals = vec![final_h5.clone()];
     finals.extend(documents.iter().map(|(path, _)| path.clone()));
-    let mut temps = Temporaries(finals.iter().map(|path| temp(path)).collect());
+    let mut temps = Temporaries(finals.iter().map(|path| temporary(path, &tag)).collect());
 
     hdf5_file::write(&temps.0[0], levels, &grids, &rfc3339_now())?;
     for (path, (_, text)) in temps.0[1..].iter().zip(&documents) {
-        std::fs::write(path, text).map_err(|source| OutputError::Io {
-            path: path.clone(),
-            source,
-        })?;
+        write_text(path, text)?;
     }
 
     // Contents reach the disk before the names do, so a crash right after
@@ -530,18 +592,25 @@ fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError
         if extra_xdmf.contains(&path) {
             continue;
         }
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(OutputError::Io { path, source: e });
-            }
-            _ => {}
-        }
+        remove_if_present(&path)?;
     }
     Ok(OutputFiles {
         hdf5: final_h5,
         xdmf: final_xdmf,
         extra_xdmf,
     })
+}
+
+/// Remove a file; whether it was there.
+fn remove_if_present(path: &Path) -> Result<bool, OutputError> {
+    match std::fs::remove_file(path) {
+        Ok(()) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
+        Err(source) => Err(OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
 }
 
 /// An output as the writers see it, whichever entry point built it: the
@@ -664,69 +733,81 @@ impl Drop for Temporaries {
 }
 
 fn validate(levels: &Levels) -> Result<(), OutputError> {
-    let Some(first) = levels.meshes.first() else {
+    if levels.meshes.is_empty() {
         return Err(OutputError::EmptySeries);
-    };
-    let n = first.complex.dim();
+    }
     let mut previous: Option<f64> = None;
     for (k, step) in levels.steps.iter().enumerate() {
-        if !step.time.is_finite() || previous.is_some_and(|t| step.time <= t) {
-            return Err(OutputError::Time {
-                step: k,
-                time: step.time,
-            });
-        }
+        check_level(levels, k, step, previous)?;
         previous = Some(step.time);
-        let complex = levels.meshes[step.mesh].complex;
-        if complex.dim() != n {
-            return Err(OutputError::MeshDimension {
-                step: k,
-                dim: complex.dim(),
-                expected: n,
+    }
+    Ok(())
+}
+
+/// The checks of one level `k` of `levels` (`step`, which need not be in
+/// `levels.steps`), whose predecessor has time `previous`.
+fn check_level(
+    levels: &Levels,
+    k: usize,
+    step: &Level,
+    previous: Option<f64>,
+) -> Result<(), OutputError> {
+    if !step.time.is_finite() || previous.is_some_and(|t| step.time <= t) {
+        return Err(OutputError::Time {
+            step: k,
+            time: step.time,
+        });
+    }
+    let complex = levels.meshes[step.mesh].complex;
+    let n = levels.dim();
+    if complex.dim() != n {
+        return Err(OutputError::MeshDimension {
+            step: k,
+            dim: complex.dim(),
+            expected: n,
+        });
+    }
+    let mut names = HashSet::new();
+    for c in step.cochains {
+        check_name(&c.name)?;
+        if levels.mesh_changes && c.name == "mesh" {
+            return Err(OutputError::InvalidName {
+                name: c.name.clone(),
+                reason: "'mesh' is the group of the step's own mesh in a series",
             });
         }
-        let mut names = HashSet::new();
-        for c in step.cochains {
-            check_name(&c.name)?;
-            if levels.mesh_changes && c.name == "mesh" {
-                return Err(OutputError::InvalidName {
-                    name: c.name.clone(),
-                    reason: "'mesh' is the group of the step's own mesh in a series",
-                });
-            }
-            if !names.insert(c.name.as_str()) {
-                return Err(OutputError::DuplicateName {
-                    step: k,
-                    name: c.name.clone(),
-                });
-            }
-            if c.dim > complex.dim() {
-                return Err(OutputError::Degree {
-                    step: k,
-                    name: c.name.clone(),
-                    dim: c.dim,
-                    complex_dim: complex.dim(),
-                });
-            }
-            let expected = complex.cell_count(c.dim);
-            if c.values.len() != expected {
-                return Err(OutputError::Shape {
-                    step: k,
-                    name: c.name.clone(),
-                    dim: c.dim,
-                    expected,
-                    got: c.values.len(),
-                });
-            }
-            if let Some(cell) = c.values.iter().position(|v| !v.is_finite()) {
-                return Err(OutputError::NonFinite {
-                    step: k,
-                    name: c.name.clone(),
-                    dim: c.dim,
-                    cell,
-                    value: c.values[cell],
-                });
-            }
+        if !names.insert(c.name.as_str()) {
+            return Err(OutputError::DuplicateName {
+                step: k,
+                name: c.name.clone(),
+            });
+        }
+        if c.dim > complex.dim() {
+            return Err(OutputError::Degree {
+                step: k,
+                name: c.name.clone(),
+                dim: c.dim,
+                complex_dim: complex.dim(),
+            });
+        }
+        let expected = complex.cell_count(c.dim);
+        if c.values.len() != expected {
+            return Err(OutputError::Shape {
+                step: k,
+                name: c.name.clone(),
+                dim: c.dim,
+                expected,
+                got: c.values.len(),
+            });
+        }
+        if let Some(cell) = c.values.iter().position(|v| !v.is_finite()) {
+            return Err(OutputError::NonFinite {
+                step: k,
+                name: c.name.clone(),
+                dim: c.dim,
+                cell,
+                value: c.values[cell],
+            });
         }
     }
     Ok(())

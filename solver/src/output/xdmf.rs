@@ -100,20 +100,39 @@ fn escape(text: &str) -> String {
     out
 }
 
+/// The h5 files an XDMF document reads, as paths relative to it.
+pub(crate) struct Files<'a> {
+    /// The file holding the mesh (`<group>/vertices`) and the XDMF arrays
+    /// (`<xdmf_group>/<p>/topology`).
+    pub mesh: &'a str,
+    /// The file holding the cochains of level k, when not the mesh file;
+    /// its levels are a time series even while there is only one of them.
+    pub level: Option<&'a dyn Fn(usize) -> String>,
+}
+
+impl<'a> Files<'a> {
+    /// Everything in one file: the layout of [`super::write_run`].
+    pub fn one(h5_name: &'a str) -> Self {
+        Files {
+            mesh: h5_name,
+            level: None,
+        }
+    }
+}
+
 /// The XDMF document of the grid of degree `degrees[i]` (its grids are
-/// `grids[m][i]`, see [`grids`]); `h5_name` is the h5 file name relative
-/// to it. One grid per document, because `meshio.read` accepts only a
-/// domain holding a single uniform grid and `TimeSeriesReader` only the
-/// last temporal collection: a plain uniform grid for at most one time
-/// level, a temporal collection for several, whose k-th grid takes its
-/// geometry and topology from the mesh of level k.
+/// `grids[m][i]`, see [`grids`]), reading `files`. One grid per document,
+/// because `meshio.read` accepts only a domain holding a single uniform
+/// grid and `TimeSeriesReader` only the last temporal collection: a plain
+/// uniform grid for at most one time level of a single-file output, a
+/// temporal collection otherwise, whose k-th grid takes its geometry and
+/// topology from the mesh of level k.
 pub(crate) fn document(
     levels: &Levels,
     grids: &[Vec<GridTopology>],
     i: usize,
-    h5_name: &str,
+    files: &Files,
 ) -> String {
-    let h5 = escape(h5_name);
     let mut out = String::new();
     out.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
     out.push_str("<Xdmf Version=\"3.0\">\n  <Domain>\n");
@@ -121,12 +140,13 @@ pub(crate) fn document(
         levels,
         grids,
         i,
-        h5: &h5,
+        mesh_h5: escape(files.mesh),
+        level_h5: files.level,
     };
-    match levels.steps.as_slice() {
-        [] => grid.uniform(&mut out, 0, None, false, 4),
-        [only] => grid.uniform(&mut out, only.mesh, Some(0), false, 4),
-        steps => {
+    match (levels.steps.as_slice(), files.level) {
+        ([], _) => grid.uniform(&mut out, 0, None, false, 4),
+        ([only], None) => grid.uniform(&mut out, only.mesh, Some(0), false, 4),
+        (steps, _) => {
             let name = grid_name(grids[0][i].degree, levels.dim());
             let _ = writeln!(
                 out,
@@ -153,15 +173,17 @@ struct Grid<'a> {
     grids: &'a [Vec<GridTopology>],
     /// Index of the document's degree in `degrees`.
     i: usize,
-    /// The escaped h5 file name.
-    h5: &'a str,
+    /// The escaped name of the h5 file with the meshes.
+    mesh_h5: String,
+    /// The (unescaped) name of the h5 file of level k, if not the mesh file.
+    level_h5: Option<&'a dyn Fn(usize) -> String>,
 }
 
 impl Grid<'_> {
     /// The uniform grid of mesh `m`, with the attributes of level `step`
     /// (none for the bare mesh) and its `<Time>` when `timed`.
     fn uniform(&self, out: &mut String, m: usize, step: Option<usize>, timed: bool, indent: usize) {
-        let (levels, h5) = (self.levels, self.h5);
+        let (levels, h5) = (self.levels, self.mesh_h5.as_str());
         let mesh = &levels.meshes[m];
         let grid = &self.grids[m][self.i];
         let n = levels.dim();
@@ -207,6 +229,10 @@ impl Grid<'_> {
         );
         let _ = writeln!(out, "{pad}  </Geometry>");
         if let Some((k, s)) = level {
+            let level_h5 = match self.level_h5 {
+                Some(name) => escape(&name(k)),
+                None => h5.to_string(),
+            };
             for c in s.cochains {
                 let Some(at) = center(grid, n, c) else {
                     continue;
@@ -222,7 +248,7 @@ impl Grid<'_> {
                 );
                 let _ = writeln!(
                     out,
-                    "{pad}    <DataItem Dimensions=\"{len}\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">{h5}:{}</DataItem>",
+                    "{pad}    <DataItem Dimensions=\"{len}\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">{level_h5}:{}</DataItem>",
                     escape(&attribute_path(mesh, grid, k, c, at))
                 );
                 let _ = writeln!(out, "{pad}  </Attribute>");
@@ -263,7 +289,7 @@ mod tests {
         );
         assert_eq!(grid_name(1, 2), "edges");
 
-        let cells = document(&levels, &grids, 0, "a&b.h5");
+        let cells = document(&levels, &grids, 0, &Files::one("a&b.h5"));
         assert_eq!(cells.matches("CollectionType=\"Temporal\"").count(), 1);
         assert!(cells
             .contains("<Grid Name=\"cells\" GridType=\"Collection\" CollectionType=\"Temporal\">"));
@@ -279,7 +305,7 @@ mod tests {
         assert!(!cells.contains("flux"));
         assert_eq!(cells.matches("<Grid ").count(), 1 + 2);
 
-        let edges = document(&levels, &grids, 1, "a&b.h5");
+        let edges = document(&levels, &grids, 1, &Files::one("a&b.h5"));
         assert!(edges
             .contains("<Grid Name=\"edges\" GridType=\"Collection\" CollectionType=\"Temporal\">"));
         assert_eq!(
@@ -313,14 +339,14 @@ mod tests {
         };
         let levels = Levels::of_run(&run);
         let grids = grids(&levels, &degrees(&levels)).unwrap();
-        let text = document(&levels, &grids, 0, "r.h5");
+        let text = document(&levels, &grids, 0, &Files::one("r.h5"));
         assert_eq!(text.matches("<Grid ").count(), 1);
         assert!(!text.contains("Collection"));
         assert!(!text.contains("<Time"));
         assert!(!text.contains("Name=\"q\""));
         assert!(text.contains("<DataItem Dimensions=\"2 4\" DataType=\"Int\" Precision=\"8\" Format=\"HDF\">r.h5:/xdmf/2/topology</DataItem>"));
         // 2×1 quads have 7 edges: 2 rows of 2 horizontal ones and 3 vertical ones.
-        let edges = document(&levels, &grids, 1, "r.h5");
+        let edges = document(&levels, &grids, 1, &Files::one("r.h5"));
         assert_eq!(edges.matches("<Grid ").count(), 1);
         assert!(!edges.contains("Collection"));
         assert!(edges.contains("<DataItem Dimensions=\"7\" DataType=\"Float\" Precision=\"8\" Format=\"HDF\">r.h5:/steps/0/q</DataItem>"));
@@ -341,7 +367,7 @@ mod tests {
         };
         let levels = Levels::of_series(&one);
         let meshes = grids(&levels, &degrees(&levels)).unwrap();
-        let text = document(&levels, &meshes, 0, "s.h5");
+        let text = document(&levels, &meshes, 0, &Files::one("s.h5"));
         // One step: a plain uniform grid, still on the step's own mesh.
         assert!(!text.contains("Collection") && !text.contains("<Time"));
         assert!(text.contains(">s.h5:/steps/0/mesh/vertices<"));
@@ -367,7 +393,7 @@ mod tests {
         let levels = Levels::of_series(&two);
         let meshes = grids(&levels, &degrees(&levels)).unwrap();
         assert_eq!(meshes.len(), 2);
-        let text = document(&levels, &meshes, 0, "s.h5");
+        let text = document(&levels, &meshes, 0, &Files::one("s.h5"));
         assert_eq!(text.matches("CollectionType=\"Temporal\"").count(), 1);
         assert!(text.contains("NumberOfElements=\"1\" NodesPerElement=\"4\""));
         assert!(text.contains("NumberOfElements=\"2\" NodesPerElement=\"4\""));

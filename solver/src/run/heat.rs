@@ -2,11 +2,11 @@
 //! the case's mesh, the temperature written at every saved level, errors
 //! against an exact u(x, t) at each of them.
 
-use super::{conductivity, scalar_fn, Field, RunError, RunResult};
+use super::{conductivity, scalar_fn, Field, LevelStream, RunError, RunResult};
 use crate::case::expr::Expression;
 use crate::case::{BoundaryKindSpec, Case, HeatSpec};
 use crate::diffusion::{lumped_vertex_volumes, Errors};
-use crate::transient::{Heat, HeatBoundary, HeatError, History, TimeFn};
+use crate::transient::{Heat, HeatBoundary, HeatError, HeatEvent, History, TimeFn};
 use hasse_complex::Complex;
 use std::sync::Arc;
 use std::time::Instant;
@@ -44,8 +44,13 @@ fn heat_problem(case: &Case, spec: &HeatSpec) -> Heat {
     heat
 }
 
-fn run_error(e: HeatError) -> RunError {
+fn run_error(e: HeatError, theta: f64) -> RunError {
     match e {
+        HeatError::NonFinite {
+            what: "temperature",
+            location,
+            time,
+        } => RunError::Solve(unstable(&format!("at {location:?}"), time, theta)),
         HeatError::Solve(e) => RunError::Solve(format!(
             "factorising M/Δt + θK: {e} (the matrix is symmetric positive definite for θ > 0 with K ≥ 0; check solver.factorization)"
         )),
@@ -65,50 +70,41 @@ fn run_error(e: HeatError) -> RunError {
     }
 }
 
+/// An explicit-leaning θ < ½ with too large a step grows without bound.
+fn unstable(place: &str, t: f64, theta: f64) -> String {
+    format!(
+        "the temperature is not finite {place} at t = {t}: the θ-scheme with θ = {theta} is only conditionally stable; use θ ≥ 0.5 or a smaller time.dt"
+    )
+}
+
 pub(super) fn solve(
     case: &Case,
     spec: &HeatSpec,
     complex: &Complex,
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
+    solve_streaming(case, spec, complex, phase, None)
+}
+
+/// As [`solve`], handing each saved level to `stream` as soon as it is
+/// computed.
+pub(super) fn solve_streaming<'a>(
+    case: &'a Case,
+    spec: &HeatSpec,
+    complex: &'a Complex,
+    phase: &mut dyn FnMut(&str),
+    mut stream: Option<&mut LevelStream<'a>>,
+) -> Result<RunResult, RunError> {
     let heat = heat_problem(case, spec);
     let time = &spec.time;
     phase("assembling and factorising");
     let started = Instant::now();
     let initial = |x: &[f64]| spec.initial.eval(x, time.start);
-    // Progress on long runs: at most ~100 updates, each a phase message.
-    let report_every = (time.steps / 100).max(1);
-    let history = heat
-        .run_with_progress(
-            complex,
-            &initial,
-            time.steps,
-            time.save_every,
-            &mut |step| {
-                if step % report_every == 0 || step == time.steps {
-                    phase(&format!(
-                        "time step {step}/{} (t = {:.6})",
-                        time.steps,
-                        time.start + step as f64 * time.dt
-                    ));
-                }
-            },
-        )
-        .map_err(run_error)?;
-    let total = started.elapsed().as_secs_f64();
-    // An explicit-leaning θ < ½ with too large a step grows without bound.
-    for (t, field) in history.times.iter().zip(&history.fields) {
-        if let Some(i) = field.iter().position(|v| !v.is_finite()) {
-            return Err(RunError::Solve(format!(
-                "the temperature is not finite at unknown {i} at t = {t}: the θ-scheme with θ = {} is only conditionally stable; use θ ≥ 0.5 or a smaller time.dt",
-                time.theta
-            )));
-        }
-    }
-
-    phase("post-processing");
-    let post = Instant::now();
-    let dim = history.degree;
+    let dim = if heat.at(time.start).location() == crate::diffusion::Location::Nodal {
+        0
+    } else {
+        complex.dim()
+    };
     let points = super::field_points(complex, dim);
     let weights = if dim == 0 {
         lumped_vertex_volumes(complex)
@@ -116,34 +112,90 @@ pub(super) fn solve(
         complex.measure(dim).to_vec()
     };
     let exact = case.exact.as_ref().and_then(|e| e.solution.as_ref());
-    let mut series = Vec::with_capacity(history.times.len());
+    let method = spec.method.name();
+    // The fields of each level are made as it completes, so that they can
+    // be written while the run goes on.
+    let mut series = Vec::new();
     let mut level_errors = Vec::new();
-    for (&t, u) in history.times.iter().zip(&history.fields) {
-        let mut fields = vec![Field {
-            name: "u".into(),
-            dim,
-            values: u.clone(),
-            description: "the temperature".into(),
-        }];
-        if let Some(solution) = exact {
-            let exact_values: Vec<f64> = points.iter().map(|x| solution.eval(x, t)).collect();
-            let (difference, l2, max) = super::weighted_errors(u, &exact_values, &weights);
-            level_errors.push((t, l2, max));
-            fields.push(Field {
-                name: "u_exact".into(),
-                dim,
-                values: exact_values,
-                description: "the exact solution at the unknowns' points".into(),
-            });
-            fields.push(Field {
-                name: "error".into(),
-                dim,
-                values: difference,
-                description: "u − u_exact".into(),
-            });
+    let mut post_seconds = 0.0;
+    let mut stream_seconds = 0.0;
+    // Progress on long runs: at most ~100 updates, each a phase message.
+    let report_every = (time.steps / 100).max(1);
+    let history = heat
+        .run_observed(
+            complex,
+            &initial,
+            time.steps,
+            time.save_every,
+            &mut |event| match event {
+                HeatEvent::Level {
+                    time: t, field: u, ..
+                } => {
+                    let post = Instant::now();
+                    let mut fields = vec![Field {
+                        name: "u".into(),
+                        dim,
+                        values: u.to_vec(),
+                        description: "the temperature".into(),
+                    }];
+                    if let Some(solution) = exact {
+                        let exact_values: Vec<f64> =
+                            points.iter().map(|x| solution.eval(x, t)).collect();
+                        let (difference, l2, max) =
+                            super::weighted_errors(u, &exact_values, &weights);
+                        level_errors.push((t, l2, max));
+                        fields.push(Field {
+                            name: "u_exact".into(),
+                            dim,
+                            values: exact_values,
+                            description: "the exact solution at the unknowns' points".into(),
+                        });
+                        fields.push(Field {
+                            name: "error".into(),
+                            dim,
+                            values: difference,
+                            description: "u − u_exact".into(),
+                        });
+                    }
+                    post_seconds += post.elapsed().as_secs_f64();
+                    if let Some(stream) = stream.as_deref_mut() {
+                        let writing = Instant::now();
+                        stream.level(complex, t, &fields, Some(method), phase);
+                        stream_seconds += writing.elapsed().as_secs_f64();
+                    }
+                    series.push((t, fields));
+                }
+                HeatEvent::Step(step) => {
+                    if step % report_every == 0 || step == time.steps {
+                        let saved = stream
+                            .as_deref()
+                            .and_then(|s| s.partial())
+                            .filter(|p| !p.is_empty())
+                            .map(|p| format!(", completed levels in {}", p.xdmf().display()))
+                            .unwrap_or_default();
+                        phase(&format!(
+                            "time step {step}/{} (t = {:.6}){saved}",
+                            time.steps,
+                            time.start + step as f64 * time.dt
+                        ));
+                    }
+                }
+            },
+        )
+        .map_err(|e| run_error(e, time.theta))?;
+    let total = started.elapsed().as_secs_f64();
+    for (t, field) in history.times.iter().zip(&history.fields) {
+        if let Some(i) = field.iter().position(|v| !v.is_finite()) {
+            return Err(RunError::Solve(unstable(
+                &format!("at unknown {i}"),
+                *t,
+                time.theta,
+            )));
         }
-        series.push((t, fields));
     }
+
+    phase("post-processing");
+    let post = Instant::now();
     let errors = level_errors.last().map(|&(_, l2, max)| Errors {
         l2,
         max,
@@ -180,15 +232,21 @@ pub(super) fn solve(
             1e3 * history.solve_seconds_per_step,
         ),
     )];
-    let timings = vec![
+    let mut timings = vec![
         ("factorisation".to_string(), history.factorization_seconds),
         (
             "time stepping".to_string(),
             history.seconds_per_step * history.steps as f64,
         ),
-        ("post-processing".to_string(), post.elapsed().as_secs_f64()),
+        (
+            "post-processing".to_string(),
+            post_seconds + post.elapsed().as_secs_f64(),
+        ),
         ("assembly + stepping".to_string(), total),
     ];
+    if stream.is_some() {
+        timings.insert(3, ("partial output".to_string(), stream_seconds));
+    }
     Ok(RunResult {
         problem: "heat".into(),
         method: Some(spec.method.name().into()),
