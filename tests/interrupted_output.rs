@@ -1,7 +1,8 @@
 //! An interrupted run leaves no output under its final names: `hasse run`
 //! is killed (SIGKILL, then SIGINT) while it writes the HDF5 file, which it
 //! writes under a temporary name and renames only when complete. After the
-//! kill, no `out.h5` / `out.xdmf` exists; a new run then succeeds.
+//! kill, no `out.h5` / `out.xdmf` exists; a new run then succeeds and
+//! removes the temporaries the killed runs left.
 //!
 //! A transient (heat) run also writes each saved level as it completes to
 //! `out.partial.xdmf` + `out.partial/`: killed after a few levels, those
@@ -51,11 +52,10 @@ fn names(dir: &Path) -> Vec<String> {
 fn interrupt(dir: &Path, signal: &str) {
     let mut child = start(&dir.join("out"));
     let deadline = Instant::now() + Duration::from_secs(120);
+    // This child's own temporary, not one an earlier killed run left.
+    let own = format!(".out.h5.tmp-{}-", child.id());
     let temporary = loop {
-        if let Some(name) = names(dir)
-            .into_iter()
-            .find(|n| n.starts_with(".out.h5.tmp-"))
-        {
+        if let Some(name) = names(dir).into_iter().find(|n| n.starts_with(&own)) {
             break name;
         }
         if let Some(status) = child.try_wait().unwrap() {
@@ -94,12 +94,24 @@ fn a_killed_run_leaves_no_output_and_a_rerun_succeeds() {
     std::fs::create_dir_all(&dir).unwrap();
     interrupt(&dir, "-KILL");
     interrupt(&dir, "-INT");
+    // Each killed run left its h5 temporary, but the second one, once it
+    // started writing, removed the first's (its process was gone): one
+    // remains.
+    let before = names(&dir);
+    assert_eq!(
+        before.iter().filter(|n| n.contains(".tmp-")).count(),
+        1,
+        "temporaries after two killed runs: {before:?}"
+    );
     let status = start(&dir.join("out")).wait().unwrap();
     assert!(status.success());
-    let left = names(&dir);
-    for final_name in ["out.h5", "out.xdmf", "out.edges.xdmf"] {
-        assert!(left.iter().any(|n| n == final_name), "{left:?}");
-    }
+    // The re-run also removed the temporaries of the killed runs, whose
+    // processes are gone.
+    assert_eq!(
+        names(&dir),
+        ["out.edges.xdmf", "out.h5", "out.xdmf"],
+        "files after the re-run"
+    );
     // The complete file opens as HDF5 (signature at offset 0).
     let h5 = std::fs::read(dir.join("out.h5")).unwrap();
     assert_eq!(&h5[..8], b"\x89HDF\r\n\x1a\n");

@@ -500,6 +500,37 @@ fn temporary(path: &Path, tag: &str) -> PathBuf {
     path.with_file_name(format!(".{name}.tmp-{tag}"))
 }
 
+/// Remove temporaries of `finals` left in `dir` by writers that were
+/// killed: those whose tag names a process that no longer runs. Temporaries
+/// of running processes (this one included) are kept, since a concurrent
+/// writer may still rename them. Best effort: without `/proc` nothing is
+/// removed, and a file that cannot be removed is left alone.
+fn remove_orphaned_temporaries(dir: &Path, finals: &[PathBuf]) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefixes: Vec<String> = finals
+        .iter()
+        .filter_map(|f| f.file_name())
+        .map(|name| format!(".{}.tmp-", name.to_string_lossy()))
+        .collect();
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(tag) = prefixes.iter().find_map(|p| name.strip_prefix(p.as_str())) else {
+            continue;
+        };
+        let Some(pid) = tag.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
 /// Whether a file name is one of [`temporary`]'s.
 fn is_temporary(name: &str) -> bool {
     name.starts_with('.') && name.contains(".tmp-")
@@ -570,6 +601,13 @@ fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError
     let mut finals = vec![final_h5.clone()];
     finals.extend(documents.iter().map(|(path, _)| path.clone()));
     let mut temps = Temporaries(finals.iter().map(|path| temporary(path, &tag)).collect());
+    let mut known = finals.clone();
+    known.extend(
+        LOWER_GRID_NAMES
+            .iter()
+            .map(|grid| dir.join(format!("{file_name}.{grid}.xdmf"))),
+    );
+    remove_orphaned_temporaries(&dir, &known);
 
     hdf5_file::write(&temps.0[0], levels, &grids, &rfc3339_now())?;
     for (path, (_, text)) in temps.0[1..].iter().zip(&documents) {
