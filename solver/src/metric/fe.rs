@@ -369,25 +369,36 @@ impl<'a> Topology<'a> {
     fn tensor_order(&self, c: usize) -> Option<Vec<usize>> {
         let vertices = self.complex.cell_vertices(self.n, c);
         let m = vertices.len();
-        if m != 1 << self.n || self.n < 2 {
+        if m != 1 << self.n || self.n < 2 || self.n > 3 {
             return None;
         }
         let edges = self.edges_of(c);
         if edges.len() != self.n * m / 2 {
             return None;
         }
-        let mut adjacent = vec![Vec::with_capacity(self.n); m];
-        for &e in &edges {
+        // At most 8 corners with 3 neighbours each: fixed arrays, since this
+        // runs for every cell of a Q1 mesh (stiffness and load).
+        let mut adjacent = [[0usize; 3]; 8];
+        let mut degree = [0usize; 8];
+        let mut ends = [(0usize, 0usize); 12];
+        for (k, &e) in edges.iter().enumerate() {
             let (a, b) = self.local_ends(e, vertices, c).ok()?;
-            adjacent[a].push(b);
-            adjacent[b].push(a);
+            ends[k] = (a, b);
+            for (x, y) in [(a, b), (b, a)] {
+                if degree[x] == self.n {
+                    return None;
+                }
+                adjacent[x][degree[x]] = y;
+                degree[x] += 1;
+            }
         }
-        if adjacent.iter().any(|a| a.len() != self.n) {
+        if degree[..m].iter().any(|&g| g != self.n) {
             return None;
         }
+        let neighbours = |x: usize| &adjacent[x][..self.n];
         let mut order = vec![usize::MAX; m];
         order[0] = 0;
-        for (axis, &b) in adjacent[0].iter().enumerate() {
+        for (axis, &b) in neighbours(0).iter().enumerate() {
             order[1 << axis] = b;
         }
         // Increasing index visits every corner after the corners one step
@@ -404,22 +415,21 @@ impl<'a> Topology<'a> {
                 order[l ^ (1 << b)],
                 order[l ^ (1 << a) ^ (1 << b)],
             );
-            order[l] = *adjacent[p]
+            order[l] = *neighbours(p)
                 .iter()
-                .find(|&&x| x != back && adjacent[q].contains(&x))?;
+                .find(|&&x| x != back && neighbours(q).contains(&x))?;
         }
-        let mut seen = vec![false; m];
+        let mut seen = [false; 8];
         for &o in &order {
             if std::mem::replace(&mut seen[o], true) {
                 return None;
             }
         }
-        let mut slot = vec![0usize; m];
+        let mut slot = [0usize; 8];
         for (l, &o) in order.iter().enumerate() {
             slot[o] = l;
         }
-        for &e in &edges {
-            let (a, b) = self.local_ends(e, vertices, c).ok()?;
+        for &(a, b) in &ends[..edges.len()] {
             if (slot[a] ^ slot[b]).count_ones() != 1 {
                 return None;
             }
