@@ -254,9 +254,12 @@ pub struct Canonical {
 struct LocalPattern {
     /// Block b's row-side unknowns are `unknowns[ptr[b]..ptr[b] + rows[b]]`
     /// and its column-side unknowns the rest up to `ptr[b + 1]`, each
-    /// sorted and distinct.
+    /// sorted and distinct; when `shared[b]` (the block's row and column
+    /// sets are the same rows of A, as in every symmetric metric) the one
+    /// list `unknowns[ptr[b]..ptr[b + 1]]` is both.
     ptr: Vec<usize>,
     rows: Vec<usize>,
+    shared: Vec<bool>,
     unknowns: Vec<usize>,
     /// Positions in M's value array of every local entry, block after
     /// block, each block row-major (row side × column side).
@@ -281,19 +284,23 @@ impl LocalPattern {
     /// The local unknown sets of every block, in block order.
     fn new(incidence: &CsMat<i8>, metric: &BlockMetric) -> Self {
         let row = |r: usize| &incidence.indices()[incidence.indptr().outer_inds_sz(r)];
-        let chunks: Vec<(Vec<usize>, Vec<usize>, Vec<usize>)> = ranges(metric.block_count())
+        type Chunk = (Vec<usize>, Vec<bool>, Vec<usize>, Vec<usize>);
+        let chunks: Vec<Chunk> = ranges(metric.block_count())
             .into_par_iter()
             .map(|range| {
                 let (first, last) = (range.start, range.end);
                 let mut rows = Vec::with_capacity(last - first);
+                let mut shared = Vec::with_capacity(last - first);
                 let mut lengths = Vec::with_capacity(last - first);
                 let mut unknowns = Vec::new();
                 for b in first..last {
                     let (r, s, _) = metric.block(b);
                     let start = unknowns.len();
-                    for (k, side) in [r, s].into_iter().enumerate() {
+                    let same = r == s;
+                    let sides: &[&[usize]] = if same { &[r] } else { &[r, s] };
+                    for (k, side) in sides.iter().enumerate() {
                         let begin = unknowns.len();
-                        for &x in side {
+                        for &x in *side {
                             unknowns.extend_from_slice(row(x));
                         }
                         unknowns[begin..].sort_unstable();
@@ -302,20 +309,23 @@ impl LocalPattern {
                             rows.push(distinct);
                         }
                     }
+                    shared.push(same);
                     lengths.push(unknowns.len() - start);
                 }
-                (rows, lengths, unknowns)
+                (rows, shared, lengths, unknowns)
             })
             .collect();
         let mut pattern = Self {
             ptr: Vec::with_capacity(metric.block_count() + 1),
             rows: Vec::with_capacity(metric.block_count()),
-            unknowns: Vec::with_capacity(chunks.iter().map(|c| c.2.len()).sum()),
+            shared: Vec::with_capacity(metric.block_count()),
+            unknowns: Vec::with_capacity(chunks.iter().map(|c| c.3.len()).sum()),
             scatter: Vec::new(),
         };
         pattern.ptr.push(0);
-        for (rows, lengths, unknowns) in chunks {
+        for (rows, shared, lengths, unknowns) in chunks {
             pattern.rows.extend_from_slice(&rows);
+            pattern.shared.extend_from_slice(&shared);
             for l in lengths {
                 let end = pattern.ptr[pattern.ptr.len() - 1] + l;
                 pattern.ptr.push(end);
@@ -332,6 +342,10 @@ impl LocalPattern {
     /// Row-side and column-side unknowns of block b.
     fn sides(&self, b: usize) -> (&[usize], &[usize]) {
         let start = self.ptr[b];
+        if self.shared[b] {
+            let both = &self.unknowns[start..self.ptr[b + 1]];
+            return (both, both);
+        }
         let middle = start + self.rows[b];
         (
             &self.unknowns[start..middle],
@@ -512,6 +526,24 @@ impl Canonical {
             let (rows, cols, w) = self.metric.block(b);
             let (left, right) = local.sides(b);
             let (p, q) = (left.len(), right.len());
+            if let ([r], [s]) = (rows, cols) {
+                // One row pair (a diagonal Ω, a face of a two-point flux):
+                // when A's rows list their unknowns as the local lists do
+                // (sorted, distinct), the local matrix is the outer
+                // product a_r w a_sᵀ, with no position searches.
+                let ((ur, ar), (us, as_)) = (row(*r), row(*s));
+                if ur == left && us == right {
+                    let places = &local.scatter[k..k + p * q];
+                    for (i, &x) in ar.iter().enumerate() {
+                        let wx = w[0] * f64::from(x);
+                        for (j, &y) in as_.iter().enumerate() {
+                            values[places[i * q + j]] += wx * f64::from(y);
+                        }
+                    }
+                    k += p * q;
+                    continue;
+                }
+            }
             half.clear();
             half.resize(rows.len() * q, 0.0);
             for (si, &s) in cols.iter().enumerate() {
