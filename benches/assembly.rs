@@ -18,7 +18,7 @@
 //! `--bench` (as under `cargo test --all-targets`) it runs small sizes and
 //! checks the hand-built matrix against hasse's.
 
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::SparseColMat;
 use hasse_complex::{generate, Complex};
 use hasse_solver::canonical::Canonical;
 use hasse_solver::diffusion::{BoundaryKind, Conductivity, Diffusion, Method};
@@ -27,50 +27,9 @@ use hasse_solver::metric::{fe, fv, isotropic};
 use std::sync::Arc;
 use std::time::Instant;
 
-fn seconds(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64()
-}
-
-fn peak_memory_gib() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
-                l.split_whitespace()
-                    .nth(1)
-                    .and_then(|v| v.parse::<f64>().ok())
-            })
-        })
-        .map_or(f64::NAN, |kib| kib / (1024.0 * 1024.0))
-}
-
-/// The cell-centred operator with Dirichlet ghosts on an n^d unit grid
-/// (λ = 1): |F|/h between cells, 2|F|/h on boundary faces.
-fn plain_matrix(n: usize, d: usize) -> SparseColMat<usize, f64> {
-    let h = 1.0 / n as f64;
-    let face = h.powi(d as i32 - 1);
-    let interior = face / h;
-    let boundary = 2.0 * face / h;
-    let cells = n.pow(d as u32);
-    let stride: Vec<usize> = (0..d).map(|a| n.pow(a as u32)).collect();
-    let mut triplets = Vec::with_capacity(cells * (2 * d + 1));
-    for c in 0..cells {
-        let mut diagonal = 0.0;
-        for &step in &stride {
-            let i = (c / step) % n;
-            for (exists, other) in [(i > 0, c.wrapping_sub(step)), (i + 1 < n, c + step)] {
-                if exists {
-                    triplets.push(Triplet::new(c, other, -interior));
-                    diagonal += interior;
-                } else {
-                    diagonal += boundary;
-                }
-            }
-        }
-        triplets.push(Triplet::new(c, c, diagonal));
-    }
-    SparseColMat::try_new_from_triplets(cells, cells, &triplets).expect("valid triplets")
-}
+#[path = "common/measure.rs"]
+mod measure;
+use measure::{peak_memory_gib, plain_matrix, seconds};
 
 fn poisson(method: Method) -> Diffusion {
     Diffusion::new(

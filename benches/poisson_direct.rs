@@ -17,52 +17,9 @@ use hasse_solver::linear::{DirectSolver, Factorization};
 use hasse_solver::metric::{fe, fv, isotropic};
 use std::time::Instant;
 
-fn seconds(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64()
-}
-
-fn peak_memory_gib() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines().find(|l| l.starts_with("VmHWM:")).and_then(|l| {
-                l.split_whitespace()
-                    .nth(1)
-                    .and_then(|v| v.parse::<f64>().ok())
-            })
-        })
-        .map_or(f64::NAN, |kib| kib / (1024.0 * 1024.0))
-}
-
-/// The cell-centred 5/7-point operator on an n^d unit grid with Dirichlet
-/// ghosts, as TPFA gives it (λ = 1): faces |F|/h between cells, 2|F|/h at
-/// the boundary. Built without hasse.
-fn plain_matrix(n: usize, d: usize) -> SparseColMat<usize, f64> {
-    let h = 1.0 / n as f64;
-    let face = h.powi(d as i32 - 1);
-    let interior = face / h;
-    let boundary = 2.0 * face / h;
-    let cells = n.pow(d as u32);
-    let stride: Vec<usize> = (0..d).map(|a| n.pow(a as u32)).collect();
-    let mut triplets = Vec::with_capacity(cells * (2 * d + 1));
-    for c in 0..cells {
-        let mut diagonal = 0.0;
-        for &step in &stride {
-            let i = (c / step) % n;
-            for (neighbour_exists, other) in [(i > 0, c.wrapping_sub(step)), (i + 1 < n, c + step)]
-            {
-                if neighbour_exists {
-                    triplets.push(Triplet::new(c, other, -interior));
-                    diagonal += interior;
-                } else {
-                    diagonal += boundary;
-                }
-            }
-        }
-        triplets.push(Triplet::new(c, c, diagonal));
-    }
-    SparseColMat::try_new_from_triplets(cells, cells, &triplets).expect("valid triplets")
-}
+#[path = "common/measure.rs"]
+mod measure;
+use measure::{peak_memory_gib, plain_matrix, seconds};
 
 fn factor_and_solve(matrix: &SparseColMat<usize, f64>) -> (f64, f64, f64, Vec<f64>) {
     let rhs = vec![1.0; matrix.nrows()];
