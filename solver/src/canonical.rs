@@ -267,8 +267,8 @@ struct LocalPattern {
 }
 
 /// `0..count` cut into a few contiguous ranges per thread, in order. Few
-/// large tasks keep the per-task buffers (a column marker of n entries, an
-/// output vector) few, since every fresh page of them costs a page fault;
+/// large tasks keep the per-task output vectors few, since every fresh
+/// page of them costs a page fault;
 /// the results are concatenated in range order, so they do not depend on
 /// the thread count.
 fn ranges(count: usize) -> Vec<std::ops::Range<usize>> {
