@@ -73,11 +73,11 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
     let t = Instant::now();
     let (incidence, metric) = match method {
         Method::Fv => (
-            complex.boundary(d).clone(),
+            complex.shared_boundary(d),
             fv::two_point(complex, &tensors).expect("metric"),
         ),
         _ => (
-            complex.coboundary(0),
+            Arc::new(complex.coboundary(0)),
             fe::stiffness_metric(complex, &tensors).expect("metric"),
         ),
     };

@@ -15,6 +15,7 @@ use hasse_complex::{generate, Complex};
 use hasse_solver::canonical::Canonical;
 use hasse_solver::linear::{DirectSolver, Factorization};
 use hasse_solver::metric::{fe, fv, isotropic};
+use std::sync::Arc;
 use std::time::Instant;
 
 #[path = "common/measure.rs"]
@@ -41,11 +42,11 @@ fn run(label: &str, complex: &Complex, n: usize, method: &str) {
     let tensors = vec![isotropic(1.0); cells];
     let (incidence, metric) = match method {
         "fv" => (
-            complex.boundary(d).clone(),
+            complex.shared_boundary(d),
             fv::two_point(complex, &tensors).expect("metric"),
         ),
         _ => (
-            complex.coboundary(0),
+            Arc::new(complex.coboundary(0)),
             fe::stiffness_metric(complex, &tensors).expect("metric"),
         ),
     };

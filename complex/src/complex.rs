@@ -10,7 +10,7 @@ use crate::tags::{CellTag, Tags};
 use rayon::prelude::*;
 use sprs::{CsMat, TriMat};
 use std::collections::VecDeque;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// An oriented cell complex of dimension n embedded in R^d (n ≤ d ≤ 3).
 ///
@@ -33,7 +33,8 @@ use std::sync::OnceLock;
 #[derive(Clone, Debug)]
 pub struct Complex {
     lar: Lar,
-    boundaries: Vec<CsMat<i8>>,
+    /// Shared, so that operators built on ∂_p use it in place.
+    boundaries: Vec<Arc<CsMat<i8>>>,
     top_orientation: Vec<i8>,
     tags: Tags,
     stars: Vec<OnceLock<CsMat<u8>>>,
@@ -117,7 +118,7 @@ impl Complex {
         Ok(Self {
             stars: (0..=n).map(|_| OnceLock::new()).collect(),
             lar,
-            boundaries,
+            boundaries: boundaries.into_iter().map(Arc::new).collect(),
             top_orientation,
             tags: Tags::default(),
             geometry: Default::default(),
@@ -137,7 +138,7 @@ impl Complex {
         Self {
             stars: (0..=lar.dim()).map(|_| OnceLock::new()).collect(),
             lar,
-            boundaries,
+            boundaries: boundaries.into_iter().map(Arc::new).collect(),
             top_orientation,
             tags,
             geometry: Default::default(),
@@ -207,6 +208,11 @@ impl Complex {
         &self.boundaries[p - 1]
     }
 
+    /// ∂_p, shared with the complex (no copy), for operators that keep it.
+    pub fn shared_boundary(&self, p: usize) -> Arc<CsMat<i8>> {
+        Arc::clone(&self.boundaries[p - 1])
+    }
+
     /// ∂_p, or an error naming the valid range.
     pub fn try_boundary(&self, p: usize) -> Result<&CsMat<i8>> {
         if p == 0 || p > self.dim() {
@@ -246,7 +252,9 @@ impl Complex {
 
     /// Betti numbers over the chosen field.
     pub fn betti_numbers_over(&self, field: Field) -> Vec<usize> {
-        homology::betti_numbers(&self.cell_counts(), &self.boundaries, field)
+        // The reduction costs far more than this copy of ∂_p.
+        let boundaries: Vec<CsMat<i8>> = self.boundaries.iter().map(|b| (**b).clone()).collect();
+        homology::betti_numbers(&self.cell_counts(), &boundaries, field)
     }
 
     /// The Hasse matrix H(K): one block-bidiagonal sparse matrix holding

@@ -7,15 +7,19 @@
 //! cell's edges, a user-given sparse Ω one 1×1 block per entry.
 //!
 //! Assembly is split like a sparse factorisation: the sparsity pattern of
-//! M and a scatter map from every entry of each block's local matrix
-//! A_{R_b}ᵀ W_b A_{S_b} to its place in M are built once
-//! ([`Canonical::new`]); numeric assembly ([`Canonical::assemble`]) is then
-//! one pass over the blocks, and can be repeated with new values of the
-//! same pattern ([`Canonical::set_metric`]).
+//! M, and how values reach it, are built once ([`Canonical::new`]);
+//! numeric assembly ([`Canonical::assemble`]) can then be repeated with new
+//! values of the same pattern ([`Canonical::set_metric`]). For a general Ω
+//! each block's local matrix A_{R_b}ᵀ W_b A_{S_b} is scattered into M
+//! through a map built with the pattern. For a diagonal Ω (two-point
+//! fluxes, diagonal Hodge stars) no map is kept: column j of M is
+//! Σ_r w_r a_rj A_r over the rows of A touching j, formed column by column
+//! in parallel from A stored by columns.
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
 use sprs::CsMat;
+use std::sync::Arc;
 
 /// Errors in building a canonical operator.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -60,6 +64,11 @@ struct Block {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BlockMetric {
     size: usize,
+    /// Empty while Ω is diagonal in row order, block b being the 1×1
+    /// block (b, b) (two-point fluxes, diagonal Hodge stars): then
+    /// `indices` is 0..k and `values` the k weights, 16 bytes a row instead
+    /// of 64 with a block record. The first block that breaks the pattern
+    /// writes the records of the earlier ones.
     blocks: Vec<Block>,
     indices: Vec<usize>,
     values: Vec<f64>,
@@ -76,14 +85,24 @@ impl BlockMetric {
 
     /// Ω = diag(values).
     pub fn diagonal(values: &[f64]) -> Self {
-        let mut m = Self::new(values.len());
-        m.blocks.reserve(values.len());
-        m.indices.reserve(values.len());
-        m.values.reserve(values.len());
-        for (r, &v) in values.iter().enumerate() {
-            m.push_block(&[r], &[r], &[v]);
+        Self::from_weights(values.to_vec())
+    }
+
+    /// Ω = diag(weights), taking the vector.
+    pub fn from_weights(weights: Vec<f64>) -> Self {
+        Self {
+            size: weights.len(),
+            blocks: Vec::new(),
+            indices: (0..weights.len()).collect(),
+            values: weights,
         }
-        m
+    }
+
+    /// The weights w when Ω = diag(w) with block b the 1×1 block (b, b)
+    /// for b < w.len() (rows beyond have no block); `None` for any other
+    /// layout of blocks.
+    pub fn diagonal_weights(&self) -> Option<&[f64]> {
+        self.blocks.is_empty().then_some(&self.values[..])
     }
 
     /// Ω from entries (row, column, value); repeated positions add up.
@@ -97,6 +116,24 @@ impl BlockMetric {
 
     /// Add the block W (|rows| × |cols|, row-major) at rows × cols.
     pub fn push_block(&mut self, rows: &[usize], cols: &[usize], values: &[f64]) {
+        if self.blocks.is_empty() {
+            let next = self.values.len();
+            if let ([r], [c], [v]) = (rows, cols, values) {
+                if *r == next && *c == next {
+                    self.indices.push(next);
+                    self.values.push(*v);
+                    return;
+                }
+            }
+            // Rows and columns of a diagonal block share its one index.
+            self.blocks = (0..next)
+                .map(|b| Block {
+                    rows: (b, 1),
+                    cols: (b, 1),
+                    values: b,
+                })
+                .collect();
+        }
         let r0 = self.indices.len();
         self.indices.extend_from_slice(rows);
         let c0 = self.indices.len();
@@ -127,11 +164,19 @@ impl BlockMetric {
 
     /// Number of blocks.
     pub fn block_count(&self) -> usize {
-        self.blocks.len()
+        if self.blocks.is_empty() {
+            self.values.len()
+        } else {
+            self.blocks.len()
+        }
     }
 
     /// Rows, columns and values of block `b`.
     pub fn block(&self, b: usize) -> (&[usize], &[usize], &[f64]) {
+        if self.blocks.is_empty() {
+            let index = &self.indices[b..b + 1];
+            return (index, index, &self.values[b..b + 1]);
+        }
         let block = &self.blocks[b];
         let rows = &self.indices[block.rows.0..block.rows.0 + block.rows.1];
         let cols = &self.indices[block.cols.0..block.cols.0 + block.cols.1];
@@ -141,6 +186,9 @@ impl BlockMetric {
 
     /// Mutable values of block `b` (row-major).
     pub fn block_values_mut(&mut self, b: usize) -> &mut [f64] {
+        if self.blocks.is_empty() {
+            return &mut self.values[b..b + 1];
+        }
         let block = &self.blocks[b];
         let len = block.rows.1 * block.cols.1;
         &mut self.values[block.values..block.values + len]
@@ -149,6 +197,12 @@ impl BlockMetric {
     /// Ω x.
     pub fn apply(&self, x: &[f64]) -> Vec<f64> {
         let mut y = vec![0.0; self.size];
+        if let Some(w) = self.diagonal_weights() {
+            for ((y, w), x) in y.iter_mut().zip(w).zip(x) {
+                *y = w * x;
+            }
+            return y;
+        }
         for b in 0..self.blocks.len() {
             let (rows, cols, w) = self.block(b);
             for (i, &r) in rows.iter().enumerate() {
@@ -165,7 +219,7 @@ impl BlockMetric {
     /// Ω as a dense matrix (for tests and small problems).
     pub fn to_dense(&self) -> Vec<Vec<f64>> {
         let mut d = vec![vec![0.0; self.size]; self.size];
-        for b in 0..self.blocks.len() {
+        for b in 0..self.block_count() {
             let (rows, cols, w) = self.block(b);
             for (i, &r) in rows.iter().enumerate() {
                 for (j, &s) in cols.iter().enumerate() {
@@ -180,18 +234,34 @@ impl BlockMetric {
     /// symmetric to `tolerance` relative to its largest entry. This is a
     /// sufficient condition for Ω (and so Aᵀ Ω A) to be symmetric.
     pub fn is_symmetric(&self, tolerance: f64) -> bool {
-        (0..self.blocks.len()).all(|b| {
-            let (rows, cols, w) = self.block(b);
-            if rows != cols {
-                return false;
-            }
-            let k = rows.len();
-            let scale = w.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            (0..k).all(|i| (0..i).all(|j| (w[i * k + j] - w[j * k + i]).abs() <= tolerance * scale))
-        })
+        self.blocks.is_empty()
+            || (0..self.blocks.len()).all(|b| {
+                let (rows, cols, w) = self.block(b);
+                if rows != cols {
+                    return false;
+                }
+                let k = rows.len();
+                let scale = w.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                (0..k).all(|i| {
+                    (0..i).all(|j| (w[i * k + j] - w[j * k + i]).abs() <= tolerance * scale)
+                })
+            })
     }
 
     fn validate(&self) -> Result<(), CanonicalError> {
+        if let Some(w) = self.diagonal_weights() {
+            if w.len() > self.size {
+                return Err(CanonicalError::RowOutOfRange {
+                    block: self.size,
+                    row: self.size,
+                    size: self.size,
+                });
+            }
+            return match w.iter().position(|v| !v.is_finite()) {
+                Some(block) => Err(CanonicalError::NonFinite { block }),
+                None => Ok(()),
+            };
+        }
         for b in 0..self.blocks.len() {
             let (rows, cols, w) = self.block(b);
             if let Some(&row) = rows.iter().chain(cols).find(|&&r| r >= self.size) {
@@ -235,12 +305,69 @@ impl BlockMetric {
 /// ```
 #[derive(Clone, Debug)]
 pub struct Canonical {
-    incidence: CsMat<i8>,
+    /// Shared, so that a boundary matrix of the complex is used in place.
+    incidence: Arc<CsMat<i8>>,
     metric: BlockMetric,
     symbolic: SymbolicSparseColMat<usize>,
-    /// Where each block's local matrix goes in M (boxed: it is large and
-    /// `Canonical` sits in enums next to small variants).
-    local: Box<LocalPattern>,
+    /// How values reach M (boxed: it is large and `Canonical` sits in
+    /// enums next to small variants).
+    assembly: Box<Assembly>,
+}
+
+/// The two ways of forming M's values.
+#[derive(Clone, Debug)]
+enum Assembly {
+    /// Ω diagonal in row order: column j of M is Σ_r w_r a_rj A_r over
+    /// the rows r of A that touch j, each column formed on its own.
+    Diagonal(Columns),
+    /// Any blocks: each block's dense local matrix scattered into M.
+    Blocks(LocalPattern),
+}
+
+/// A by columns: the rows of A (with a metric block) that touch each
+/// unknown, in increasing order, and their signs.
+#[derive(Clone, Debug)]
+struct Columns {
+    ptr: Vec<usize>,
+    rows: Vec<usize>,
+    signs: Vec<i8>,
+}
+
+impl Columns {
+    /// Rows `0..rows` of the CSR matrix `a`, by columns.
+    fn new(a: &CsMat<i8>, rows: usize) -> Self {
+        let n = a.cols();
+        let end = a.indptr().index(rows) - a.indptr().index(0);
+        let mut ptr = vec![0usize; n + 1];
+        for &j in &a.indices()[..end] {
+            ptr[j + 1] += 1;
+        }
+        for j in 0..n {
+            ptr[j + 1] += ptr[j];
+        }
+        let mut next = ptr[..n].to_vec();
+        let mut by_column = vec![0usize; end];
+        let mut signs = vec![0i8; end];
+        for r in 0..rows {
+            let range = a.indptr().outer_inds_sz(r);
+            for (&j, &sign) in a.indices()[range.clone()].iter().zip(&a.data()[range]) {
+                by_column[next[j]] = r;
+                signs[next[j]] = sign;
+                next[j] += 1;
+            }
+        }
+        Self {
+            ptr,
+            rows: by_column,
+            signs,
+        }
+    }
+
+    /// The rows touching unknown j and their signs.
+    fn column(&self, j: usize) -> (&[usize], &[i8]) {
+        let range = self.ptr[j]..self.ptr[j + 1];
+        (&self.rows[range.clone()], &self.signs[range])
+    }
 }
 
 /// Block b of Ω touches only the unknowns in the columns of A's rows R_b
@@ -376,34 +503,11 @@ impl LocalPattern {
             }
         }
         drop(next);
-        // A column's candidates are few (a vertex's cells times their
-        // vertices), so sorting them beats an n-sized marker per task.
-        let parts: Vec<(Vec<usize>, Vec<usize>)> = ranges(n)
-            .into_par_iter()
-            .map(|range| {
-                let mut counts = Vec::with_capacity(range.len());
-                let mut rows = Vec::new();
-                for j in range {
-                    let begin = rows.len();
-                    for &b in &blocks_of[block_ptr[j]..block_ptr[j + 1]] {
-                        rows.extend_from_slice(self.sides(b).0);
-                    }
-                    rows[begin..].sort_unstable();
-                    counts.push(dedup_tail(&mut rows, begin));
-                }
-                (counts, rows)
-            })
-            .collect();
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        col_ptr.push(0);
-        let mut row_idx = Vec::with_capacity(parts.iter().map(|p| p.1.len()).sum());
-        for (counts, rows) in parts {
-            for c in counts {
-                col_ptr.push(col_ptr[col_ptr.len() - 1] + c);
+        pattern_by_columns(n, |j, rows| {
+            for &b in &blocks_of[block_ptr[j]..block_ptr[j + 1]] {
+                rows.extend_from_slice(self.sides(b).0);
             }
-            row_idx.extend_from_slice(&rows);
-        }
-        (col_ptr, row_idx)
+        })
     }
 
     /// Fill `scatter` for the pattern (col_ptr, row_idx).
@@ -431,6 +535,72 @@ impl LocalPattern {
     }
 }
 
+/// The pattern (column pointers, row indices) of an n-column matrix whose
+/// column j holds the rows `candidates(j, out)` appends to `out` (repeats
+/// allowed), sorted within each column. A column's candidates are few (a
+/// vertex's cells times their vertices), so sorting them in a small
+/// scratch vector beats an n-sized marker per task. The columns are
+/// counted first and then written straight into the one row array: fresh
+/// pages cost a fault each on this kind of machine, and a second copy of
+/// the pattern would cost as much as the sorting.
+fn pattern_by_columns(
+    n: usize,
+    candidates: impl Fn(usize, &mut Vec<usize>) + Sync,
+) -> (Vec<usize>, Vec<usize>) {
+    let distinct = |j: usize, scratch: &mut Vec<usize>| {
+        scratch.clear();
+        candidates(j, scratch);
+        scratch.sort_unstable();
+        scratch.dedup();
+    };
+    let parts = ranges(n);
+    let mut col_ptr = vec![0usize; n + 1];
+    let counts = split_at_ranges(&mut col_ptr[1..], &parts, |j| j);
+    parts
+        .par_iter()
+        .zip(counts)
+        .for_each_init(Vec::new, |scratch, (range, counts)| {
+            for (j, count) in range.clone().zip(counts) {
+                distinct(j, scratch);
+                *count = scratch.len();
+            }
+        });
+    for j in 0..n {
+        col_ptr[j + 1] += col_ptr[j];
+    }
+    let mut row_idx = vec![0usize; col_ptr[n]];
+    let columns = split_at_ranges(&mut row_idx, &parts, |j| col_ptr[j]);
+    parts
+        .par_iter()
+        .zip(columns)
+        .for_each_init(Vec::new, |scratch, (range, out)| {
+            let base = col_ptr[range.start];
+            for j in range.clone() {
+                distinct(j, scratch);
+                out[col_ptr[j] - base..col_ptr[j + 1] - base].copy_from_slice(scratch);
+            }
+        });
+    (col_ptr, row_idx)
+}
+
+/// `data` cut at `offset(range.start)` of each of the consecutive `parts`
+/// (offsets relative to the first part's start), one piece per part, so
+/// that parts can be filled in parallel.
+fn split_at_ranges<'a, T>(
+    data: &'a mut [T],
+    parts: &[std::ops::Range<usize>],
+    offset: impl Fn(usize) -> usize,
+) -> Vec<&'a mut [T]> {
+    let mut pieces = Vec::with_capacity(parts.len());
+    let mut rest = data;
+    for range in parts {
+        let (head, tail) = rest.split_at_mut(offset(range.end) - offset(range.start));
+        pieces.push(head);
+        rest = tail;
+    }
+    pieces
+}
+
 /// Remove repeated values from the sorted `v[begin..]`; returns how many
 /// distinct values remain there.
 fn dedup_tail(v: &mut Vec<usize>, begin: usize) -> usize {
@@ -448,11 +618,15 @@ fn dedup_tail(v: &mut Vec<usize>, begin: usize) -> usize {
 impl Canonical {
     /// Build the operator and its assembly pattern. `incidence` is A
     /// (rows: metric rows, columns: unknowns), exact integers.
-    pub fn new(incidence: CsMat<i8>, metric: BlockMetric) -> Result<Self, CanonicalError> {
+    pub fn new(
+        incidence: impl Into<Arc<CsMat<i8>>>,
+        metric: BlockMetric,
+    ) -> Result<Self, CanonicalError> {
+        let incidence = incidence.into();
         let incidence = if incidence.is_csr() {
             incidence
         } else {
-            incidence.to_csr()
+            Arc::new(incidence.to_csr())
         };
         if metric.size() != incidence.rows() {
             return Err(CanonicalError::SizeMismatch {
@@ -462,15 +636,30 @@ impl Canonical {
         }
         metric.validate()?;
         let n = incidence.cols();
-        let mut local = LocalPattern::new(&incidence, &metric);
-        let (col_ptr, row_idx) = local.matrix_pattern(n);
-        local.locate(&col_ptr, &row_idx);
+        let (assembly, (col_ptr, row_idx)) = match metric.diagonal_weights() {
+            Some(weights) => {
+                let columns = Columns::new(&incidence, weights.len());
+                let a = &*incidence;
+                let pattern = pattern_by_columns(n, |j, out| {
+                    for &r in columns.column(j).0 {
+                        out.extend_from_slice(&a.indices()[a.indptr().outer_inds_sz(r)]);
+                    }
+                });
+                (Assembly::Diagonal(columns), pattern)
+            }
+            None => {
+                let mut local = LocalPattern::new(&incidence, &metric);
+                let pattern = local.matrix_pattern(n);
+                local.locate(&pattern.0, &pattern.1);
+                (Assembly::Blocks(local), pattern)
+            }
+        };
         let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         Ok(Self {
             incidence,
             metric,
             symbolic,
-            local: Box::new(local),
+            assembly: Box::new(assembly),
         })
     }
 
@@ -482,6 +671,11 @@ impl Canonical {
     /// The incidence matrix A.
     pub fn incidence(&self) -> &CsMat<i8> {
         &self.incidence
+    }
+
+    /// The incidence matrix A, shared.
+    pub fn shared_incidence(&self) -> Arc<CsMat<i8>> {
+        Arc::clone(&self.incidence)
     }
 
     /// The metric Ω.
@@ -511,13 +705,55 @@ impl Canonical {
     /// block after block, so the sums (and so the bits) are the same for
     /// any thread count.
     pub fn assemble(&self) -> SparseColMat<usize, f64> {
-        let mut values = vec![0.0; self.nonzeros()];
-        let a = &self.incidence;
-        let row = |r: usize| {
-            let range = a.indptr().outer_inds_sz(r);
-            (&a.indices()[range.clone()], &a.data()[range])
+        let values = match (&*self.assembly, self.metric.diagonal_weights()) {
+            (Assembly::Diagonal(columns), Some(weights)) => self.diagonal_values(columns, weights),
+            (Assembly::Blocks(local), _) => self.block_values(local),
+            // `set_metric` keeps the block layout, and with it the variant.
+            (Assembly::Diagonal(_), None) => unreachable!("a diagonal pattern with a block metric"),
         };
-        let local = &self.local;
+        SparseColMat::new(self.symbolic.clone(), values)
+    }
+
+    /// Row r of A: its unknowns and signs.
+    fn row(&self, r: usize) -> (&[usize], &[i8]) {
+        let a = &*self.incidence;
+        let range = a.indptr().outer_inds_sz(r);
+        (&a.indices()[range.clone()], &a.data()[range])
+    }
+
+    /// M's values for Ω = diag(w), column after column in parallel; entry
+    /// (i, j) sums w_r a_ri a_rj over r in increasing order, whatever the
+    /// thread count.
+    fn diagonal_values(&self, columns: &Columns, weights: &[f64]) -> Vec<f64> {
+        let mut values = vec![0.0; self.nonzeros()];
+        let col_ptr = self.symbolic.col_ptr();
+        let row_idx = self.symbolic.row_idx();
+        let parts = ranges(self.unknowns());
+        let slices = split_at_ranges(&mut values, &parts, |j| col_ptr[j]);
+        parts.into_par_iter().zip(slices).for_each(|(range, out)| {
+            let base = col_ptr[range.start];
+            for j in range {
+                let (first, last) = (col_ptr[j], col_ptr[j + 1]);
+                let column = &row_idx[first..last];
+                let column_values = &mut out[first - base..last - base];
+                let (rows, signs) = columns.column(j);
+                for (&r, &sign) in rows.iter().zip(signs) {
+                    let weight = weights[r] * f64::from(sign);
+                    let (unknowns, row_signs) = self.row(r);
+                    for (&i, &x) in unknowns.iter().zip(row_signs) {
+                        column_values[position(column, i)] += weight * f64::from(x);
+                    }
+                }
+            }
+        });
+        values
+    }
+
+    /// M's values block after block: each block's dense A_Rᵀ W A_S added
+    /// in block order.
+    fn block_values(&self, local: &LocalPattern) -> Vec<f64> {
+        let mut values = vec![0.0; self.nonzeros()];
+        let row = |r: usize| self.row(r);
         // W A_S (|R| × |U_S|) and then A_Rᵀ (W A_S) (|U_R| × |U_S|).
         let mut half = Vec::new();
         let mut dense = Vec::new();
@@ -573,7 +809,7 @@ impl Canonical {
             }
             k += p * q;
         }
-        SparseColMat::new(self.symbolic.clone(), values)
+        values
     }
 
     /// A u: the differences of `u` across every metric row.
@@ -711,6 +947,114 @@ mod tests {
             assert!((mu[i] - row).abs() < 1e-14);
         }
         assert!(!omega.is_symmetric(0.0));
+    }
+
+    #[test]
+    fn a_diagonal_metric_stays_compact_until_a_block_breaks_the_pattern() {
+        let mut omega = BlockMetric::new(3);
+        omega.push_block(&[0], &[0], &[2.0]);
+        omega.push_block(&[1], &[1], &[3.0]);
+        assert_eq!(omega.diagonal_weights(), Some(&[2.0, 3.0][..]));
+        assert_eq!(omega.block_count(), 2);
+        assert_eq!(omega.block(1), (&[1][..], &[1][..], &[3.0][..]));
+        // An off-diagonal block: the earlier blocks get records and keep
+        // their rows, columns and values.
+        omega.push_block(&[2], &[0], &[5.0]);
+        assert_eq!(omega.diagonal_weights(), None);
+        assert_eq!(omega.block_count(), 3);
+        assert_eq!(omega.block(0), (&[0][..], &[0][..], &[2.0][..]));
+        assert_eq!(omega.block(2), (&[2][..], &[0][..], &[5.0][..]));
+        let dense = omega.to_dense();
+        assert_eq!(dense[0], vec![2.0, 0.0, 0.0]);
+        assert_eq!(dense[1], vec![0.0, 3.0, 0.0]);
+        assert_eq!(dense[2], vec![5.0, 0.0, 0.0]);
+        // A block out of row order also ends the compact layout.
+        let mut skipped = BlockMetric::new(3);
+        skipped.push_block(&[1], &[1], &[1.0]);
+        assert_eq!(skipped.diagonal_weights(), None);
+        assert_eq!(skipped.apply(&[1.0, 4.0, 9.0]), vec![0.0, 4.0, 0.0]);
+        // Out-of-range and non-finite diagonal entries are refused by number.
+        let a = CsMat::new((2, 2), vec![0, 1, 3], vec![0, 0, 1], vec![1i8, -1, 1]);
+        let mut long = BlockMetric::diagonal(&[1.0, 1.0]);
+        long.push_block(&[2], &[2], &[1.0]);
+        assert_eq!(
+            Canonical::new(a.clone(), long).err(),
+            Some(CanonicalError::RowOutOfRange {
+                block: 2,
+                row: 2,
+                size: 2
+            })
+        );
+        let mut beyond = BlockMetric::diagonal(&[1.0]);
+        beyond.push_block(&[1], &[1], &[1.0]);
+        beyond.push_block(&[2], &[2], &[1.0]);
+        assert_eq!(beyond.diagonal_weights().map(<[f64]>::len), Some(3));
+        assert_eq!(beyond.size(), 1);
+        assert!(matches!(
+            beyond.validate(),
+            Err(CanonicalError::RowOutOfRange {
+                block: 1,
+                row: 1,
+                size: 1
+            })
+        ));
+        assert_eq!(
+            Canonical::new(a, BlockMetric::diagonal(&[1.0, f64::NAN])).err(),
+            Some(CanonicalError::NonFinite { block: 1 })
+        );
+    }
+
+    #[test]
+    fn diagonal_metrics_assemble_like_the_dense_triple_product_and_the_block_path() {
+        // A = ∂_2 of a 3×2 grid of squares (17 edges × 6 cells): the
+        // two-point flux operator. Dyadic weights make every sum exact, so
+        // the column-wise diagonal assembly, the block-wise assembly and
+        // the dense product must agree to the last bit.
+        let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+        let a = grid.boundary(2).clone();
+        let rows = a.rows();
+        let weights: Vec<f64> = (0..rows).map(|r| 0.25 * (r % 5 + 1) as f64).collect();
+        let dense_a = DMatrix::from_fn(rows, 6, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
+        for blocks in [rows, rows - 4] {
+            // Only the first `blocks` rows carry a weight; the rest have no
+            // block at all and must not enter the pattern.
+            let mut diagonal = BlockMetric::diagonal(&weights[..blocks]);
+            diagonal.add_rows(rows - blocks);
+            assert!(diagonal.diagonal_weights().is_some());
+            let mut by_blocks = BlockMetric::new(rows);
+            for r in (0..blocks).rev() {
+                by_blocks.push_block(&[r], &[r], &[weights[r]]);
+            }
+            assert!(by_blocks.diagonal_weights().is_none());
+            let fast = Canonical::new(a.clone(), diagonal).unwrap().assemble();
+            let general = Canonical::new(a.clone(), by_blocks).unwrap().assemble();
+            assert_eq!(fast.symbolic().col_ptr(), general.symbolic().col_ptr());
+            assert_eq!(fast.symbolic().row_idx(), general.symbolic().row_idx());
+            assert_eq!(fast.val(), general.val());
+            let w = DMatrix::from_fn(rows, rows, |i, j| {
+                if i == j && i < blocks {
+                    weights[i]
+                } else {
+                    0.0
+                }
+            });
+            let expected = dense_a.transpose() * w * &dense_a;
+            let m = fast.to_dense();
+            for i in 0..6 {
+                for j in 0..6 {
+                    assert_eq!(
+                        m[(i, j)],
+                        expected[(i, j)],
+                        "({i},{j}) with {blocks} blocks"
+                    );
+                }
+            }
+        }
+        // Cells 0 and 5 (opposite corners) share no edge: no stored entry.
+        let op = Canonical::new(a, BlockMetric::diagonal(&weights)).unwrap();
+        let m = op.assemble();
+        let column = &m.symbolic().row_idx()[m.symbolic().col_ptr()[0]..m.symbolic().col_ptr()[1]];
+        assert!(!column.contains(&5));
     }
 
     #[test]

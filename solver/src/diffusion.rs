@@ -431,6 +431,11 @@ pub(crate) fn tagged_boundary_faces<'a>(
 
 /// Ω's diagonal entries on the rows that have one (summed over blocks).
 fn diagonal_of(metric: &BlockMetric, rows: usize) -> Vec<Option<f64>> {
+    if let Some(weights) = metric.diagonal_weights() {
+        let mut diag: Vec<Option<f64>> = weights.iter().copied().map(Some).collect();
+        diag.resize(rows, None);
+        return diag;
+    }
     let mut diag = vec![None; rows];
     for b in 0..metric.block_count() {
         let (r, s, w) = metric.block(b);
@@ -599,17 +604,17 @@ impl Diffusion {
 
         let (incidence, metric, unknowns) = match self.method {
             Method::Fe => (
-                complex.coboundary(0),
+                Arc::new(complex.coboundary(0)),
                 fe::stiffness_metric(complex, &tensors)?,
                 complex.cell_count(0),
             ),
             Method::Dec(kind) => (
-                complex.coboundary(0),
+                Arc::new(complex.coboundary(0)),
                 dec::hodge_metric(complex, kind, &tensors)?,
                 complex.cell_count(0),
             ),
             Method::Fv => (
-                complex.boundary(n).clone(),
+                complex.shared_boundary(n),
                 match &cell_points {
                     None => fv::two_point(complex, &tensors)?,
                     Some(points) => fv::two_point_at(complex, &tensors, points)?,
@@ -617,13 +622,13 @@ impl Diffusion {
                 cells,
             ),
             Method::Fd => (
-                complex.boundary(n).clone(),
+                complex.shared_boundary(n),
                 fd::five_point(complex, &tensors)?,
                 cells,
             ),
             Method::FvMimetic => {
                 let (a, omega, layout) = fv::mimetic_hybrid(complex, &tensors)?;
-                (a, omega, layout.cells + layout.faces)
+                (Arc::new(a), omega, layout.cells + layout.faces)
             }
         };
         let flux_rows = incidence.rows();
@@ -697,7 +702,7 @@ impl Diffusion {
                 metric_final.push_block(&[flux_rows + k], &[flux_rows + k], &[weight]);
                 ghost_values.push(value);
             }
-            tri.to_csr()
+            Arc::new(tri.to_csr())
         };
         let canonical = Canonical::new(incidence, metric_final)?;
         // b += Aᵀ Ω w for ghost values w (Dirichlet faces, Robin ghosts).
