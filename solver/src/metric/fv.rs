@@ -63,18 +63,41 @@ struct HalfFace<'a> {
     x_cell: &'a [f64],
 }
 
-impl HalfFace<'_> {
-    /// Build the half-face of top cell `cell` on (n−1)-cell `face`.
-    fn new(complex: &Complex, face: usize, cell: usize) -> HalfFace<'_> {
-        let (n, d) = (complex.dim(), complex.embedding_dim());
-        HalfFace {
-            area: complex.measure(n - 1)[face],
-            normal: &complex.normal()[face * d..(face + 1) * d],
-            x_face: complex.centroid_of(n - 1, face),
-            x_cell: complex.centroid_of(n, cell),
+/// The primal geometry half-faces are made of, fetched from the complex's
+/// caches once rather than per face.
+struct FaceGeometry<'a> {
+    d: usize,
+    areas: &'a [f64],
+    normals: &'a [f64],
+    face_centroids: &'a [f64],
+    cell_centroids: &'a [f64],
+}
+
+impl<'a> FaceGeometry<'a> {
+    fn new(complex: &'a Complex) -> Self {
+        let n = complex.dim();
+        FaceGeometry {
+            d: complex.embedding_dim(),
+            areas: complex.measure(n - 1),
+            normals: complex.normal(),
+            face_centroids: complex.centroid(n - 1),
+            cell_centroids: complex.centroid(n),
         }
     }
 
+    /// The half-face of top cell `cell` on (n−1)-cell `face`.
+    fn half(&self, face: usize, cell: usize) -> HalfFace<'a> {
+        let d = self.d;
+        HalfFace {
+            area: self.areas[face],
+            normal: &self.normals[face * d..(face + 1) * d],
+            x_face: &self.face_centroids[face * d..(face + 1) * d],
+            x_cell: &self.cell_centroids[cell * d..(cell + 1) * d],
+        }
+    }
+}
+
+impl HalfFace<'_> {
     /// d_{K,F} / κ_{K,F}: the resistance of the half cell between the
     /// centroid and the face, per unit face area. A centroid on the face
     /// plane (a degenerate or non-convex cell) has no such resistance.
@@ -146,41 +169,43 @@ pub fn two_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, M
     check_tensors(tensors, complex.cell_count(n), complex.embedding_dim())?;
     let boundary = complex.try_boundary(n)?;
     let faces = boundary.rows();
-    // Warm the geometry caches once, outside the parallel loop.
-    let _ = (
-        complex.measure(n - 1),
-        complex.centroid(n),
-        complex.normal(),
-    );
-    let _ = complex.centroid(n - 1);
-    let sigma = (0..faces)
-        .into_par_iter()
-        .map(|face| {
-            let range = boundary.indptr().outer_inds_sz(face);
-            let cells = &boundary.indices()[range];
-            if cells.len() > 2 {
-                return Err(MetricError::UnsupportedMesh {
-                    method: METHOD,
-                    needs: "every (n−1)-cell shared by at most two top cells",
-                    detail: format!("(n−1)-cell {face} lies on {} top cells", cells.len()),
-                });
-            }
-            let mut resistance = 0.0;
-            let mut area = 0.0;
-            for &cell in cells {
-                let half = HalfFace::new(complex, face, cell);
-                resistance += half.resistance(&tensors[cell], cell, METHOD)?;
-                area = half.area;
-            }
-            // A face on no top cell carries no flux.
-            Ok(if cells.is_empty() {
-                0.0
-            } else {
-                area / resistance
-            })
+    let geometry = FaceGeometry::new(complex);
+    let sigma_of = |face: usize| {
+        let range = boundary.indptr().outer_inds_sz(face);
+        let cells = &boundary.indices()[range];
+        if cells.len() > 2 {
+            return Err(MetricError::UnsupportedMesh {
+                method: METHOD,
+                needs: "every (n−1)-cell shared by at most two top cells",
+                detail: format!("(n−1)-cell {face} lies on {} top cells", cells.len()),
+            });
+        }
+        let mut resistance = 0.0;
+        let mut area = 0.0;
+        for &cell in cells {
+            let half = geometry.half(face, cell);
+            resistance += half.resistance(&tensors[cell], cell, METHOD)?;
+            area = half.area;
+        }
+        // A face on no top cell carries no flux.
+        Ok(if cells.is_empty() {
+            0.0
+        } else {
+            area / resistance
         })
-        .collect::<Result<Vec<f64>, MetricError>>()?;
-    Ok(BlockMetric::diagonal(&sigma))
+    };
+    let mut sigma = vec![0.0; faces];
+    let all_good = sigma
+        .par_iter_mut()
+        .enumerate()
+        .try_for_each(|(face, out)| sigma_of(face).map(|value| *out = value));
+    if all_good.is_err() {
+        // Report the first bad face, whichever thread met one.
+        if let Some(error) = (0..faces).find_map(|face| sigma_of(face).err()) {
+            return Err(error);
+        }
+    }
+    Ok(BlockMetric::from_weights(sigma))
 }
 
 /// Two-point flux approximation with the cell unknowns at given points
@@ -447,7 +472,8 @@ pub fn mimetic_hybrid(
     let layout = HybridLayout { cells, faces };
     let by_cell = complex.boundary_csc(n);
     let indptr = by_cell.indptr();
-    let _ = (complex.measure(n), complex.measure(n - 1), complex.normal());
+    let _ = complex.measure(n);
+    let geometry = FaceGeometry::new(complex);
     let _ = (complex.centroid(n), complex.centroid(n - 1));
 
     let blocks = (0..cells)
@@ -462,7 +488,7 @@ pub fn mimetic_hybrid(
             let mut areas = Vec::with_capacity(m);
             let mut resistances = Vec::with_capacity(m);
             for (i, (&face, &sign)) in cell_faces.iter().zip(signs).enumerate() {
-                let half = HalfFace::new(complex, face, cell);
+                let half = geometry.half(face, cell);
                 for a in 0..d {
                     outward[(i, a)] = f64::from(sign) * half.area * half.normal[a];
                     offsets[(i, a)] = half.x_face[a] - half.x_cell[a];
@@ -527,8 +553,9 @@ mod tests {
         let m = col.nnz();
         let (mut nn, mut dd) = (DMatrix::zeros(m, d), DMatrix::zeros(m, d));
         let (mut areas, mut res) = (vec![], vec![]);
+        let geometry = FaceGeometry::new(complex);
         for (i, (face, &s)) in col.iter().enumerate() {
-            let h = HalfFace::new(complex, face, cell);
+            let h = geometry.half(face, cell);
             for a in 0..d {
                 nn[(i, a)] = f64::from(s) * h.area * h.normal[a];
                 dd[(i, a)] = h.x_face[a] - h.x_cell[a];

@@ -20,6 +20,7 @@ pub mod fe;
 pub mod fv;
 
 use hasse_complex::ComplexError;
+use rayon::prelude::*;
 
 /// A symmetric tensor; the leading d×d block is used in R^d.
 pub type Tensor = [[f64; 3]; 3];
@@ -62,32 +63,44 @@ pub fn check_tensors(tensors: &[Tensor], cells: usize, d: usize) -> Result<(), M
             cells,
         });
     }
-    for (cell, t) in tensors.iter().enumerate() {
-        if t.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(MetricError::NonFinite { cell });
-        }
-        // Leading principal minors > 0 (Sylvester) on the symmetric part,
-        // scaled to unit size first: the minors of a valid K = 1e-200·I
-        // would otherwise underflow to zero.
-        let scale = t[..d]
-            .iter()
-            .flat_map(|row| row[..d].iter())
-            .fold(0.0f64, |a, v| a.max(v.abs()));
-        let scale = if scale > 0.0 { scale } else { 1.0 };
-        let m = |i: usize, j: usize| 0.5 * (t[i][j] + t[j][i]) / scale;
-        let minors = [
-            m(0, 0),
-            m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0),
-            m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1))
-                - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
-                + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0)),
-        ];
-        if let Some(&bad) = minors[..d].iter().find(|&&v| v <= 0.0) {
-            return Err(MetricError::NotPositive {
-                cell,
-                value: bad * scale,
-            });
-        }
+    // In parallel; the first bad cell in cell order is the one reported.
+    match tensors
+        .par_iter()
+        .enumerate()
+        .find_map_first(|(cell, t)| tensor_problem(t, cell, d))
+    {
+        Some(problem) => Err(problem),
+        None => Ok(()),
     }
-    Ok(())
+}
+
+/// Why tensor `t` of `cell` is not symmetric positive definite in R^d, if
+/// it is not.
+fn tensor_problem(t: &Tensor, cell: usize, d: usize) -> Option<MetricError> {
+    if t.iter().flatten().any(|v| !v.is_finite()) {
+        return Some(MetricError::NonFinite { cell });
+    }
+    // Leading principal minors > 0 (Sylvester) on the symmetric part,
+    // scaled to unit size first: the minors of a valid K = 1e-200·I
+    // would otherwise underflow to zero.
+    let scale = t[..d]
+        .iter()
+        .flat_map(|row| row[..d].iter())
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    let scale = if scale > 0.0 { scale } else { 1.0 };
+    let m = |i: usize, j: usize| 0.5 * (t[i][j] + t[j][i]) / scale;
+    let minors = [
+        m(0, 0),
+        m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0),
+        m(0, 0) * (m(1, 1) * m(2, 2) - m(1, 2) * m(2, 1))
+            - m(0, 1) * (m(1, 0) * m(2, 2) - m(1, 2) * m(2, 0))
+            + m(0, 2) * (m(1, 0) * m(2, 1) - m(1, 1) * m(2, 0)),
+    ];
+    minors[..d]
+        .iter()
+        .find(|&&v| v <= 0.0)
+        .map(|&bad| MetricError::NotPositive {
+            cell,
+            value: bad * scale,
+        })
 }
