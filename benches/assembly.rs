@@ -29,7 +29,7 @@ use std::time::Instant;
 
 #[path = "common/measure.rs"]
 mod measure;
-use measure::{peak_memory_gib, plain_matrix, seconds};
+use measure::{cpu_and_faults, peak_memory_gib, plain_matrix, seconds};
 
 fn poisson(method: Method) -> Diffusion {
     Diffusion::new(
@@ -65,8 +65,10 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
     );
     let geometry = seconds(started);
     let started = Instant::now();
+    let (cpu_before, faults_before) = cpu_and_faults();
     let system = poisson(method).assemble(complex).expect("assembly");
     let whole = seconds(started);
+    let (cpu_after, faults_after) = cpu_and_faults();
 
     let cells = complex.cell_count(d);
     let tensors = vec![isotropic(1.0); cells];
@@ -89,9 +91,11 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
     let matrix = canonical.assemble();
     let values_seconds = seconds(t);
     print!(
-        "{label:<26} unknowns {:>8} nnz {:>9} | geometry {geometry:>6.3}s | Diffusion::assemble {whole:>6.3}s | Ω {metric_seconds:>6.3}s  pattern {pattern_seconds:>6.3}s  values {values_seconds:>6.3}s",
+        "{label:<26} unknowns {:>8} nnz {:>9} | geometry {geometry:>6.3}s | Diffusion::assemble {whole:>6.3}s (cpu {:.2}s, {}k page faults) | Ω {metric_seconds:>6.3}s  pattern {pattern_seconds:>6.3}s  values {values_seconds:>6.3}s",
         matrix.nrows(),
         matrix.val().len(),
+        cpu_after - cpu_before,
+        (faults_after - faults_before) / 1000,
     );
     if let Some(n) = plain {
         let t = Instant::now();

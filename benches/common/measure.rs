@@ -29,6 +29,24 @@ pub fn peak_memory_gib() -> f64 {
         .map_or(f64::NAN, |kib| kib / (1024.0 * 1024.0))
 }
 
+/// (CPU seconds of all threads, minor page faults) of this process so far,
+/// from `/proc/self/stat`; differences of two readings are steadier than
+/// wall time on a loaded machine. CPU time has the kernel tick's
+/// resolution (10 ms). NaN and 0 where `/proc` is missing.
+pub fn cpu_and_faults() -> (f64, u64) {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // Fields after the parenthesised command name, which may hold spaces.
+    let fields: Vec<&str> = stat
+        .rsplit_once(')')
+        .map_or(vec![], |(_, rest)| rest.split_whitespace().collect());
+    let field = |k: usize| fields.get(k).and_then(|v| v.parse::<u64>().ok());
+    // After ')': state is field 0, minflt 7, utime 11, stime 12.
+    match (field(7), field(11), field(12)) {
+        (Some(faults), Some(user), Some(system)) => ((user + system) as f64 / 100.0, faults),
+        _ => (f64::NAN, 0),
+    }
+}
+
 /// The cell-centred 5/7-point operator on an n^d unit grid with Dirichlet
 /// ghosts, as the two-point flux gives it (λ = 1): |F|/h between cells,
 /// 2|F|/h on boundary faces. Built without hasse.

@@ -362,7 +362,8 @@ pub struct Assembled {
 #[derive(Clone, Debug)]
 struct DataLayout {
     faces: Faces,
-    /// Ω's diagonal on boundary face rows (cell-centred methods).
+    /// Ω's diagonal on each conditioned face's row, in the order of
+    /// `faces.condition` (cell-centred methods).
     cell_diagonal: Vec<Option<f64>>,
 }
 
@@ -371,8 +372,10 @@ struct BoundaryData {
     fixed: Vec<Option<f64>>,
     /// Ghost rows: (unknown, weight, ghost value) appended to A and Ω.
     ghosts: Vec<(usize, f64, f64)>,
-    /// Cell-centred boundary faces whose own row changes weight or value.
-    face_weight: Vec<Option<f64>>,
+    /// Cell-centred boundary faces whose own row changes weight: (row,
+    /// weight), by row.
+    face_weight: Vec<(usize, f64)>,
+    /// Ghost value of every flux row (non-zero on Dirichlet and Robin faces).
     face_value: Vec<f64>,
     /// Cell-centred Neumann faces carry no row weight; their flux (along
     /// the face's orientation) is the data's, −s g |F|.
@@ -381,20 +384,23 @@ struct BoundaryData {
 
 #[derive(Clone, Debug)]
 struct Faces {
-    /// Condition index applied to each boundary (n−1)-cell, if any.
-    condition: Vec<Option<usize>>,
+    /// (face, condition index) of every conditioned boundary (n−1)-cell,
+    /// by face.
+    condition: Vec<(usize, usize)>,
 }
 
-/// The index of the last tag (in `tags` order) naming each (n−1)-cell, so
-/// later conditions override earlier ones. Errors: a tag missing from the
-/// mesh, a tag of cells of another dimension, a tagged interior face.
+/// (face, k) for every (n−1)-cell a tag names, in face order, with k the
+/// index of the last such tag (in `tags` order), so later conditions
+/// override earlier ones. Only boundary faces appear, so the list is short
+/// next to the face count. Errors: a tag missing from the mesh, a tag of
+/// cells of another dimension, a tagged interior face.
 pub(crate) fn tagged_boundary_faces<'a>(
     complex: &Complex,
     tags: impl Iterator<Item = &'a str>,
-) -> Result<Vec<Option<usize>>, DiffusionError> {
+) -> Result<Vec<(usize, usize)>, DiffusionError> {
     let n = complex.dim();
     let top = complex.boundary(n);
-    let mut condition = vec![None; complex.cell_count(n - 1)];
+    let mut condition: Vec<(usize, usize)> = Vec::new();
     for (k, name) in tags.enumerate() {
         let tag = complex
             .tag(name)
@@ -423,27 +429,66 @@ pub(crate) fn tagged_boundary_faces<'a>(
                     face: f,
                 });
             }
-            condition[f] = Some(k);
+            condition.push((f, k));
         }
     }
-    Ok(condition)
+    // Stable: a face's entries stay in tag order, and the last one wins.
+    condition.sort_by_key(|&(f, _)| f);
+    let mut last: Vec<(usize, usize)> = Vec::with_capacity(condition.len());
+    for (f, k) in condition {
+        match last.last_mut() {
+            Some(previous) if previous.0 == f => previous.1 = k,
+            _ => last.push((f, k)),
+        }
+    }
+    Ok(last)
 }
 
-/// Ω's diagonal entries on the rows that have one (summed over blocks).
-fn diagonal_of(metric: &BlockMetric, rows: usize) -> Vec<Option<f64>> {
+/// Ω's diagonal entry (summed over its 1×1 blocks) on each of the sorted
+/// `rows`, or `None` where a row has none.
+fn diagonal_on(metric: &BlockMetric, rows: &[usize]) -> Vec<Option<f64>> {
     if let Some(weights) = metric.diagonal_weights() {
-        let mut diag: Vec<Option<f64>> = weights.iter().copied().map(Some).collect();
-        diag.resize(rows, None);
-        return diag;
+        return rows.iter().map(|&r| weights.get(r).copied()).collect();
     }
-    let mut diag = vec![None; rows];
+    let mut diag = vec![None; rows.len()];
     for b in 0..metric.block_count() {
         let (r, s, w) = metric.block(b);
-        if r.len() == 1 && r == s {
-            diag[r[0]] = Some(diag[r[0]].unwrap_or(0.0) + w[0]);
+        if let ([r], [s]) = (r, s) {
+            if r == s {
+                if let Ok(k) = rows.binary_search(r) {
+                    diag[k] = Some(diag[k].unwrap_or(0.0) + w[0]);
+                }
+            }
         }
     }
     diag
+}
+
+/// Set the diagonal weight of each listed row (sorted, distinct) of Ω: the
+/// row's first 1×1 block takes the weight and its other 1×1 blocks zero.
+fn replace_row_weights(metric: &mut BlockMetric, rows: &[(usize, f64)]) {
+    if metric.diagonal_weights().is_some() {
+        // Block r is row r's only block.
+        for &(r, weight) in rows {
+            if r < metric.block_count() {
+                metric.block_values_mut(r)[0] = weight;
+            }
+        }
+        return;
+    }
+    let mut replaced = vec![false; rows.len()];
+    for b in 0..metric.block_count() {
+        let (r, s, _) = metric.block(b);
+        if let ([r], [s]) = (r, s) {
+            if r == s {
+                if let Ok(k) = rows.binary_search_by_key(r, |&(row, _)| row) {
+                    let first = !replaced[k];
+                    replaced[k] = true;
+                    metric.block_values_mut(b)[0] = if first { rows[k].1 } else { 0.0 };
+                }
+            }
+        }
+    }
 }
 
 fn evaluate(f: &ScalarFn, x: &[f64], what: &'static str) -> Result<f64, DiffusionError> {
@@ -641,7 +686,10 @@ impl Diffusion {
 
         let top = complex.boundary(n);
         let cell_diagonal = match location {
-            Location::CellCentred => diagonal_of(&metric, flux_rows),
+            Location::CellCentred => {
+                let rows: Vec<usize> = faces.condition.iter().map(|&(f, _)| f).collect();
+                diagonal_on(&metric, &rows)
+            }
             _ => Vec::new(),
         };
         let layout = DataLayout {
@@ -664,30 +712,24 @@ impl Diffusion {
             &mut rhs,
         )?;
         let faces = &layout.faces;
+        let indptr = top.indptr();
+        let on_boundary = |f: usize| indptr.outer_inds_sz(f).len() == 1;
+        let conditioned = |f: usize| faces.condition.binary_search_by_key(&f, |c| c.0).is_ok();
         if location == Location::CellCentred {
             // Boundary faces without a condition are homogeneous Neumann.
-            for (f, weight) in face_weight.iter_mut().enumerate().take(face_count) {
-                if faces.condition[f].is_none() && top.outer_view(f).map_or(0, |r| r.nnz()) == 1 {
-                    *weight = Some(0.0);
-                }
+            let untagged: Vec<(usize, f64)> = (0..face_count)
+                .filter(|&f| on_boundary(f) && !conditioned(f))
+                .map(|f| (f, 0.0))
+                .collect();
+            if !untagged.is_empty() {
+                face_weight.extend(untagged);
+                face_weight.sort_by_key(|&(f, _)| f);
             }
         }
 
         // A and Ω with the boundary changes and the ghost rows.
         let mut metric_final = metric;
-        let mut replaced = vec![false; flux_rows];
-        for b in 0..metric_final.block_count() {
-            let (r, s, _) = metric_final.block(b);
-            if r.len() == 1 && r == s {
-                let row = r[0];
-                if let Some(weight) = face_weight[row] {
-                    // The row's whole diagonal is replaced once, by its first block.
-                    let first = !replaced[row];
-                    replaced[row] = true;
-                    metric_final.block_values_mut(b)[0] = if first { weight } else { 0.0 };
-                }
-            }
-        }
+        replace_row_weights(&mut metric_final, &face_weight);
         metric_final.add_rows(ghosts.len());
         let mut ghost_values = face_value.clone();
         let incidence = if ghosts.is_empty() {
@@ -716,8 +758,10 @@ impl Diffusion {
         let pure_neumann = fixed.iter().all(Option::is_none)
             && ghosts.is_empty()
             && (location != Location::CellCentred
-                || (0..face_count).all(|f| {
-                    top.outer_view(f).map_or(0, |r| r.nnz()) != 1 || face_weight[f] == Some(0.0)
+                || (0..face_count).filter(|&f| on_boundary(f)).all(|f| {
+                    face_weight
+                        .binary_search_by_key(&f, |w| w.0)
+                        .is_ok_and(|k| face_weight[k].1 == 0.0)
                 }));
         let assembly_seconds = started.elapsed().as_secs_f64();
         Ok(Assembled {
@@ -790,7 +834,6 @@ impl Diffusion {
         let d = complex.embedding_dim();
         let cells = complex.cell_count(n);
         let unknowns = rhs.len();
-        let face_count = complex.cell_count(n - 1);
         let face_area = complex.measure(n - 1);
         let face_centre = complex.centroid(n - 1);
         let x_face = |f: usize| &face_centre[f * d..(f + 1) * d];
@@ -798,13 +841,10 @@ impl Diffusion {
         let (faces, cell_diagonal) = (&layout.faces, &layout.cell_diagonal);
         let mut fixed: Vec<Option<f64>> = vec![None; unknowns];
         let mut ghosts: Vec<(usize, f64, f64)> = Vec::new();
-        let mut face_weight: Vec<Option<f64>> = vec![None; flux_rows];
+        let mut face_weight: Vec<(usize, f64)> = Vec::new();
         let mut face_value = vec![0.0; flux_rows];
         let mut neumann_flux = vec![0.0; flux_rows];
-        for f in 0..face_count {
-            let Some(k) = faces.condition[f] else {
-                continue;
-            };
+        for (slot, &(f, k)) in faces.condition.iter().enumerate() {
             let bc = &self.boundary[k];
             let area = face_area[f];
             let xf = x_face(f);
@@ -828,7 +868,7 @@ impl Diffusion {
                             tag: bc.tag.clone(),
                             face: f,
                         })?;
-                    let sigma = cell_diagonal[f].ok_or(DiffusionError::Unsupported {
+                    let sigma = cell_diagonal[slot].ok_or(DiffusionError::Unsupported {
                         method: self.method.name(),
                         what: "boundary conditions with a non-diagonal boundary metric",
                     })?;
@@ -851,14 +891,14 @@ impl Diffusion {
                             face_value[f] = sign * evaluate(g, xg, "Dirichlet value")?
                         }
                         BoundaryKind::Neumann(g) => {
-                            face_weight[f] = Some(0.0);
+                            face_weight.push((f, 0.0));
                             let outward = evaluate(g, xf, "Neumann value")? * area;
                             rhs[cell] += outward;
                             neumann_flux[f] = -sign * outward;
                         }
                         BoundaryKind::Robin { alpha, value } => {
                             let a = robin_alpha(bc, f, alpha, xg)?;
-                            face_weight[f] = Some(sigma * a * area / (sigma + a * area));
+                            face_weight.push((f, sigma * a * area / (sigma + a * area)));
                             face_value[f] = sign * evaluate(value, xg, "Robin value")? / a;
                         }
                     }

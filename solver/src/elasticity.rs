@@ -404,8 +404,7 @@ impl Elasticity {
         let mut fixed = vec![None; d * vertices];
         let condition = self.boundary_faces(complex, d)?;
         let area = complex.measure(n - 1);
-        for (f, k) in condition.iter().enumerate() {
-            let Some(k) = *k else { continue };
+        for &(f, k) in &condition {
             let face = complex.cell_vertices(n - 1, f);
             let share = area[f] / face.len() as f64;
             for &v in face {
@@ -464,12 +463,13 @@ impl Elasticity {
         })
     }
 
-    /// The condition (index into `boundary`) on every (n−1)-cell, if any.
+    /// (face, condition index into `boundary`) for every conditioned
+    /// (n−1)-cell, by face.
     fn boundary_faces(
         &self,
         complex: &Complex,
         d: usize,
-    ) -> Result<Vec<Option<usize>>, ElasticityError> {
+    ) -> Result<Vec<(usize, usize)>, ElasticityError> {
         let condition = diffusion::tagged_boundary_faces(
             complex,
             self.boundary.iter().map(|(name, _)| name.as_str()),
