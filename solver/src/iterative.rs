@@ -184,6 +184,11 @@ impl RowMatrix {
         self.val.len()
     }
 
+    /// Stored entries of row `i`.
+    pub fn row_len(&self, i: usize) -> usize {
+        self.ptr[i + 1] - self.ptr[i]
+    }
+
     /// Column indices and values of row `i`.
     pub fn row(&self, i: usize) -> (&[u32], &[f64]) {
         let r = self.ptr[i]..self.ptr[i + 1];
@@ -215,6 +220,28 @@ impl RowMatrix {
                 let (c, v) = self.row(i);
                 *yi = c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum();
             });
+    }
+
+    /// y = M x and xᵀy in one pass, the inner product summed as [`dot`]
+    /// sums it (the same bits as `multiply` followed by `dot(x, y)`).
+    pub fn multiply_dot(&self, x: &[f64], y: &mut [f64]) -> f64 {
+        let partial: Vec<f64> = y
+            .par_chunks_mut(DOT_CHUNK)
+            .enumerate()
+            .map(|(chunk, ys)| {
+                let base = chunk * DOT_CHUNK;
+                for (k, yi) in ys.iter_mut().enumerate() {
+                    let (c, v) = self.row(base + k);
+                    *yi = c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum();
+                }
+                x[base..base + ys.len()]
+                    .iter()
+                    .zip(ys.iter())
+                    .map(|(p, q)| p * q)
+                    .sum::<f64>()
+            })
+            .collect();
+        partial.iter().sum()
     }
 
     /// r = b − M x, in parallel over rows.
@@ -268,37 +295,90 @@ impl RowMatrix {
     /// parallel over rows. Each entry is summed in the order of this row's
     /// entries, whatever the thread count, so the bits do not depend on it.
     pub fn product(&self, other: &RowMatrix) -> RowMatrix {
+        self.gustavson(other, None)
+    }
+
+    /// P − diag(scale) · (self · P): one Jacobi-type smoothing step applied
+    /// to the columns of P (`scale` holds ω/a_ii per row), in one pass over
+    /// the rows. Entry by entry the same numbers as forming self · P with
+    /// [`RowMatrix::product`] and then subtracting: P's pattern joined with
+    /// the product's, an entry of the product alone is 0 − s·(AP)_ij.
+    pub fn smoothed(&self, p: &RowMatrix, scale: &[f64]) -> RowMatrix {
+        self.gustavson(p, Some(scale))
+    }
+
+    /// self · other, or other − diag(scale)(self · other) with `scale`
+    /// (then other has as many rows as self). Rows are computed in fixed
+    /// chunks, each by one thread, and written to their place in the
+    /// result in parallel.
+    fn gustavson(&self, other: &RowMatrix, scale: Option<&[f64]>) -> RowMatrix {
         assert_eq!(
             self.ncols, other.nrows,
             "inner dimensions of a sparse product"
         );
         let width = other.ncols;
-        let chunks: Vec<(Vec<usize>, Vec<u32>, Vec<f64>)> = (0..self.nrows.div_ceil(ROW_CHUNK))
+        let chunks: Vec<(Vec<u32>, Vec<u32>, Vec<f64>)> = (0..self.nrows.div_ceil(ROW_CHUNK))
             .into_par_iter()
             .map_init(
                 || (vec![0.0f64; width], vec![usize::MAX; width]),
                 |(acc, mark), chunk| {
                     let rows = chunk * ROW_CHUNK..((chunk + 1) * ROW_CHUNK).min(self.nrows);
                     let mut lengths = Vec::with_capacity(rows.len());
-                    let (mut idx, mut val) = (Vec::new(), Vec::new());
+                    // An upper bound of the chunk's entries (up to 2²²),
+                    // so that the buffers rarely grow by copying (pages of
+                    // the bound that are never written are never touched).
+                    let bound: usize = rows
+                        .clone()
+                        .map(|i| {
+                            let extra = scale.map_or(0, |_| other.row_len(i));
+                            self.row(i)
+                                .0
+                                .iter()
+                                .map(|&k| other.row_len(k as usize))
+                                .sum::<usize>()
+                                + extra
+                        })
+                        .sum::<usize>()
+                        .min(1 << 22);
+                    let (mut idx, mut val) = (Vec::with_capacity(bound), Vec::with_capacity(bound));
                     for i in rows {
+                        let tag = i;
                         let start = idx.len();
                         let (c, v) = self.row(i);
                         for (&k, &a) in c.iter().zip(v) {
                             let (ck, vk) = other.row(k as usize);
                             for (&j, &b) in ck.iter().zip(vk) {
                                 let j = j as usize;
-                                if mark[j] != i {
-                                    mark[j] = i;
+                                if mark[j] != tag {
+                                    mark[j] = tag;
                                     acc[j] = 0.0;
                                     idx.push(j as u32);
                                 }
                                 acc[j] += a * b;
                             }
                         }
+                        if let Some(scale) = scale {
+                            let s = scale[i];
+                            for &j in &idx[start..] {
+                                let j = j as usize;
+                                acc[j] = 0.0 - s * acc[j];
+                            }
+                            // pv + (0 − s·x) is pv − s·x exactly (P has no −0).
+                            let (pc, pv) = other.row(i);
+                            for (&j, &b) in pc.iter().zip(pv) {
+                                let j = j as usize;
+                                if mark[j] != tag {
+                                    mark[j] = tag;
+                                    acc[j] = b;
+                                    idx.push(j as u32);
+                                } else {
+                                    acc[j] += b;
+                                }
+                            }
+                        }
                         idx[start..].sort_unstable();
                         val.extend(idx[start..].iter().map(|&j| acc[j as usize]));
-                        lengths.push(idx.len() - start);
+                        lengths.push((idx.len() - start) as u32);
                     }
                     (lengths, idx, val)
                 },
@@ -306,16 +386,28 @@ impl RowMatrix {
             .collect();
         let mut ptr = Vec::with_capacity(self.nrows + 1);
         ptr.push(0);
-        let total: usize = chunks.iter().map(|c| c.1.len()).sum();
-        let mut idx = Vec::with_capacity(total);
-        let mut val = Vec::with_capacity(total);
-        for (lengths, i, v) in chunks {
-            for l in lengths {
-                ptr.push(ptr.last().copied().unwrap_or(0) + l);
+        let mut end = 0;
+        for (lengths, _, _) in &chunks {
+            for &l in lengths {
+                end += l as usize;
+                ptr.push(end);
             }
-            idx.extend(i);
-            val.extend(v);
         }
+        let mut idx = vec![0u32; end];
+        let mut val = vec![0.0; end];
+        let mut pieces = Vec::with_capacity(chunks.len());
+        let (mut idx_rest, mut val_rest) = (idx.as_mut_slice(), val.as_mut_slice());
+        for chunk in &chunks {
+            let (i, r) = std::mem::take(&mut idx_rest).split_at_mut(chunk.1.len());
+            let (v, s) = std::mem::take(&mut val_rest).split_at_mut(chunk.2.len());
+            idx_rest = r;
+            val_rest = s;
+            pieces.push((i, v, chunk));
+        }
+        pieces.into_par_iter().for_each(|(i, v, chunk)| {
+            i.copy_from_slice(&chunk.1);
+            v.copy_from_slice(&chunk.2);
+        });
         RowMatrix {
             nrows: self.nrows,
             ncols: width,
@@ -375,7 +467,7 @@ impl RowMatrix {
 
 /// Entries per partial sum of [`dot`]: the summation order depends on this
 /// constant only, never on the number of threads.
-const DOT_CHUNK: usize = 8192;
+pub(crate) const DOT_CHUNK: usize = 8192;
 
 /// aᵀb, summed in fixed chunks so the result is bit-identical for any
 /// number of threads.
@@ -519,8 +611,7 @@ pub fn preconditioned_cg(
                 tolerance: options.tolerance,
             });
         }
-        matrix.multiply(&p, &mut product);
-        let curvature = dot(&p, &product);
+        let curvature = matrix.multiply_dot(&p, &mut product);
         if curvature.is_nan() || curvature <= 0.0 {
             return Err(CgError::Breakdown {
                 iteration: iterations,
@@ -528,17 +619,22 @@ pub fn preconditioned_cg(
             });
         }
         let alpha = rz / curvature;
-        x.par_iter_mut()
-            .with_min_len(ROW_CHUNK)
-            .zip(&p)
-            .for_each(|(x, p)| *x += alpha * p);
-        r.par_iter_mut()
-            .with_min_len(ROW_CHUNK)
-            .zip(&product)
-            .for_each(|(r, q)| *r -= alpha * q);
+        // x += αp, r −= αq and rᵀr in one pass, rᵀr summed as `dot` does.
+        let partial: Vec<f64> = x
+            .par_chunks_mut(DOT_CHUNK)
+            .zip(r.par_chunks_mut(DOT_CHUNK))
+            .zip(p.par_chunks(DOT_CHUNK))
+            .zip(product.par_chunks(DOT_CHUNK))
+            .map(|(((x, r), p), q)| {
+                x.iter_mut().zip(p).for_each(|(x, p)| *x += alpha * p);
+                r.iter_mut().zip(q).for_each(|(r, q)| *r -= alpha * q);
+                r.iter().map(|r| r * r).sum::<f64>()
+            })
+            .collect();
+        let rr: f64 = partial.iter().sum();
         preconditioner.apply(&r, &mut z);
         let rz_next = dot(&r, &z);
-        if rz_next.is_nan() || (rz_next <= 0.0 && dot(&r, &r) > 0.0) {
+        if rz_next.is_nan() || (rz_next <= 0.0 && rr > 0.0) {
             return Err(CgError::Preconditioner {
                 iteration: iterations,
                 value: rz_next,
@@ -551,7 +647,7 @@ pub fn preconditioned_cg(
             .zip(&z)
             .for_each(|(p, z)| *p = z + beta * *p);
         iterations += 1;
-        residual = dot(&r, &r).sqrt() / norm_b;
+        residual = rr.sqrt() / norm_b;
     }
     // The recurrence drifts from the true residual; report the true one.
     matrix.residual(rhs, &x, &mut product);

@@ -69,7 +69,7 @@
 //! ```
 
 use crate::iterative::{
-    dot, preconditioned_cg, CgError, CgOptions, CgReport, Preconditioner, RowMatrix,
+    dot, preconditioned_cg, CgError, CgOptions, CgReport, Preconditioner, RowMatrix, DOT_CHUNK,
 };
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
@@ -461,12 +461,23 @@ struct Coarse {
     algebraic: bool,
 }
 
+/// The vectors of one level, allocated once at setup. The finest level
+/// takes b and x from the caller (the residual and the preconditioned
+/// residual of CG) and uses only the scratch.
 #[derive(Default)]
 struct Work {
     b: Vec<f64>,
     x: Vec<f64>,
+    scratch: Scratch,
+}
+
+/// The smoother's residual and two Chebyshev directions (the new one is
+/// written while the old one is read by the neighbouring rows).
+#[derive(Default)]
+struct Scratch {
     r: Vec<f64>,
     d: Vec<f64>,
+    e: Vec<f64>,
 }
 
 /// A multigrid hierarchy, ready to be applied as a preconditioner.
@@ -504,6 +515,13 @@ fn inverse_diagonal(matrix: &RowMatrix, level: usize) -> Result<Vec<f64>, Multig
 /// max_i Σ_j |a_ij| / a_ii. Lanczos finds the top of the spectrum in a few
 /// steps where power iteration creeps towards it from below, and a bound
 /// that is too low makes the Chebyshev smoother amplify the top modes.
+///
+/// The largest Ritz value only grows with the steps (the Lanczos matrices
+/// are nested), so once 1.1 × it passes the Gershgorin bound the answer is
+/// that bound and the remaining steps are skipped: on M-matrices such as
+/// the finest two-point-flux operator (D⁻¹M ≤ 2) this happens within a few
+/// steps. Each step is one pass for the product and pᵀq and one for the
+/// residual, the scaled residual and rᵀz, summed as [`dot`] sums.
 fn spectral_bound(matrix: &RowMatrix, inverse_diagonal: &[f64]) -> f64 {
     let n = matrix.nrows();
     let gershgorin = (0..n)
@@ -517,41 +535,72 @@ fn spectral_bound(matrix: &RowMatrix, inverse_diagonal: &[f64]) -> f64 {
     // A fixed, non-smooth right-hand side (no random state): it has
     // components along the high modes.
     let mut r: Vec<f64> = (0..n)
+        .into_par_iter()
+        .with_min_len(ROW_CHUNK)
         .map(|i| ((i.wrapping_mul(2_654_435_761)) % 1000) as f64 / 1000.0 - 0.5)
         .collect();
-    let mut z: Vec<f64> = r.iter().zip(inverse_diagonal).map(|(r, d)| r * d).collect();
+    let mut z: Vec<f64> = r
+        .par_iter()
+        .with_min_len(ROW_CHUNK)
+        .zip(inverse_diagonal)
+        .map(|(r, d)| r * d)
+        .collect();
     let mut p = z.clone();
     let mut q = vec![0.0; n];
     let mut rz = dot(&r, &z);
     let (mut alphas, mut betas) = (Vec::new(), Vec::new());
+    // 1.1 × ritz ≥ this means the result is the Gershgorin bound whatever
+    // the later steps find (the margin covers the rounding of the small
+    // eigenproblems).
+    let capped = gershgorin * (1.0 + 1e-12);
     for _ in 0..20.min(n) {
         if rz.is_nan() || rz <= 0.0 {
             break;
         }
-        matrix.multiply(&p, &mut q);
-        let pq = dot(&p, &q);
+        let pq = matrix.multiply_dot(&p, &mut q);
         if pq.is_nan() || pq <= 0.0 {
             break;
         }
         let alpha = rz / pq;
-        r.par_iter_mut().zip(&q).for_each(|(r, q)| *r -= alpha * q);
-        z.par_iter_mut()
-            .zip(&r)
-            .zip(inverse_diagonal)
-            .for_each(|((z, r), d)| *z = r * d);
-        let rz_next = dot(&r, &z);
+        let partial: Vec<f64> = r
+            .par_chunks_mut(DOT_CHUNK)
+            .zip(z.par_chunks_mut(DOT_CHUNK))
+            .zip(q.par_chunks(DOT_CHUNK))
+            .zip(inverse_diagonal.par_chunks(DOT_CHUNK))
+            .map(|(((r, z), q), d)| {
+                r.iter_mut().zip(q).for_each(|(r, q)| *r -= alpha * q);
+                z.iter_mut()
+                    .zip(r.iter())
+                    .zip(d)
+                    .for_each(|((z, r), d)| *z = r * d);
+                r.iter().zip(z.iter()).map(|(r, z)| r * z).sum::<f64>()
+            })
+            .collect();
+        let rz_next: f64 = partial.iter().sum();
         let beta = rz_next / rz;
         alphas.push(alpha);
         betas.push(beta);
         rz = rz_next;
+        if 1.1 * largest_ritz(&alphas, &betas) >= capped {
+            return gershgorin.max(f64::MIN_POSITIVE);
+        }
         p.par_iter_mut()
+            .with_min_len(ROW_CHUNK)
             .zip(&z)
             .for_each(|(p, z)| *p = z + beta * *p);
     }
-    let k = alphas.len();
-    if k == 0 {
+    if alphas.is_empty() {
         return gershgorin.max(f64::MIN_POSITIVE);
     }
+    (1.1 * largest_ritz(&alphas, &betas))
+        .min(gershgorin)
+        .max(f64::MIN_POSITIVE)
+}
+
+/// The largest eigenvalue of the Lanczos matrix of CG coefficients
+/// `alphas`, `betas` (one of each per step; the last β is not used).
+fn largest_ritz(alphas: &[f64], betas: &[f64]) -> f64 {
+    let k = alphas.len();
     let mut t = nalgebra::DMatrix::<f64>::zeros(k, k);
     for j in 0..k {
         t[(j, j)] = 1.0 / alphas[j]
@@ -566,16 +615,14 @@ fn spectral_bound(matrix: &RowMatrix, inverse_diagonal: &[f64]) -> f64 {
             t[(j + 1, j)] = off;
         }
     }
-    let ritz = t
-        .symmetric_eigenvalues()
+    t.symmetric_eigenvalues()
         .iter()
-        .fold(0.0f64, |m, &v| m.max(v));
-    (1.1 * ritz).min(gershgorin).max(f64::MIN_POSITIVE)
+        .fold(0.0f64, |m, &v| m.max(v))
 }
 
 /// P − ω D⁻¹ M P with ω = 4/(3λ), λ bounding the spectrum of D⁻¹M: one
 /// damped Jacobi step applied to the columns of P, as in smoothed
-/// aggregation.
+/// aggregation ([`RowMatrix::smoothed`]: one parallel pass over the rows).
 fn smooth_prolongation(
     matrix: &RowMatrix,
     inverse_diagonal: &[f64],
@@ -583,33 +630,12 @@ fn smooth_prolongation(
     p: &RowMatrix,
 ) -> Result<RowMatrix, MultigridError> {
     let omega = 4.0 / (3.0 * lambda);
-    let ap = matrix.product(p);
-    let mut ptr = vec![0];
-    let mut idx = Vec::with_capacity(ap.nnz());
-    let mut val = Vec::with_capacity(ap.nnz());
-    for (i, &dinv) in inverse_diagonal.iter().enumerate().take(p.nrows()) {
-        let (pc, pv) = p.row(i);
-        let (ac, av) = ap.row(i);
-        let scale = omega * dinv;
-        // Merge two sorted rows.
-        let (mut s, mut t) = (0, 0);
-        while s < pc.len() || t < ac.len() {
-            let take_p = t == ac.len() || (s < pc.len() && pc[s] <= ac[t]);
-            let take_a = s == pc.len() || (t < ac.len() && ac[t] <= pc[s]);
-            let (j, mut v) = if take_p { (pc[s], pv[s]) } else { (ac[t], 0.0) };
-            if take_a {
-                v -= scale * av[t];
-                t += 1;
-            }
-            if take_p {
-                s += 1;
-            }
-            idx.push(j);
-            val.push(v);
-        }
-        ptr.push(idx.len());
-    }
-    Ok(RowMatrix::new(p.nrows(), p.ncols(), ptr, idx, val)?)
+    let scale: Vec<f64> = inverse_diagonal
+        .par_iter()
+        .with_min_len(ROW_CHUNK)
+        .map(|d| omega * d)
+        .collect();
+    Ok(matrix.smoothed(p, &scale))
 }
 
 /// The tentative prolongation of smoothed aggregation and the coarse
@@ -843,11 +869,24 @@ impl Multigrid {
             .iter()
             .map(|l| l.matrix.nrows())
             .chain([coarse.matrix.nrows()])
-            .map(|n| Work {
-                b: vec![0.0; n],
-                x: vec![0.0; n],
-                r: vec![0.0; n],
-                d: vec![0.0; n],
+            .enumerate()
+            .map(|(l, n)| {
+                // The finest level's b and x are the caller's; the coarsest
+                // level needs no smoother scratch.
+                let (vectors, scratch) = match (l == 0 && !levels.is_empty(), l < levels.len()) {
+                    (true, _) => (0, n),
+                    (false, true) => (n, n),
+                    (false, false) => (n, 0),
+                };
+                Work {
+                    b: vec![0.0; vectors],
+                    x: vec![0.0; vectors],
+                    scratch: Scratch {
+                        r: vec![0.0; scratch],
+                        d: vec![0.0; scratch],
+                        e: vec![0.0; scratch],
+                    },
+                }
             })
             .collect();
         Ok(Self {
@@ -916,83 +955,144 @@ impl Multigrid {
         )?)
     }
 
-    fn smooth(&self, level: &Level, w: &mut Work, zero_start: bool, want_residual: bool) {
+    /// Smoothing steps on M x = b from x (from zero when `zero_start`,
+    /// whatever x holds), leaving b − M x in `w.r` when `want_residual`.
+    ///
+    /// Chebyshev runs one pass over the rows per step: the step's product
+    /// M d, the new residual, the new direction and the update of x, all
+    /// row by row (x is not read by other rows then, only d). The numbers
+    /// are those of the textbook order of vector operations.
+    fn smooth(
+        &self,
+        level: &Level,
+        b: &[f64],
+        x: &mut [f64],
+        w: &mut Scratch,
+        zero_start: bool,
+        want_residual: bool,
+    ) {
         let a = &level.matrix;
-        let dinv = &level.inverse_diagonal;
+        let dinv = &level.inverse_diagonal[..];
         match self.smoother {
             Smoother::Jacobi { omega, sweeps } => {
                 for sweep in 0..sweeps {
                     if sweep == 0 && zero_start {
-                        w.x.par_iter_mut()
+                        x.par_iter_mut()
                             .with_min_len(ROW_CHUNK)
-                            .zip(&w.b)
+                            .zip(b)
                             .zip(dinv)
                             .for_each(|((x, b), d)| *x = omega * d * b);
                         continue;
                     }
-                    a.residual(&w.b, &w.x, &mut w.r);
-                    w.x.par_iter_mut()
+                    a.residual(b, x, &mut w.r);
+                    x.par_iter_mut()
                         .with_min_len(ROW_CHUNK)
                         .zip(&w.r)
                         .zip(dinv)
                         .for_each(|((x, r), d)| *x += omega * d * r);
                 }
                 if want_residual {
-                    a.residual(&w.b, &w.x, &mut w.r);
+                    a.residual(b, x, &mut w.r);
                 }
             }
             Smoother::Chebyshev { degree, ratio } => {
                 // Chebyshev iteration on D⁻¹M (Saad, Iterative Methods,
                 // Algorithm 12.1) for the interval [λ/ratio, λ], keeping
-                // the residual r = b − M x up to date.
+                // the residual r = b − M x up to date:
+                //   r₀ = b − M x, d₀ = D⁻¹r₀/θ, x += d₀;
+                //   r_{k+1} = r_k − M d_k, d_{k+1} = s₁ d_k + s₂ D⁻¹ r_{k+1},
+                //   x += d_{k+1}.
                 let (hi, lo) = (level.lambda, level.lambda / ratio);
                 let theta = 0.5 * (hi + lo);
                 let delta = 0.5 * (hi - lo);
                 let sigma = theta / delta;
                 let mut rho = 1.0 / sigma;
+                let Scratch { r, d, e } = w;
+                // Whether x still lacks d₀ (when the first pass had to read
+                // x at the neighbouring rows).
+                let mut pending = !zero_start;
                 if zero_start {
-                    w.r.copy_from_slice(&w.b);
-                    w.x.iter_mut().for_each(|x| *x = 0.0);
-                } else {
-                    a.residual(&w.b, &w.x, &mut w.r);
-                }
-                w.d.par_iter_mut()
-                    .with_min_len(ROW_CHUNK)
-                    .zip(&w.r)
-                    .zip(dinv)
-                    .for_each(|((d, r), di)| *d = di * r / theta);
-                for k in 0..degree {
-                    w.x.par_iter_mut()
+                    // r₀ = b (read from b below), x = 0 + d₀.
+                    x.par_iter_mut()
                         .with_min_len(ROW_CHUNK)
-                        .zip(&w.d)
-                        .for_each(|(x, d)| *x += d);
-                    if k + 1 == degree && !want_residual {
-                        break;
-                    }
-                    // r ← r − M d, row by row.
-                    let d = &w.d;
-                    w.r.par_iter_mut()
-                        .with_min_len(ROW_CHUNK)
-                        .enumerate()
-                        .for_each(|(i, r)| {
-                            let (c, v) = a.row(i);
-                            *r -= c
-                                .iter()
-                                .zip(v)
-                                .map(|(&j, &m)| m * d[j as usize])
-                                .sum::<f64>();
+                        .zip(d.par_iter_mut())
+                        .zip(b)
+                        .zip(dinv)
+                        .for_each(|(((x, d), b), di)| {
+                            *d = di * b / theta;
+                            *x = 0.0 + *d;
                         });
-                    if k + 1 == degree {
-                        break;
-                    }
+                } else {
+                    let xr: &[f64] = x;
+                    r.par_iter_mut()
+                        .with_min_len(ROW_CHUNK)
+                        .zip(d.par_iter_mut())
+                        .enumerate()
+                        .for_each(|(i, (ri, di))| {
+                            let (c, v) = a.row(i);
+                            *ri = b[i]
+                                - c.iter()
+                                    .zip(v)
+                                    .map(|(&j, &m)| m * xr[j as usize])
+                                    .sum::<f64>();
+                            *di = dinv[i] * *ri / theta;
+                        });
+                }
+                // The residual so far: b until the first product.
+                let mut from_b = zero_start;
+                for _ in 1..degree {
                     let rho_next = 1.0 / (2.0 * sigma - rho);
                     let (s1, s2) = (rho_next * rho, 2.0 * rho_next / delta);
-                    w.d.par_iter_mut()
+                    let dk: &[f64] = d;
+                    let source: Option<&[f64]> = from_b.then_some(b);
+                    x.par_iter_mut()
                         .with_min_len(ROW_CHUNK)
-                        .zip(&w.r)
-                        .zip(dinv)
-                        .for_each(|((d, r), di)| *d = s1 * *d + s2 * di * r);
+                        .zip(r.par_iter_mut())
+                        .zip(e.par_iter_mut())
+                        .enumerate()
+                        .for_each(|(i, ((x, r), e))| {
+                            let (c, v) = a.row(i);
+                            let old = source.map_or(*r, |b| b[i]);
+                            *r = old
+                                - c.iter()
+                                    .zip(v)
+                                    .map(|(&j, &m)| m * dk[j as usize])
+                                    .sum::<f64>();
+                            *e = s1 * dk[i] + s2 * dinv[i] * *r;
+                            if pending {
+                                *x += dk[i];
+                            }
+                            *x += *e;
+                        });
+                    std::mem::swap(d, e);
                     rho = rho_next;
+                    from_b = false;
+                    pending = false;
+                }
+                if want_residual {
+                    let dk: &[f64] = d;
+                    let source: Option<&[f64]> = from_b.then_some(b);
+                    x.par_iter_mut()
+                        .with_min_len(ROW_CHUNK)
+                        .zip(r.par_iter_mut())
+                        .enumerate()
+                        .for_each(|(i, (x, r))| {
+                            let (c, v) = a.row(i);
+                            let old = source.map_or(*r, |b| b[i]);
+                            *r = old
+                                - c.iter()
+                                    .zip(v)
+                                    .map(|(&j, &m)| m * dk[j as usize])
+                                    .sum::<f64>();
+                            if pending {
+                                *x += dk[i];
+                            }
+                        });
+                } else if pending {
+                    x.par_iter_mut()
+                        .with_min_len(ROW_CHUNK)
+                        .zip(&d[..])
+                        .for_each(|(x, d)| *x += d);
                 }
             }
         }
@@ -1002,20 +1102,28 @@ impl Multigrid {
         let mut guard = self.work.lock().unwrap_or_else(|e| e.into_inner());
         let work = &mut *guard;
         let depth = self.levels.len();
-        work[0].b.copy_from_slice(r);
+        if depth == 0 {
+            let w = &mut work[0];
+            w.b.copy_from_slice(r);
+            self.coarse.solve(w);
+            z.copy_from_slice(&w.x);
+            return;
+        }
         for (l, level) in self.levels.iter().enumerate() {
             let (here, below) = work.split_at_mut(l + 1);
-            let w = &mut here[l];
-            self.smooth(level, w, true, true);
-            level.r.multiply(&w.r, &mut below[0].b);
+            let Work { b, x, scratch } = &mut here[l];
+            let (b, x): (&[f64], &mut [f64]) = if l == 0 { (r, &mut *z) } else { (b, x) };
+            self.smooth(level, b, x, scratch, true, true);
+            level.r.multiply(&scratch.r, &mut below[0].b);
         }
         self.coarse.solve(&mut work[depth]);
         for (l, level) in self.levels.iter().enumerate().rev() {
             let (here, below) = work.split_at_mut(l + 1);
-            let w = &mut here[l];
+            let Work { b, x, scratch } = &mut here[l];
+            let (b, x): (&[f64], &mut [f64]) = if l == 0 { (r, &mut *z) } else { (b, x) };
             let xc = &below[0].x;
             let (p, c) = (&level.p, level.correction);
-            w.x.par_iter_mut()
+            x.par_iter_mut()
                 .with_min_len(ROW_CHUNK)
                 .enumerate()
                 .for_each(|(i, x)| {
@@ -1026,9 +1134,8 @@ impl Multigrid {
                         .map(|(&j, &a)| a * xc[j as usize])
                         .sum::<f64>();
                 });
-            self.smooth(level, w, false, false);
+            self.smooth(level, b, x, scratch, false, false);
         }
-        z.copy_from_slice(&work[0].x);
     }
 }
 
