@@ -731,7 +731,7 @@ impl Diffusion {
         let mut metric_final = metric;
         replace_row_weights(&mut metric_final, &face_weight);
         metric_final.add_rows(ghosts.len());
-        let mut ghost_values = face_value.clone();
+        let mut ghost_values = face_value;
         let incidence = if ghosts.is_empty() {
             incidence
         } else {
