@@ -136,8 +136,13 @@ impl BlockMetric {
         }
         let r0 = self.indices.len();
         self.indices.extend_from_slice(rows);
-        let c0 = self.indices.len();
-        self.indices.extend_from_slice(cols);
+        // A symmetric block's columns are its rows: stored once.
+        let c0 = if rows == cols {
+            r0
+        } else {
+            self.indices.extend_from_slice(cols);
+            r0 + rows.len()
+        };
         let v0 = self.values.len();
         self.values.extend_from_slice(values);
         self.blocks.push(Block {
