@@ -587,7 +587,7 @@ pub fn stiffness_metric(complex: &Complex, lame: &[Lame]) -> Result<BlockMetric,
                 }
             }
             let (cell_edges, pinv) = fe::edge_pseudo_inverse(&top, c, "elasticity")?;
-            let lift = DMatrix::<f64>::identity(d, d).kronecker(&pinv);
+            let lift = DMatrix::<f64>::identity(d, d).kronecker(&*pinv);
             let omega = lift.transpose() * kc * &lift;
             let size = omega.nrows();
             let rows: Vec<usize> = (0..d)

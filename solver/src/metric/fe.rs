@@ -35,6 +35,7 @@ use hasse_complex::Complex;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use sprs::CsMat;
+use std::rc::Rc;
 
 /// A point padded to three coordinates.
 pub(crate) type Point = [f64; 3];
@@ -506,7 +507,7 @@ pub(crate) fn edge_pseudo_inverse(
     top: &Topology,
     c: usize,
     method: &'static str,
-) -> Result<(Vec<usize>, DMatrix<f64>), MetricError> {
+) -> Result<(Vec<usize>, Rc<DMatrix<f64>>), MetricError> {
     let vertices = top.complex.cell_vertices(top.n, c);
     let edges = top.edges_of(c);
     // A_c is pure topology: the vertex count and each edge's local (tail,
@@ -528,20 +529,20 @@ pub(crate) fn edge_pseudo_inverse(
         a[(r, ends[0])] = -1.0;
         a[(r, ends[1])] = 1.0;
     }
-    let pinv =
-        a.pseudo_inverse(PSEUDO_INVERSE_TOLERANCE)
-            .map_err(|_| MetricError::UnsupportedCell {
-                method,
-                needs: "a cell whose edge incidence has a pseudo-inverse",
-                cell: c,
-            })?;
+    let pinv = Rc::new(a.pseudo_inverse(PSEUDO_INVERSE_TOLERANCE).map_err(|_| {
+        MetricError::UnsupportedCell {
+            method,
+            needs: "a cell whose edge incidence has a pseudo-inverse",
+            cell: c,
+        }
+    })?);
     PSEUDO_INVERSES.with(|cache| {
         let mut cache = cache.borrow_mut();
         // Unstructured polytopal meshes have few repeats: bound the memory.
         if cache.len() >= PSEUDO_INVERSE_CACHE_SIZE {
             cache.clear();
         }
-        cache.insert(key, pinv.clone());
+        cache.insert(key, Rc::clone(&pinv));
     });
     Ok((edges, pinv))
 }
@@ -552,7 +553,8 @@ const PSEUDO_INVERSE_CACHE_SIZE: usize = 1024;
 thread_local! {
     /// A_c⁺ by local incidence pattern (vertex count, then the local tail
     /// and head of each edge in the cell's edge order).
-    static PSEUDO_INVERSES: std::cell::RefCell<std::collections::HashMap<Vec<usize>, DMatrix<f64>>> =
+    /// Shared (`Rc`): a cell borrows its pattern's A_c⁺ without a copy.
+    static PSEUDO_INVERSES: std::cell::RefCell<std::collections::HashMap<Vec<usize>, Rc<DMatrix<f64>>>> =
         std::cell::RefCell::new(std::collections::HashMap::new());
 }
 
@@ -565,7 +567,7 @@ fn edge_block(
     method: &'static str,
 ) -> Result<Local, MetricError> {
     let (edges, pinv) = edge_pseudo_inverse(top, c, method)?;
-    let omega = pinv.transpose() * kc * &pinv;
+    let omega = pinv.transpose() * kc * &*pinv;
     let m = edges.len();
     // Symmetric up to rounding; made exactly so.
     let values: Vec<f64> = (0..m * m)
