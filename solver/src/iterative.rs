@@ -195,6 +195,12 @@ impl RowMatrix {
         (&self.idx[r.clone()], &self.val[r])
     }
 
+    /// Row `i` times `x`, summed in storage order.
+    pub fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
+        let (c, v) = self.row(i);
+        c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum()
+    }
+
     /// The sum of the stored diagonal entries of each row.
     pub fn diagonal(&self) -> Vec<f64> {
         (0..self.nrows)
@@ -217,8 +223,7 @@ impl RowMatrix {
             .with_min_len(ROW_CHUNK)
             .enumerate()
             .for_each(|(i, yi)| {
-                let (c, v) = self.row(i);
-                *yi = c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum();
+                *yi = self.row_dot(i, x);
             });
     }
 
@@ -231,8 +236,7 @@ impl RowMatrix {
             .map(|(chunk, ys)| {
                 let base = chunk * DOT_CHUNK;
                 for (k, yi) in ys.iter_mut().enumerate() {
-                    let (c, v) = self.row(base + k);
-                    *yi = c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum();
+                    *yi = self.row_dot(base + k, x);
                 }
                 x[base..base + ys.len()]
                     .iter()
@@ -250,12 +254,7 @@ impl RowMatrix {
             .with_min_len(ROW_CHUNK)
             .enumerate()
             .for_each(|(i, ri)| {
-                let (c, v) = self.row(i);
-                *ri = b[i]
-                    - c.iter()
-                        .zip(v)
-                        .map(|(&j, &a)| a * x[j as usize])
-                        .sum::<f64>();
+                *ri = b[i] - self.row_dot(i, x);
             });
     }
 

@@ -1029,12 +1029,7 @@ impl Multigrid {
                         .zip(d.par_iter_mut())
                         .enumerate()
                         .for_each(|(i, (ri, di))| {
-                            let (c, v) = a.row(i);
-                            *ri = b[i]
-                                - c.iter()
-                                    .zip(v)
-                                    .map(|(&j, &m)| m * xr[j as usize])
-                                    .sum::<f64>();
+                            *ri = b[i] - a.row_dot(i, xr);
                             *di = dinv[i] * *ri / theta;
                         });
                 }
@@ -1051,13 +1046,8 @@ impl Multigrid {
                         .zip(e.par_iter_mut())
                         .enumerate()
                         .for_each(|(i, ((x, r), e))| {
-                            let (c, v) = a.row(i);
                             let old = source.map_or(*r, |b| b[i]);
-                            *r = old
-                                - c.iter()
-                                    .zip(v)
-                                    .map(|(&j, &m)| m * dk[j as usize])
-                                    .sum::<f64>();
+                            *r = old - a.row_dot(i, dk);
                             *e = s1 * dk[i] + s2 * dinv[i] * *r;
                             if pending {
                                 *x += dk[i];
@@ -1077,13 +1067,8 @@ impl Multigrid {
                         .zip(r.par_iter_mut())
                         .enumerate()
                         .for_each(|(i, (x, r))| {
-                            let (c, v) = a.row(i);
                             let old = source.map_or(*r, |b| b[i]);
-                            *r = old
-                                - c.iter()
-                                    .zip(v)
-                                    .map(|(&j, &m)| m * dk[j as usize])
-                                    .sum::<f64>();
+                            *r = old - a.row_dot(i, dk);
                             if pending {
                                 *x += dk[i];
                             }
@@ -1126,14 +1111,7 @@ impl Multigrid {
             x.par_iter_mut()
                 .with_min_len(ROW_CHUNK)
                 .enumerate()
-                .for_each(|(i, x)| {
-                    let (cols, v) = p.row(i);
-                    *x += c * cols
-                        .iter()
-                        .zip(v)
-                        .map(|(&j, &a)| a * xc[j as usize])
-                        .sum::<f64>();
-                });
+                .for_each(|(i, x)| *x += c * p.row_dot(i, xc));
             self.smooth(level, b, x, scratch, false, false);
         }
     }
