@@ -209,6 +209,13 @@ impl Complex {
     }
 
     /// ∂_p, shared with the complex (no copy), for operators that keep it.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    /// let shared = k.shared_boundary(2);
+    /// assert!(std::ptr::eq(&*shared, k.boundary(2)));
+    /// ```
     pub fn shared_boundary(&self, p: usize) -> Arc<CsMat<i8>> {
         Arc::clone(&self.boundaries[p - 1])
     }

@@ -100,7 +100,20 @@ impl BlockMetric {
 
     /// The weights w when Ω = diag(w) with block b the 1×1 block (b, b)
     /// for b < w.len() (rows beyond have no block); `None` for any other
-    /// layout of blocks.
+    /// layout of blocks. [`Canonical`] assembles such an Ω column by
+    /// column, without a scatter map.
+    ///
+    /// ```
+    /// use hasse_solver::canonical::BlockMetric;
+    /// let mut omega = BlockMetric::from_weights(vec![2.0, 3.0]);
+    /// omega.add_rows(1);
+    /// omega.push_block(&[2], &[2], &[4.0]);
+    /// assert_eq!(omega.diagonal_weights(), Some(&[2.0, 3.0, 4.0][..]));
+    /// // A block off the diagonal (or out of row order) ends the layout.
+    /// omega.push_block(&[0], &[1], &[1.0]);
+    /// assert_eq!(omega.diagonal_weights(), None);
+    /// assert_eq!(omega.block(1), (&[1][..], &[1][..], &[3.0][..]));
+    /// ```
     pub fn diagonal_weights(&self) -> Option<&[f64]> {
         self.blocks.is_empty().then_some(&self.values[..])
     }
