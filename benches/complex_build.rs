@@ -7,12 +7,18 @@
 //! sparse products" a complete complex costs.
 //!
 //! Run with `scripts/bench` (prints the headline table) or
-//! `cargo bench --bench complex_build`.
+//! `cargo bench --bench complex_build`. For a quick look at construction
+//! alone (no geometry), set `COMPLEX_BUILD_QUICK=2d` or `=3d` (optionally
+//! `COMPLEX_BUILD_REPEAT=k`): the binary then times `rectangle(1000, 1000)`
+//! or `box3(100, 100, 100)` k times and prints the process's peak memory.
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::{criterion_group, BenchmarkId, Criterion};
 use hasse_complex::{generate, Complex};
 use std::hint::black_box;
-use std::time::Duration;
+use std::time::{Duration, Instant};
+
+#[path = "common/measure.rs"]
+mod measure;
 
 fn build_with_geometry(axes: &[Vec<f64>]) -> Complex {
     let complex = generate::grid(axes).expect("grid parameters are valid");
@@ -75,5 +81,37 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
+/// Construction alone, repeated: one line per build, then the peak memory.
+fn quick(which: &str, repeat: usize) {
+    let unit = [0.0, 1.0];
+    for _ in 0..repeat {
+        let t = Instant::now();
+        let complex = match which {
+            "3d" => generate::box3(100, 100, 100, unit, unit, unit),
+            _ => generate::rectangle(1000, 1000, unit, unit),
+        }
+        .expect("grid parameters are valid");
+        let seconds = measure::seconds(t);
+        println!(
+            "{which} build {seconds:.3} s  cells {:?}",
+            complex.cell_counts()
+        );
+        drop(black_box(complex));
+    }
+    println!("peak memory {:.3} GiB", measure::peak_memory_gib());
+}
+
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+fn main() {
+    if let Ok(which) = std::env::var("COMPLEX_BUILD_QUICK") {
+        let repeat = std::env::var("COMPLEX_BUILD_REPEAT")
+            .ok()
+            .and_then(|r| r.parse().ok())
+            .unwrap_or(1);
+        quick(&which, repeat);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}
