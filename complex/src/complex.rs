@@ -66,8 +66,9 @@ impl Complex {
         let k0 = vertices.len();
         let mut matrices = vec![characteristic_matrix(&vertex_sets(&cells), k0)];
         let mut current = cells;
-        for _ in (2..=n).rev() {
-            let level = extract_facets(&current);
+        for p in (2..=n).rev() {
+            // The edges (p = 2) need no facets of their own.
+            let level = extract_facets(&current, p > 2);
             matrices.push(characteristic_matrix(&level.sets, k0));
             current = level.cells;
         }
@@ -86,8 +87,14 @@ impl Complex {
             });
         }
         let mut boundaries = Vec::with_capacity(n);
+        // Frames of the top cells, when ∂_n needed them (non-simplices).
+        let mut top_frames = None;
         for p in 1..=n {
-            boundaries.push(signed_boundary(&lar, p)?);
+            let (boundary, frames) = signed_boundary(&lar, p)?;
+            boundaries.push(boundary);
+            if p == n {
+                top_frames = frames;
+            }
         }
         // One pass over the top cells: degeneracy, and the ambient orientation
         // (only used when n = d).
@@ -96,16 +103,19 @@ impl Complex {
             .into_par_iter()
             .map(|j| {
                 let cell = lar.cell_vertices(n, j);
-                let f = frame::frame(vertices, cell, n).ok_or_else(|| {
-                    ComplexError::DegenerateCell {
-                        dim: n,
-                        cell: j,
-                        vertices: cell.to_vec(),
-                    }
+                let f = match &top_frames {
+                    Some(frames) => frames[j],
+                    None => frame::frame(vertices, cell, n),
+                };
+                let f = f.ok_or_else(|| ComplexError::DegenerateCell {
+                    dim: n,
+                    cell: j,
+                    vertices: cell.to_vec(),
                 })?;
                 Ok(if frame::det(n, &f.basis) > 0.0 { 1 } else { -1 })
             })
             .collect::<Result<_>>()?;
+        drop(top_frames);
         check_closed(&lar, &boundaries)?;
         let top_orientation = orient_top_cells(&lar, &boundaries[n - 1], ambient)?;
         let top = &mut boundaries[n - 1];
@@ -441,12 +451,16 @@ impl Subcomplex {
     }
 }
 
+/// The frame of every cell of one dimension (`None` for a degenerate cell).
+type CellFrames = Vec<Option<frame::Frame>>;
+
 /// ∂_p with signs: exact (−1)^k between simplices, the geometric induced
 /// orientation otherwise. Frames are computed on the fly (once per facet,
 /// once per incident cell) rather than stored: at 10^6 cells stored frames
 /// cost more in memory traffic than recomputing them. Top cells are not
-/// yet oriented.
-fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
+/// yet oriented. The frames of the p-cells are returned when they were
+/// computed (some p-cell is not a simplex), for the top level's orientation.
+fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>)> {
     const CHUNK: usize = 8192;
     let (indptr, indices) = lar.boundary_pattern(p);
     let rows = lar.cell_count(p - 1);
@@ -518,8 +532,9 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
         .collect::<Result<_>>()?;
     let data: Vec<i8> = chunks.concat();
     let shape = (rows, lar.cell_count(p));
-    CsMat::try_new(shape, indptr, indices, data)
-        .map_err(|e| ComplexError::Invalid(format!("internal: boundary matrix ∂_{p}: {}", e.3)))
+    let matrix = CsMat::try_new(shape, indptr, indices, data)
+        .map_err(|e| ComplexError::Invalid(format!("internal: boundary matrix ∂_{p}: {}", e.3)))?;
+    Ok((matrix, upper_frames))
 }
 
 /// Orientation flags of the top cells: the ambient orientation when n = d,
@@ -613,32 +628,70 @@ fn enclosed_volume(lar: &Lar, by_cell: &CsMat<i8>, flags: &[i8], component: &[us
 /// geometry, and on a twisted or self-intersecting cell (a "bow-tie" face of
 /// a hexahedron whose nodes are out of order) they need not: report the
 /// cell rather than hand out a complex that breaks ∂∂ = 0.
+///
+/// The product is formed row by row (row v of ∂_{p−1} ∂_p gathers the rows
+/// of ∂_p of v's cofaces), in parallel and with no transposed copy; only when
+/// some row does not cancel is the column-wise search run, to name the first
+/// open cell.
 fn check_closed(lar: &Lar, boundaries: &[CsMat<i8>]) -> Result<()> {
+    const CHUNK: usize = 8192;
     for p in 2..=boundaries.len() {
-        if (0..lar.cell_count(p)).all(|j| lar.cell_vertices(p, j).len() == p + 1) {
+        if (0..lar.cell_count(p))
+            .into_par_iter()
+            .all(|j| lar.cell_vertices(p, j).len() == p + 1)
+        {
             continue;
         }
-        let (lower, upper) = (&boundaries[p - 2], boundaries[p - 1].to_csc());
-        let lower = lower.to_csc();
-        let mut terms: Vec<(usize, i32)> = Vec::new();
-        for (cell, column) in upper.outer_iterator().enumerate() {
-            terms.clear();
-            for (facet, &s) in column.iter() {
-                if let Some(edges) = lower.outer_view(facet) {
-                    terms.extend(edges.iter().map(|(v, &t)| (v, i32::from(s) * i32::from(t))));
+        let (lower, upper) = (&boundaries[p - 2], &boundaries[p - 1]);
+        let rows = lower.rows();
+        let closed = (0..rows.div_ceil(CHUNK)).into_par_iter().all(|chunk| {
+            let mut terms: Vec<(usize, i32)> = Vec::new();
+            (chunk * CHUNK..((chunk + 1) * CHUNK).min(rows)).all(|v| {
+                terms.clear();
+                let Some(row) = lower.outer_view(v) else {
+                    return true;
+                };
+                for (facet, &s) in row.iter() {
+                    if let Some(cells) = upper.outer_view(facet) {
+                        terms.extend(cells.iter().map(|(j, &t)| (j, i32::from(s) * i32::from(t))));
+                    }
                 }
+                terms.sort_unstable_by_key(|&(j, _)| j);
+                terms
+                    .chunk_by(|a, b| a.0 == b.0)
+                    .all(|run| run.iter().map(|&(_, t)| t).sum::<i32>() == 0)
+            })
+        });
+        if !closed {
+            first_open_cell(lar, lower, upper, p)?;
+        }
+    }
+    Ok(())
+}
+
+/// The column-wise form of [`check_closed`] for one level: the error names
+/// the lowest-numbered p-cell whose faces do not close up.
+fn first_open_cell(lar: &Lar, lower: &CsMat<i8>, upper: &CsMat<i8>, p: usize) -> Result<()> {
+    let upper = upper.to_csc();
+    let lower = lower.to_csc();
+    let mut terms: Vec<(usize, i32)> = Vec::new();
+    for (cell, column) in upper.outer_iterator().enumerate() {
+        terms.clear();
+        for (facet, &s) in column.iter() {
+            if let Some(edges) = lower.outer_view(facet) {
+                terms.extend(edges.iter().map(|(v, &t)| (v, i32::from(s) * i32::from(t))));
             }
-            terms.sort_unstable_by_key(|&(v, _)| v);
-            let open = terms
-                .chunk_by(|a, b| a.0 == b.0)
-                .any(|run| run.iter().map(|&(_, t)| t).sum::<i32>() != 0);
-            if open {
-                return Err(ComplexError::Invalid(format!(
+        }
+        terms.sort_unstable_by_key(|&(v, _)| v);
+        let open = terms
+            .chunk_by(|a, b| a.0 == b.0)
+            .any(|run| run.iter().map(|&(_, t)| t).sum::<i32>() != 0);
+        if open {
+            return Err(ComplexError::Invalid(format!(
                     "{p}-cell {cell} (vertices {:?}) is twisted or self-intersecting: its {}-faces do not close up around it (∂∂ ≠ 0); check the order of its vertices",
                     lar.cell_vertices(p, cell),
                     p - 1
                 )));
-            }
         }
     }
     Ok(())
