@@ -10,8 +10,10 @@
 //! coming from neighbouring cells are merged by their vertex sets.
 
 use crate::error::{ComplexError, Result};
+use crate::lar::{characteristic_matrix, widen};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use sprs::CsMat;
 
 /// Vertex coordinates: `len()` points in R^`dim()`, stored row by row.
 ///
@@ -122,29 +124,17 @@ pub struct TopCells {
 impl TopCells {
     /// Simplices, each a list of p+1 vertex indices.
     pub fn simplices<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
-        let mut out = Self::default();
-        for c in cells {
-            out.push_simplex(c.as_ref());
-        }
-        out
+        Self::collect(cells, Self::push_simplex)
     }
 
     /// Cuboids (segments, quads, hexes), each 2^p vertices in tensor order.
     pub fn cuboids<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
-        let mut out = Self::default();
-        for c in cells {
-            out.push_cuboid(c.as_ref());
-        }
-        out
+        Self::collect(cells, Self::push_cuboid)
     }
 
     /// Convex polygons in cyclic vertex order.
     pub fn polygons<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
-        let mut out = Self::default();
-        for c in cells {
-            out.push_polygon(c.as_ref());
-        }
-        out
+        Self::collect(cells, Self::push_polygon)
     }
 
     /// Convex polyhedra, each a list of faces in cyclic vertex order.
@@ -152,6 +142,26 @@ impl TopCells {
         let mut out = Self::default();
         for c in cells {
             out.push_polyhedron(c.as_ref());
+        }
+        out
+    }
+
+    /// Cells pushed one by one, the lists reserved from the iterator's
+    /// length hint and the first cell's size.
+    fn collect<C: AsRef<[usize]>>(
+        cells: impl IntoIterator<Item = C>,
+        push: fn(&mut Self, &[usize]),
+    ) -> Self {
+        let mut out = Self::default();
+        let cells = cells.into_iter();
+        let count = cells.size_hint().0;
+        out.shapes.reserve(count);
+        out.offsets.reserve(count + 1);
+        for (k, c) in cells.enumerate() {
+            if k == 0 {
+                out.vertices.reserve(count.saturating_mul(c.as_ref().len()));
+            }
+            push(&mut out, c.as_ref());
         }
         out
     }
@@ -240,6 +250,9 @@ impl TopCells {
     /// Check every cell against the vertex count and its shape, and return the
     /// common cell dimension.
     pub(crate) fn validate(&self, vertex_count: usize) -> Result<usize> {
+        if let Some(dim) = self.quick_validate(vertex_count) {
+            return Ok(dim);
+        }
         if self.is_empty() {
             return Err(ComplexError::NoCells);
         }
@@ -328,6 +341,42 @@ impl TopCells {
             }
         }
         dim.ok_or(ComplexError::NoCells)
+    }
+
+    /// The common dimension when every cell is valid and no cell is a
+    /// polyhedron or has more than 8 vertices: checked in parallel and
+    /// without allocating. `None` sends [`TopCells::validate`] to the full
+    /// check, which names the first offending cell.
+    fn quick_validate(&self, vertex_count: usize) -> Option<usize> {
+        if self.is_empty() || self.shapes.contains(&Shape::Polyhedron) {
+            return None;
+        }
+        let dim_of = |i: usize| -> Option<usize> {
+            let raw = self.raw_vertices(i);
+            let n = raw.len();
+            if n > 8 || raw.iter().any(|&v| v as usize >= vertex_count) {
+                return None;
+            }
+            let mut buffer = [0u32; 8];
+            let sorted = &mut buffer[..n];
+            sorted.copy_from_slice(raw);
+            sorted.sort_unstable();
+            if sorted.windows(2).any(|w| w[0] == w[1]) {
+                return None;
+            }
+            match self.shapes[i] {
+                Shape::Simplex if n >= 2 => Some(n - 1),
+                Shape::Cuboid if matches!(n, 2 | 4 | 8) => Some(n.trailing_zeros() as usize),
+                Shape::Polygon if n >= 3 => Some(2),
+                _ => None,
+            }
+        };
+        let dim = dim_of(0)?;
+        (0..self.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .all(|i| dim_of(i) == Some(dim))
+            .then_some(dim)
     }
 
     /// Number of facets of cell `i` and the total length of their vertex
@@ -473,6 +522,23 @@ impl FlatSets {
     pub fn get(&self, i: usize) -> &[u32] {
         &self.vertices[self.offsets[i]..self.offsets[i + 1]]
     }
+}
+
+/// The characteristic matrix M_p of the cells themselves (their sorted
+/// vertex sets as rows), sorted and widened in one parallel pass.
+pub(crate) fn top_characteristic(cells: &TopCells, vertex_count: usize) -> CsMat<u8> {
+    if cells.shapes.contains(&Shape::Polyhedron) || cells.offsets.is_empty() {
+        return characteristic_matrix(vertex_sets(cells), vertex_count);
+    }
+    let indices = widen(&cells.offsets, &cells.vertices, true);
+    let nnz = indices.len();
+    // Rows are sorted by `widen` and in range after validation.
+    CsMat::new(
+        (cells.len(), vertex_count),
+        cells.offsets.clone(),
+        indices,
+        vec![1u8; nnz],
+    )
 }
 
 /// The sorted vertex sets of every cell, without a heap allocation per

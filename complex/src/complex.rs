@@ -1,7 +1,7 @@
 //! The oriented cell complex: LAR characteristic matrices plus the signed
 //! boundary matrices ∂_p, with the topological queries built on them.
 
-use crate::cells::{extract_facets, vertex_sets, TopCells, Vertices};
+use crate::cells::{extract_facets, top_characteristic, TopCells, Vertices};
 use crate::error::{ComplexError, Result};
 use crate::frame;
 use crate::homology::{self, Field};
@@ -64,16 +64,17 @@ impl Complex {
             });
         }
         let k0 = vertices.len();
-        let mut matrices = vec![characteristic_matrix(&vertex_sets(&cells), k0)];
+        let mut matrices = vec![top_characteristic(&cells, k0)];
         let mut current = cells;
         for p in (2..=n).rev() {
             // The edges (p = 2) need no facets of their own.
             let level = extract_facets(&current, p > 2);
-            matrices.push(characteristic_matrix(&level.sets, k0));
+            matrices.push(characteristic_matrix(level.sets, k0));
             current = level.cells;
         }
         matrices.reverse();
-        Self::from_lar(Lar::new(vertices, matrices)?)
+        let lar = Lar::new(vertices, matrices)?;
+        Self::from_lar(lar)
     }
 
     /// Orient a LAR whose characteristic matrices are all given (every cell
@@ -119,9 +120,10 @@ impl Complex {
         check_closed(&lar, &boundaries)?;
         let top_orientation = orient_top_cells(&lar, &boundaries[n - 1], ambient)?;
         let top = &mut boundaries[n - 1];
-        let cols: Vec<usize> = top.indices().to_vec();
-        for (value, col) in top.data_mut().iter_mut().zip(cols) {
-            *value *= top_orientation[col];
+        for mut row in top.outer_iterator_mut() {
+            for (col, value) in row.iter_mut() {
+                *value *= top_orientation[col];
+            }
         }
         check_coherence(&boundaries[n - 1], n == lar.vertices().dim())?;
         Ok(Self {
@@ -461,8 +463,6 @@ type CellFrames = Vec<Option<frame::Frame>>;
 /// yet oriented. The frames of the p-cells are returned when they were
 /// computed (some p-cell is not a simplex), for the top level's orientation.
 fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>)> {
-    const CHUNK: usize = 8192;
-    let (indptr, indices) = lar.boundary_pattern(p);
     let rows = lar.cell_count(p - 1);
     let vertices = lar.vertices();
     let degenerate = |dim: usize, cell: usize, verts: &[usize]| ComplexError::DegenerateCell {
@@ -482,10 +482,11 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>
                 .map(|j| frame::frame(vertices, lar.cell_vertices(p, j), p))
                 .collect()
         });
-    let row_signs = |i: usize, out: &mut Vec<i8>| -> Result<()> {
+    let row_signs = |i: usize, columns: &[u32], out: &mut Vec<i8>| -> Result<()> {
         let facet = lar.cell_vertices(p - 1, i);
         let mut facet_frame = None;
-        for &j in &indices[indptr[i]..indptr[i + 1]] {
+        for &j in columns {
+            let j = j as usize;
             let cell = lar.cell_vertices(p, j);
             if cell.len() == p + 1 && facet.len() == p {
                 let k = facet
@@ -504,11 +505,11 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>
             }
             let cell_frame = upper_frames
                 .as_ref()
-                .and_then(|frames| frames[j])
+                .and_then(|frames| frames[j].as_ref())
                 .ok_or_else(|| degenerate(p, j, cell))?;
             let sign = facet_frame
                 .as_ref()
-                .and_then(|f| frame::induced_sign(&cell_frame, f, cell_frame.diameter))
+                .and_then(|f| frame::induced_sign(cell_frame, f, cell_frame.diameter))
                 .ok_or_else(|| {
                     ComplexError::Invalid(format!(
                         "{}-cell {i} (vertices {facet:?}) does not bound {p}-cell {j} (vertices {cell:?}) from outside: the cell is not convex or is degenerate",
@@ -519,18 +520,7 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>
         }
         Ok(())
     };
-    let chunks: Vec<Vec<i8>> = (0..rows.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|chunk| {
-            let rows = chunk * CHUNK..((chunk + 1) * CHUNK).min(rows);
-            let mut out = Vec::with_capacity(indptr[rows.end] - indptr[rows.start]);
-            for i in rows {
-                row_signs(i, &mut out)?;
-            }
-            Ok(out)
-        })
-        .collect::<Result<_>>()?;
-    let data: Vec<i8> = chunks.concat();
+    let (indptr, indices, data) = lar.boundary_pattern_with(p, row_signs)?;
     let shape = (rows, lar.cell_count(p));
     let matrix = CsMat::try_new(shape, indptr, indices, data)
         .map_err(|e| ComplexError::Invalid(format!("internal: boundary matrix ∂_{p}: {}", e.3)))?;
