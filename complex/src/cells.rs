@@ -379,6 +379,18 @@ impl TopCells {
             .then_some(dim)
     }
 
+    /// The common length of the facets of cell `i` (`None` for polyhedra,
+    /// whose faces may differ).
+    fn facet_len(&self, i: usize) -> Option<usize> {
+        let n = self.raw_vertices(i).len();
+        match self.shapes[i] {
+            Shape::Simplex => Some(n.saturating_sub(1)),
+            Shape::Cuboid => Some(n / 2),
+            Shape::Polygon => Some(2),
+            Shape::Polyhedron => None,
+        }
+    }
+
     /// Number of facets of cell `i` and the total length of their vertex
     /// lists, as [`TopCells::push_facets`] writes them.
     fn facet_sizes(&self, i: usize) -> (usize, usize) {
@@ -610,17 +622,26 @@ pub(crate) fn extract_facets(cells: &TopCells, keep_cells: bool) -> ExtractedLev
         .collect();
     let facet_total: usize = sizes.iter().map(|s| s.0).sum();
     let slot_total: usize = sizes.iter().map(|s| s.1).sum();
-    let mut offsets = vec![0usize; facet_total + 1];
+    // When every facet has the same length (simplices, cuboids, polygons:
+    // the usual meshes) candidate c sits at c·len and no offsets are kept.
+    let fixed = cells.facet_len(0).filter(|&len| {
+        (0..cells.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .all(|i| cells.facet_len(i) == Some(len))
+    });
+    let offset_count = if fixed.is_some() { 0 } else { facet_total };
+    let mut offsets = vec![0usize; if fixed.is_some() { 0 } else { facet_total + 1 }];
     let mut sorted = vec![0u32; slot_total];
     let mut shapes = vec![Shape::Simplex; if keep_cells { facet_total } else { 0 }];
     let mut raw = vec![0u32; if keep_cells { slot_total } else { 0 }];
     {
         let mut jobs = Vec::with_capacity(chunks);
-        let (mut o_rest, mut s_rest) = (&mut offsets[..facet_total], sorted.as_mut_slice());
+        let (mut o_rest, mut s_rest) = (&mut offsets[..offset_count], sorted.as_mut_slice());
         let (mut h_rest, mut r_rest) = (shapes.as_mut_slice(), raw.as_mut_slice());
         let mut slot_base = 0;
         for (c, &(nf, nv)) in sizes.iter().enumerate() {
-            let (o, o_tail) = o_rest.split_at_mut(nf);
+            let (o, o_tail) = o_rest.split_at_mut(if fixed.is_some() { 0 } else { nf });
             let (s, s_tail) = s_rest.split_at_mut(nv);
             let (h, h_tail) = h_rest.split_at_mut(if keep_cells { nf } else { 0 });
             let (r, r_tail) = r_rest.split_at_mut(if keep_cells { nv } else { 0 });
@@ -637,9 +658,10 @@ pub(crate) fn extract_facets(cells: &TopCells, keep_cells: bool) -> ExtractedLev
                 for i in chunk_range(c) {
                     cells.push_facets(i, out);
                 }
-                debug_assert_eq!(out.len(), offsets.len());
                 for (f, w) in out.offsets.windows(2).enumerate() {
-                    offsets[f] = slot_base + w[0];
+                    if fixed.is_none() {
+                        offsets[f] = slot_base + w[0];
+                    }
                     let set = &mut sorted[w[0]..w[1]];
                     set.copy_from_slice(&out.vertices[w[0]..w[1]]);
                     set.sort_unstable();
@@ -651,8 +673,14 @@ pub(crate) fn extract_facets(cells: &TopCells, keep_cells: bool) -> ExtractedLev
             },
         );
     }
-    offsets[facet_total] = slot_total;
-    let set = |c: usize| &sorted[offsets[c]..offsets[c + 1]];
+    if fixed.is_none() {
+        offsets[facet_total] = slot_total;
+    }
+    let span = |c: usize| match fixed {
+        Some(len) => c * len..(c + 1) * len,
+        None => offsets[c]..offsets[c + 1],
+    };
+    let set = |c: usize| &sorted[span(c)];
 
     // Counting sort by smallest vertex.
     let bound = sorted
@@ -753,7 +781,7 @@ pub(crate) fn extract_facets(cells: &TopCells, keep_cells: bool) -> ExtractedLev
                     vertices[at..at + s.len()].copy_from_slice(s);
                     if keep_cells {
                         shapes_out[k] = shapes[c];
-                        raw_out[at..at + s.len()].copy_from_slice(&raw[offsets[c]..offsets[c + 1]]);
+                        raw_out[at..at + s.len()].copy_from_slice(&raw[span(c)]);
                     }
                     at += s.len();
                     ends[k] = slot_base + at;

@@ -105,7 +105,7 @@ impl Complex {
             .map(|j| {
                 let cell = lar.cell_vertices(n, j);
                 let f = match &top_frames {
-                    Some(frames) => frames[j],
+                    Some(frames) => frames.get(j),
                     None => frame::frame(vertices, cell, n),
                 };
                 let f = f.ok_or_else(|| ComplexError::DegenerateCell {
@@ -453,16 +453,13 @@ impl Subcomplex {
     }
 }
 
-/// The frame of every cell of one dimension (`None` for a degenerate cell).
-type CellFrames = Vec<Option<frame::Frame>>;
-
 /// ∂_p with signs: exact (−1)^k between simplices, the geometric induced
 /// orientation otherwise. Frames are computed on the fly (once per facet,
 /// once per incident cell) rather than stored: at 10^6 cells stored frames
 /// cost more in memory traffic than recomputing them. Top cells are not
 /// yet oriented. The frames of the p-cells are returned when they were
 /// computed (some p-cell is not a simplex), for the top level's orientation.
-fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>)> {
+fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<frame::PackedFrames>)> {
     let rows = lar.cell_count(p - 1);
     let vertices = lar.vertices();
     let degenerate = |dim: usize, cell: usize, verts: &[usize]| ComplexError::DegenerateCell {
@@ -473,14 +470,13 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>
     // Frames of the upper cells are needed by every facet of a non-simplex
     // cell: compute them once per cell (a hex is met by six faces). Facet
     // frames are computed once per row, so they are never stored.
-    let upper_frames: Option<Vec<Option<frame::Frame>>> = (0..lar.cell_count(p))
+    let upper_frames: Option<frame::PackedFrames> = (0..lar.cell_count(p))
         .into_par_iter()
         .any(|j| lar.cell_vertices(p, j).len() != p + 1)
         .then(|| {
-            (0..lar.cell_count(p))
-                .into_par_iter()
-                .map(|j| frame::frame(vertices, lar.cell_vertices(p, j), p))
-                .collect()
+            frame::PackedFrames::new(p, lar.cell_count(p), |j| {
+                frame::frame(vertices, lar.cell_vertices(p, j), p)
+            })
         });
     let row_signs = |i: usize, columns: &[u32], out: &mut Vec<i8>| -> Result<()> {
         let facet = lar.cell_vertices(p - 1, i);
@@ -505,11 +501,11 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<CellFrames>
             }
             let cell_frame = upper_frames
                 .as_ref()
-                .and_then(|frames| frames[j].as_ref())
+                .and_then(|frames| frames.get(j))
                 .ok_or_else(|| degenerate(p, j, cell))?;
             let sign = facet_frame
                 .as_ref()
-                .and_then(|f| frame::induced_sign(cell_frame, f, cell_frame.diameter))
+                .and_then(|f| frame::induced_sign(&cell_frame, f, cell_frame.diameter))
                 .ok_or_else(|| {
                     ComplexError::Invalid(format!(
                         "{}-cell {i} (vertices {facet:?}) does not bound {p}-cell {j} (vertices {cell:?}) from outside: the cell is not convex or is degenerate",
