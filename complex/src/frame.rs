@@ -91,6 +91,7 @@ impl PackedFrames {
     }
 
     /// The frame of cell `j`, as `frame_of(j)` returned it.
+    #[inline]
     pub fn get(&self, j: usize) -> Option<Frame> {
         let dim = self.dim;
         let slot = &self.data[j * (3 * dim + 4)..(j + 1) * (3 * dim + 4)];

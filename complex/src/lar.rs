@@ -163,6 +163,7 @@ impl Lar {
     }
 
     /// Sorted vertices of p-cell `i`.
+    #[inline]
     pub fn cell_vertices(&self, p: usize, i: usize) -> &[usize] {
         if p == 0 {
             // Row i of the identity M_0.
