@@ -624,7 +624,8 @@ pub(crate) fn extract_facets(cells: &TopCells, keep_cells: bool) -> ExtractedLev
     let slot_total: usize = sizes.iter().map(|s| s.1).sum();
     // When every facet has the same length (simplices, cuboids, polygons:
     // the usual meshes) candidate c sits at c·len and no offsets are kept.
-    let fixed = cells.facet_len(0).filter(|&len| {
+    let first_len = (!cells.is_empty()).then(|| cells.facet_len(0)).flatten();
+    let fixed = first_len.filter(|&len| {
         (0..cells.len())
             .into_par_iter()
             .with_min_len(4096)
