@@ -7,12 +7,20 @@
 //! sparse products" a complete complex costs.
 //!
 //! Run with `scripts/bench` (prints the headline table) or
-//! `cargo bench --bench complex_build`.
+//! `cargo bench --bench complex_build`. For a quick look at construction
+//! alone (no geometry), set `COMPLEX_BUILD_QUICK=2d` or `=3d` (optionally
+//! `COMPLEX_BUILD_REPEAT=k`): the binary then times `rectangle(1000, 1000)`
+//! or `box3(100, 100, 100)` k times and prints the process's peak memory
+//! (and, with `COMPLEX_BUILD_HASH` set, a hash of the whole construction,
+//! to compare two builds of the crate).
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use criterion::{criterion_group, BenchmarkId, Criterion};
 use hasse_complex::{generate, Complex};
 use std::hint::black_box;
-use std::time::Duration;
+use std::time::{Duration, Instant};
+
+#[path = "common/measure.rs"]
+mod measure;
 
 fn build_with_geometry(axes: &[Vec<f64>]) -> Complex {
     let complex = generate::grid(axes).expect("grid parameters are valid");
@@ -75,5 +83,72 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
+/// FNV-1a over every ∂_p (pointers, indices, signs), the characteristic
+/// matrices, the top orientation and the tags: equal hashes from two builds
+/// of the crate mean the same complex.
+fn construction_hash(complex: &Complex) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |x: u64| {
+        for b in x.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for p in 1..=complex.dim() {
+        let d = complex.boundary(p);
+        d.indptr().raw_storage().iter().for_each(|&i| eat(i as u64));
+        d.indices().iter().for_each(|&i| eat(i as u64));
+        d.data().iter().for_each(|&s| eat(s as u64));
+        let m = complex.lar().characteristic(p).expect("level exists");
+        m.indices().iter().for_each(|&i| eat(i as u64));
+    }
+    complex
+        .top_orientation()
+        .iter()
+        .for_each(|&s| eat(s as u64));
+    for (name, tag) in complex.tags().iter() {
+        name.bytes().for_each(|b| eat(u64::from(b)));
+        tag.cells.iter().for_each(|&c| eat(c as u64));
+    }
+    h
+}
+
+/// Construction alone, repeated: one line per build, then the peak memory.
+fn quick(which: &str, repeat: usize) {
+    let unit = [0.0, 1.0];
+    for _ in 0..repeat {
+        let t = Instant::now();
+        let complex = match which {
+            "3d" => generate::box3(100, 100, 100, unit, unit, unit),
+            _ => generate::rectangle(1000, 1000, unit, unit),
+        }
+        .expect("grid parameters are valid");
+        let seconds = measure::seconds(t);
+        println!(
+            "{which} build {seconds:.3} s  cells {:?}",
+            complex.cell_counts()
+        );
+        if std::env::var_os("COMPLEX_BUILD_HASH").is_some() {
+            println!(
+                "{which} construction hash {:#018x}",
+                construction_hash(&complex)
+            );
+        }
+        drop(black_box(complex));
+    }
+    println!("peak memory {:.3} GiB", measure::peak_memory_gib());
+}
+
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+fn main() {
+    if let Ok(which) = std::env::var("COMPLEX_BUILD_QUICK") {
+        let repeat = std::env::var("COMPLEX_BUILD_REPEAT")
+            .ok()
+            .and_then(|r| r.parse().ok())
+            .unwrap_or(1);
+        quick(&which, repeat);
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

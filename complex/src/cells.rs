@@ -10,8 +10,10 @@
 //! coming from neighbouring cells are merged by their vertex sets.
 
 use crate::error::{ComplexError, Result};
+use crate::lar::{characteristic_matrix, widen};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use sprs::CsMat;
 
 /// Vertex coordinates: `len()` points in R^`dim()`, stored row by row.
 ///
@@ -122,29 +124,17 @@ pub struct TopCells {
 impl TopCells {
     /// Simplices, each a list of p+1 vertex indices.
     pub fn simplices<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
-        let mut out = Self::default();
-        for c in cells {
-            out.push_simplex(c.as_ref());
-        }
-        out
+        Self::collect(cells, Self::push_simplex)
     }
 
     /// Cuboids (segments, quads, hexes), each 2^p vertices in tensor order.
     pub fn cuboids<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
-        let mut out = Self::default();
-        for c in cells {
-            out.push_cuboid(c.as_ref());
-        }
-        out
+        Self::collect(cells, Self::push_cuboid)
     }
 
     /// Convex polygons in cyclic vertex order.
     pub fn polygons<C: AsRef<[usize]>>(cells: impl IntoIterator<Item = C>) -> Self {
-        let mut out = Self::default();
-        for c in cells {
-            out.push_polygon(c.as_ref());
-        }
-        out
+        Self::collect(cells, Self::push_polygon)
     }
 
     /// Convex polyhedra, each a list of faces in cyclic vertex order.
@@ -152,6 +142,26 @@ impl TopCells {
         let mut out = Self::default();
         for c in cells {
             out.push_polyhedron(c.as_ref());
+        }
+        out
+    }
+
+    /// Cells pushed one by one, the lists reserved from the iterator's
+    /// length hint and the first cell's size.
+    fn collect<C: AsRef<[usize]>>(
+        cells: impl IntoIterator<Item = C>,
+        push: fn(&mut Self, &[usize]),
+    ) -> Self {
+        let mut out = Self::default();
+        let cells = cells.into_iter();
+        let count = cells.size_hint().0;
+        out.shapes.reserve(count);
+        out.offsets.reserve(count + 1);
+        for (k, c) in cells.enumerate() {
+            if k == 0 {
+                out.vertices.reserve(count.saturating_mul(c.as_ref().len()));
+            }
+            push(&mut out, c.as_ref());
         }
         out
     }
@@ -240,6 +250,9 @@ impl TopCells {
     /// Check every cell against the vertex count and its shape, and return the
     /// common cell dimension.
     pub(crate) fn validate(&self, vertex_count: usize) -> Result<usize> {
+        if let Some(dim) = self.quick_validate(vertex_count) {
+            return Ok(dim);
+        }
         if self.is_empty() {
             return Err(ComplexError::NoCells);
         }
@@ -328,6 +341,73 @@ impl TopCells {
             }
         }
         dim.ok_or(ComplexError::NoCells)
+    }
+
+    /// The common dimension when every cell is valid and no cell is a
+    /// polyhedron or has more than 8 vertices: checked in parallel and
+    /// without allocating. `None` sends [`TopCells::validate`] to the full
+    /// check, which names the first offending cell.
+    fn quick_validate(&self, vertex_count: usize) -> Option<usize> {
+        if self.is_empty() || self.shapes.contains(&Shape::Polyhedron) {
+            return None;
+        }
+        let dim_of = |i: usize| -> Option<usize> {
+            let raw = self.raw_vertices(i);
+            let n = raw.len();
+            if n > 8 || raw.iter().any(|&v| v as usize >= vertex_count) {
+                return None;
+            }
+            let mut buffer = [0u32; 8];
+            let sorted = &mut buffer[..n];
+            sorted.copy_from_slice(raw);
+            sorted.sort_unstable();
+            if sorted.windows(2).any(|w| w[0] == w[1]) {
+                return None;
+            }
+            match self.shapes[i] {
+                Shape::Simplex if n >= 2 => Some(n - 1),
+                Shape::Cuboid if matches!(n, 2 | 4 | 8) => Some(n.trailing_zeros() as usize),
+                Shape::Polygon if n >= 3 => Some(2),
+                _ => None,
+            }
+        };
+        let dim = dim_of(0)?;
+        (0..self.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .all(|i| dim_of(i) == Some(dim))
+            .then_some(dim)
+    }
+
+    /// The common length of the facets of cell `i` (`None` for polyhedra,
+    /// whose faces may differ).
+    fn facet_len(&self, i: usize) -> Option<usize> {
+        let n = self.raw_vertices(i).len();
+        match self.shapes[i] {
+            Shape::Simplex => Some(n.saturating_sub(1)),
+            Shape::Cuboid => Some(n / 2),
+            Shape::Polygon => Some(2),
+            Shape::Polyhedron => None,
+        }
+    }
+
+    /// Number of facets of cell `i` and the total length of their vertex
+    /// lists, as [`TopCells::push_facets`] writes them.
+    fn facet_sizes(&self, i: usize) -> (usize, usize) {
+        let n = self.raw_vertices(i).len();
+        match self.shapes[i] {
+            Shape::Simplex => (n, n * n.saturating_sub(1)),
+            // 2p facets of 2^(p−1) vertices each.
+            Shape::Cuboid => {
+                let p = n.trailing_zeros() as usize;
+                (2 * p, p * n)
+            }
+            Shape::Polygon => (n, 2 * n),
+            Shape::Polyhedron => {
+                let faces = polyhedron_faces(self.raw_vertices(i));
+                (faces.len(), faces.iter().map(|f| f.len()).sum())
+            }
+        }
     }
 
     /// Facets of cell `i`, appended to `out` as cells one dimension lower.
@@ -450,9 +530,27 @@ impl FlatSets {
         self.offsets.len().saturating_sub(1)
     }
 
+    #[cfg(test)]
     pub fn get(&self, i: usize) -> &[u32] {
         &self.vertices[self.offsets[i]..self.offsets[i + 1]]
     }
+}
+
+/// The characteristic matrix M_p of the cells themselves (their sorted
+/// vertex sets as rows), sorted and widened in one parallel pass.
+pub(crate) fn top_characteristic(cells: &TopCells, vertex_count: usize) -> CsMat<u8> {
+    if cells.shapes.contains(&Shape::Polyhedron) || cells.offsets.is_empty() {
+        return characteristic_matrix(vertex_sets(cells), vertex_count);
+    }
+    let indices = widen(&cells.offsets, &cells.vertices, true);
+    let nnz = indices.len();
+    // Rows are sorted by `widen` and in range after validation.
+    CsMat::new(
+        (cells.len(), vertex_count),
+        cells.offsets.clone(),
+        indices,
+        vec![1u8; nnz],
+    )
 }
 
 /// The sorted vertex sets of every cell, without a heap allocation per
@@ -495,97 +593,205 @@ fn compare_sets(a: &[u32], b: &[u32]) -> std::cmp::Ordering {
     b.len().cmp(&a.len())
 }
 
-fn vertex_bound(sets: &FlatSets) -> usize {
-    sets.vertices
-        .iter()
-        .map(|&v| v as usize + 1)
-        .max()
-        .unwrap_or(0)
-}
-
-/// Candidate indices ordered by vertex set (the order of [`compare_sets`],
-/// ties by index). Sets are bucketed by their smallest vertex with a
-/// counting sort, then each small bucket is sorted on its own: linear in
-/// the number of candidates, and the same order as one global sort.
-fn sorted_by_vertex_set(sets: &FlatSets, vertex_count: usize) -> Vec<u32> {
-    let mut start = vec![0usize; vertex_count + 1];
-    for i in 0..sets.len() {
-        start[sets.get(i)[0] as usize + 1] += 1;
-    }
-    for v in 0..vertex_count {
-        start[v + 1] += start[v];
-    }
-    let mut order = vec![0u32; sets.len()];
-    let mut next = start.clone();
-    for i in 0..sets.len() {
-        let v = sets.get(i)[0] as usize;
-        order[next[v]] = i as u32;
-        next[v] += 1;
-    }
-    // Buckets are disjoint slices; sort them in parallel in fixed-size groups.
-    let mut buckets: Vec<&mut [u32]> = Vec::with_capacity(vertex_count);
-    let mut rest = order.as_mut_slice();
-    for v in 0..vertex_count {
-        let (bucket, tail) = rest.split_at_mut(start[v + 1] - start[v]);
-        buckets.push(bucket);
-        rest = tail;
-    }
-    buckets
-        .par_iter_mut()
-        .with_min_len(1024)
-        .for_each(|bucket| {
-            bucket.sort_unstable_by(|&a, &b| {
-                compare_sets(sets.get(a as usize), sets.get(b as usize)).then(a.cmp(&b))
-            })
-        });
-    order
-}
-
 /// Extract, merge and number the facets of `cells` (all of dimension p ≥ 2).
-pub(crate) fn extract_facets(cells: &TopCells) -> ExtractedLevel {
+/// With `keep_cells` false only the vertex sets are produced (`cells` of
+/// the result is empty): the lowest extracted level needs no facets of its
+/// own.
+///
+/// The facets of every cell are written, chunk by chunk in parallel, into
+/// one flat candidate list (raw vertices, sorted vertex set, shape), sized
+/// beforehand so nothing is concatenated or regrown. Candidates are then
+/// bucketed by their smallest vertex (counting sort, stable) and each bucket
+/// is sorted by vertex set, ties by candidate number, which is the order of
+/// [`compare_sets`] over the whole list; the first candidate of each run of
+/// equal sets is the extracted cell. Buckets are independent, so sorting,
+/// counting and writing the unique cells run in parallel over groups of
+/// buckets.
+pub(crate) fn extract_facets(cells: &TopCells, keep_cells: bool) -> ExtractedLevel {
     const CHUNK: usize = 4096;
-    let chunks: Vec<TopCells> = (0..cells.len())
-        .collect::<Vec<_>>()
-        .par_chunks(CHUNK)
-        .map(|ids| {
-            let mut out = TopCells::default();
-            for &i in ids {
-                cells.push_facets(i, &mut out);
-            }
-            out
+    let chunks = cells.len().div_ceil(CHUNK);
+    let chunk_range = |c: usize| c * CHUNK..((c + 1) * CHUNK).min(cells.len());
+    // Facet and vertex-slot counts per chunk, then their prefix sums.
+    let sizes: Vec<(usize, usize)> = (0..chunks)
+        .into_par_iter()
+        .map(|c| {
+            chunk_range(c)
+                .map(|i| cells.facet_sizes(i))
+                .fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
         })
         .collect();
-    let mut candidates = TopCells::default();
-    candidates.offsets.push(0);
-    for chunk in chunks {
-        let base = candidates.vertices.len();
-        candidates.shapes.extend(chunk.shapes);
-        candidates
-            .offsets
-            .extend(chunk.offsets.iter().skip(1).map(|o| o + base));
-        candidates.vertices.extend(chunk.vertices);
-    }
-    let sets = vertex_sets(&candidates);
-
-    let order = sorted_by_vertex_set(&sets, vertex_bound(&sets));
-    let mut level = TopCells::default();
-    let mut unique = FlatSets {
-        offsets: vec![0],
-        vertices: Vec::new(),
-    };
-    let mut previous: Option<&[u32]> = None;
-    for &i in &order {
-        let set = sets.get(i as usize);
-        if previous == Some(set) {
-            continue;
+    let facet_total: usize = sizes.iter().map(|s| s.0).sum();
+    let slot_total: usize = sizes.iter().map(|s| s.1).sum();
+    // When every facet has the same length (simplices, cuboids, polygons:
+    // the usual meshes) candidate c sits at c·len and no offsets are kept.
+    let first_len = (!cells.is_empty()).then(|| cells.facet_len(0)).flatten();
+    let fixed = first_len.filter(|&len| {
+        (0..cells.len())
+            .into_par_iter()
+            .with_min_len(4096)
+            .all(|i| cells.facet_len(i) == Some(len))
+    });
+    let offset_count = if fixed.is_some() { 0 } else { facet_total };
+    let mut offsets = vec![0usize; if fixed.is_some() { 0 } else { facet_total + 1 }];
+    let mut sorted = vec![0u32; slot_total];
+    let mut shapes = vec![Shape::Simplex; if keep_cells { facet_total } else { 0 }];
+    let mut raw = vec![0u32; if keep_cells { slot_total } else { 0 }];
+    {
+        let mut jobs = Vec::with_capacity(chunks);
+        let (mut o_rest, mut s_rest) = (&mut offsets[..offset_count], sorted.as_mut_slice());
+        let (mut h_rest, mut r_rest) = (shapes.as_mut_slice(), raw.as_mut_slice());
+        let mut slot_base = 0;
+        for (c, &(nf, nv)) in sizes.iter().enumerate() {
+            let (o, o_tail) = o_rest.split_at_mut(if fixed.is_some() { 0 } else { nf });
+            let (s, s_tail) = s_rest.split_at_mut(nv);
+            let (h, h_tail) = h_rest.split_at_mut(if keep_cells { nf } else { 0 });
+            let (r, r_tail) = r_rest.split_at_mut(if keep_cells { nv } else { 0 });
+            (o_rest, s_rest, h_rest, r_rest) = (o_tail, s_tail, h_tail, r_tail);
+            jobs.push((c, slot_base, o, s, h, r));
+            slot_base += nv;
         }
-        previous = Some(set);
-        level.push_raw(
-            candidates.shapes[i as usize],
-            candidates.raw_vertices(i as usize).iter().copied(),
+        jobs.into_par_iter().for_each_init(
+            TopCells::default,
+            |out, (c, slot_base, offsets, sorted, shapes, raw)| {
+                out.shapes.clear();
+                out.offsets.clear();
+                out.vertices.clear();
+                for i in chunk_range(c) {
+                    cells.push_facets(i, out);
+                }
+                for (f, w) in out.offsets.windows(2).enumerate() {
+                    if fixed.is_none() {
+                        offsets[f] = slot_base + w[0];
+                    }
+                    let set = &mut sorted[w[0]..w[1]];
+                    set.copy_from_slice(&out.vertices[w[0]..w[1]]);
+                    set.sort_unstable();
+                }
+                if keep_cells {
+                    shapes.copy_from_slice(&out.shapes);
+                    raw.copy_from_slice(&out.vertices);
+                }
+            },
         );
-        unique.vertices.extend_from_slice(set);
-        unique.offsets.push(unique.vertices.len());
+    }
+    if fixed.is_none() {
+        offsets[facet_total] = slot_total;
+    }
+    let span = |c: usize| match fixed {
+        Some(len) => c * len..(c + 1) * len,
+        None => offsets[c]..offsets[c + 1],
+    };
+    let set = |c: usize| &sorted[span(c)];
+
+    // Counting sort by smallest vertex.
+    let bound = sorted
+        .par_iter()
+        .map(|&v| v as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut start = vec![0usize; bound + 1];
+    for c in 0..facet_total {
+        start[set(c)[0] as usize + 1] += 1;
+    }
+    for v in 0..bound {
+        start[v + 1] += start[v];
+    }
+    let mut order = vec![0u32; facet_total];
+    {
+        let mut next = start.clone();
+        for c in 0..facet_total {
+            let v = set(c)[0] as usize;
+            order[next[v]] = c as u32;
+            next[v] += 1;
+        }
+    }
+
+    // Groups of consecutive buckets: sort each bucket, count unique sets.
+    const GROUP: usize = 2048;
+    let groups = bound.div_ceil(GROUP);
+    let group_buckets = |g: usize| g * GROUP..((g + 1) * GROUP).min(bound);
+    let same = |a: u32, b: u32| set(a as usize) == set(b as usize);
+    let mut group_slices: Vec<(usize, &mut [u32])> = Vec::with_capacity(groups);
+    let mut rest = order.as_mut_slice();
+    for g in 0..groups {
+        let r = group_buckets(g);
+        let (slice, tail) = rest.split_at_mut(start[r.end] - start[r.start]);
+        group_slices.push((g, slice));
+        rest = tail;
+    }
+    let unique_sizes: Vec<(usize, usize)> = group_slices
+        .into_par_iter()
+        .map(|(g, slice)| {
+            let first = start[group_buckets(g).start];
+            let mut count = (0, 0);
+            for v in group_buckets(g) {
+                let bucket = &mut slice[start[v] - first..start[v + 1] - first];
+                // Already in candidate order (the counting sort is stable):
+                // a stable sort by set alone breaks ties by candidate number.
+                bucket.sort_by(|&a, &b| compare_sets(set(a as usize), set(b as usize)));
+                for (k, &c) in bucket.iter().enumerate() {
+                    if k == 0 || !same(bucket[k - 1], c) {
+                        count.0 += 1;
+                        count.1 += set(c as usize).len();
+                    }
+                }
+            }
+            count
+        })
+        .collect();
+
+    // Write the unique cells, group by group.
+    let unique_total: usize = unique_sizes.iter().map(|s| s.0).sum();
+    let unique_slots: usize = unique_sizes.iter().map(|s| s.1).sum();
+    let mut unique = FlatSets {
+        offsets: vec![0usize; unique_total + 1],
+        vertices: vec![0u32; unique_slots],
+    };
+    let mut level = TopCells::default();
+    if keep_cells {
+        level.shapes = vec![Shape::Simplex; unique_total];
+        level.vertices = vec![0u32; unique_slots];
+    }
+    {
+        let mut jobs = Vec::with_capacity(groups);
+        let (mut o_rest, mut v_rest) = (&mut unique.offsets[1..], unique.vertices.as_mut_slice());
+        let (mut h_rest, mut r_rest) = (level.shapes.as_mut_slice(), level.vertices.as_mut_slice());
+        let mut slot_base = 0;
+        for (g, &(nf, nv)) in unique_sizes.iter().enumerate() {
+            let (o, o_tail) = o_rest.split_at_mut(nf);
+            let (v, v_tail) = v_rest.split_at_mut(nv);
+            let (h, h_tail) = h_rest.split_at_mut(if keep_cells { nf } else { 0 });
+            let (r, r_tail) = r_rest.split_at_mut(if keep_cells { nv } else { 0 });
+            (o_rest, v_rest, h_rest, r_rest) = (o_tail, v_tail, h_tail, r_tail);
+            jobs.push((g, slot_base, o, v, h, r));
+            slot_base += nv;
+        }
+        let order = &order;
+        jobs.into_par_iter()
+            .for_each(|(g, slot_base, ends, vertices, shapes_out, raw_out)| {
+                let buckets = group_buckets(g);
+                let slice = &order[start[buckets.start]..start[buckets.end]];
+                let (mut k, mut at) = (0, 0);
+                for (idx, &c) in slice.iter().enumerate() {
+                    // Equal sets share their smallest vertex, hence a bucket.
+                    if idx > 0 && same(slice[idx - 1], c) {
+                        continue;
+                    }
+                    let c = c as usize;
+                    let s = set(c);
+                    vertices[at..at + s.len()].copy_from_slice(s);
+                    if keep_cells {
+                        shapes_out[k] = shapes[c];
+                        raw_out[at..at + s.len()].copy_from_slice(&raw[span(c)]);
+                    }
+                    at += s.len();
+                    ends[k] = slot_base + at;
+                    k += 1;
+                }
+            });
+    }
+    if keep_cells {
+        level.offsets = unique.offsets.clone();
     }
     ExtractedLevel {
         cells: level,
@@ -610,7 +816,7 @@ mod tests {
     #[test]
     fn shared_facets_are_merged_and_numbered_by_vertex_set() {
         let tris = TopCells::simplices([[2usize, 1, 0], [1, 2, 3]]);
-        let edges = extract_facets(&tris);
+        let edges = extract_facets(&tris, true);
         let sets: Vec<&[u32]> = (0..edges.sets.len()).map(|i| edges.sets.get(i)).collect();
         assert_eq!(sets, vec![&[0, 1][..], &[0, 2], &[1, 2], &[1, 3], &[2, 3]]);
     }

@@ -1,7 +1,7 @@
 //! The oriented cell complex: LAR characteristic matrices plus the signed
 //! boundary matrices ∂_p, with the topological queries built on them.
 
-use crate::cells::{extract_facets, vertex_sets, TopCells, Vertices};
+use crate::cells::{extract_facets, top_characteristic, TopCells, Vertices};
 use crate::error::{ComplexError, Result};
 use crate::frame;
 use crate::homology::{self, Field};
@@ -65,15 +65,17 @@ impl Complex {
             });
         }
         let k0 = vertices.len();
-        let mut matrices = vec![characteristic_matrix(&vertex_sets(&cells), k0)];
+        let mut matrices = vec![top_characteristic(&cells, k0)];
         let mut current = cells;
-        for _ in (2..=n).rev() {
-            let level = extract_facets(&current);
-            matrices.push(characteristic_matrix(&level.sets, k0));
+        for p in (2..=n).rev() {
+            // The edges (p = 2) need no facets of their own.
+            let level = extract_facets(&current, p > 2);
+            matrices.push(characteristic_matrix(level.sets, k0));
             current = level.cells;
         }
         matrices.reverse();
-        Self::from_lar(Lar::new(vertices, matrices)?)
+        let lar = Lar::new(vertices, matrices)?;
+        Self::from_lar(lar)
     }
 
     /// Orient a LAR whose characteristic matrices are all given (every cell
@@ -87,8 +89,14 @@ impl Complex {
             });
         }
         let mut boundaries = Vec::with_capacity(n);
+        // Frames of the top cells, when ∂_n needed them (non-simplices).
+        let mut top_frames = None;
         for p in 1..=n {
-            boundaries.push(signed_boundary(&lar, p)?);
+            let (boundary, frames) = signed_boundary(&lar, p)?;
+            boundaries.push(boundary);
+            if p == n {
+                top_frames = frames;
+            }
         }
         // One pass over the top cells: degeneracy, and the ambient orientation
         // (only used when n = d).
@@ -97,22 +105,26 @@ impl Complex {
             .into_par_iter()
             .map(|j| {
                 let cell = lar.cell_vertices(n, j);
-                let f = frame::frame(vertices, cell, n).ok_or_else(|| {
-                    ComplexError::DegenerateCell {
-                        dim: n,
-                        cell: j,
-                        vertices: cell.to_vec(),
-                    }
+                let f = match &top_frames {
+                    Some(frames) => frames.get(j),
+                    None => frame::frame(vertices, cell, n),
+                };
+                let f = f.ok_or_else(|| ComplexError::DegenerateCell {
+                    dim: n,
+                    cell: j,
+                    vertices: cell.to_vec(),
                 })?;
                 Ok(if frame::det(n, &f.basis) > 0.0 { 1 } else { -1 })
             })
             .collect::<Result<_>>()?;
+        drop(top_frames);
         check_closed(&lar, &boundaries)?;
         let top_orientation = orient_top_cells(&lar, &boundaries[n - 1], ambient)?;
         let top = &mut boundaries[n - 1];
-        let cols: Vec<usize> = top.indices().to_vec();
-        for (value, col) in top.data_mut().iter_mut().zip(cols) {
-            *value *= top_orientation[col];
+        for mut row in top.outer_iterator_mut() {
+            for (col, value) in row.iter_mut() {
+                *value *= top_orientation[col];
+            }
         }
         check_coherence(&boundaries[n - 1], n == lar.vertices().dim())?;
         Ok(Self {
@@ -460,10 +472,9 @@ impl Subcomplex {
 /// orientation otherwise. Frames are computed on the fly (once per facet,
 /// once per incident cell) rather than stored: at 10^6 cells stored frames
 /// cost more in memory traffic than recomputing them. Top cells are not
-/// yet oriented.
-fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
-    const CHUNK: usize = 8192;
-    let (indptr, indices) = lar.boundary_pattern(p);
+/// yet oriented. The frames of the p-cells are returned when they were
+/// computed (some p-cell is not a simplex), for the top level's orientation.
+fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<frame::PackedFrames>)> {
     let rows = lar.cell_count(p - 1);
     let vertices = lar.vertices();
     let degenerate = |dim: usize, cell: usize, verts: &[usize]| ComplexError::DegenerateCell {
@@ -474,19 +485,19 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
     // Frames of the upper cells are needed by every facet of a non-simplex
     // cell: compute them once per cell (a hex is met by six faces). Facet
     // frames are computed once per row, so they are never stored.
-    let upper_frames: Option<Vec<Option<frame::Frame>>> = (0..lar.cell_count(p))
+    let upper_frames: Option<frame::PackedFrames> = (0..lar.cell_count(p))
         .into_par_iter()
         .any(|j| lar.cell_vertices(p, j).len() != p + 1)
         .then(|| {
-            (0..lar.cell_count(p))
-                .into_par_iter()
-                .map(|j| frame::frame(vertices, lar.cell_vertices(p, j), p))
-                .collect()
+            frame::PackedFrames::new(p, lar.cell_count(p), |j| {
+                frame::frame(vertices, lar.cell_vertices(p, j), p)
+            })
         });
-    let row_signs = |i: usize, out: &mut Vec<i8>| -> Result<()> {
+    let row_signs = |i: usize, columns: &[u32], out: &mut Vec<i8>| -> Result<()> {
         let facet = lar.cell_vertices(p - 1, i);
         let mut facet_frame = None;
-        for &j in &indices[indptr[i]..indptr[i + 1]] {
+        for &j in columns {
+            let j = j as usize;
             let cell = lar.cell_vertices(p, j);
             if cell.len() == p + 1 && facet.len() == p {
                 let k = facet
@@ -505,7 +516,7 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
             }
             let cell_frame = upper_frames
                 .as_ref()
-                .and_then(|frames| frames[j])
+                .and_then(|frames| frames.get(j))
                 .ok_or_else(|| degenerate(p, j, cell))?;
             let sign = facet_frame
                 .as_ref()
@@ -520,21 +531,11 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<CsMat<i8>> {
         }
         Ok(())
     };
-    let chunks: Vec<Vec<i8>> = (0..rows.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|chunk| {
-            let rows = chunk * CHUNK..((chunk + 1) * CHUNK).min(rows);
-            let mut out = Vec::with_capacity(indptr[rows.end] - indptr[rows.start]);
-            for i in rows {
-                row_signs(i, &mut out)?;
-            }
-            Ok(out)
-        })
-        .collect::<Result<_>>()?;
-    let data: Vec<i8> = chunks.concat();
+    let (indptr, indices, data) = lar.boundary_pattern_with(p, row_signs)?;
     let shape = (rows, lar.cell_count(p));
-    CsMat::try_new(shape, indptr, indices, data)
-        .map_err(|e| ComplexError::Invalid(format!("internal: boundary matrix ∂_{p}: {}", e.3)))
+    let matrix = CsMat::try_new(shape, indptr, indices, data)
+        .map_err(|e| ComplexError::Invalid(format!("internal: boundary matrix ∂_{p}: {}", e.3)))?;
+    Ok((matrix, upper_frames))
 }
 
 /// Orientation flags of the top cells: the ambient orientation when n = d,
@@ -628,32 +629,70 @@ fn enclosed_volume(lar: &Lar, by_cell: &CsMat<i8>, flags: &[i8], component: &[us
 /// geometry, and on a twisted or self-intersecting cell (a "bow-tie" face of
 /// a hexahedron whose nodes are out of order) they need not: report the
 /// cell rather than hand out a complex that breaks ∂∂ = 0.
+///
+/// The product is formed row by row (row v of ∂_{p−1} ∂_p gathers the rows
+/// of ∂_p of v's cofaces), in parallel and with no transposed copy; only when
+/// some row does not cancel is the column-wise search run, to name the first
+/// open cell.
 fn check_closed(lar: &Lar, boundaries: &[CsMat<i8>]) -> Result<()> {
+    const CHUNK: usize = 8192;
     for p in 2..=boundaries.len() {
-        if (0..lar.cell_count(p)).all(|j| lar.cell_vertices(p, j).len() == p + 1) {
+        if (0..lar.cell_count(p))
+            .into_par_iter()
+            .all(|j| lar.cell_vertices(p, j).len() == p + 1)
+        {
             continue;
         }
-        let (lower, upper) = (&boundaries[p - 2], boundaries[p - 1].to_csc());
-        let lower = lower.to_csc();
-        let mut terms: Vec<(usize, i32)> = Vec::new();
-        for (cell, column) in upper.outer_iterator().enumerate() {
-            terms.clear();
-            for (facet, &s) in column.iter() {
-                if let Some(edges) = lower.outer_view(facet) {
-                    terms.extend(edges.iter().map(|(v, &t)| (v, i32::from(s) * i32::from(t))));
+        let (lower, upper) = (&boundaries[p - 2], &boundaries[p - 1]);
+        let rows = lower.rows();
+        let closed = (0..rows.div_ceil(CHUNK)).into_par_iter().all(|chunk| {
+            let mut terms: Vec<(usize, i32)> = Vec::new();
+            (chunk * CHUNK..((chunk + 1) * CHUNK).min(rows)).all(|v| {
+                terms.clear();
+                let Some(row) = lower.outer_view(v) else {
+                    return true;
+                };
+                for (facet, &s) in row.iter() {
+                    if let Some(cells) = upper.outer_view(facet) {
+                        terms.extend(cells.iter().map(|(j, &t)| (j, i32::from(s) * i32::from(t))));
+                    }
                 }
+                terms.sort_unstable_by_key(|&(j, _)| j);
+                terms
+                    .chunk_by(|a, b| a.0 == b.0)
+                    .all(|run| run.iter().map(|&(_, t)| t).sum::<i32>() == 0)
+            })
+        });
+        if !closed {
+            first_open_cell(lar, lower, upper, p)?;
+        }
+    }
+    Ok(())
+}
+
+/// The column-wise form of [`check_closed`] for one level: the error names
+/// the lowest-numbered p-cell whose faces do not close up.
+fn first_open_cell(lar: &Lar, lower: &CsMat<i8>, upper: &CsMat<i8>, p: usize) -> Result<()> {
+    let upper = upper.to_csc();
+    let lower = lower.to_csc();
+    let mut terms: Vec<(usize, i32)> = Vec::new();
+    for (cell, column) in upper.outer_iterator().enumerate() {
+        terms.clear();
+        for (facet, &s) in column.iter() {
+            if let Some(edges) = lower.outer_view(facet) {
+                terms.extend(edges.iter().map(|(v, &t)| (v, i32::from(s) * i32::from(t))));
             }
-            terms.sort_unstable_by_key(|&(v, _)| v);
-            let open = terms
-                .chunk_by(|a, b| a.0 == b.0)
-                .any(|run| run.iter().map(|&(_, t)| t).sum::<i32>() != 0);
-            if open {
-                return Err(ComplexError::Invalid(format!(
+        }
+        terms.sort_unstable_by_key(|&(v, _)| v);
+        let open = terms
+            .chunk_by(|a, b| a.0 == b.0)
+            .any(|run| run.iter().map(|&(_, t)| t).sum::<i32>() != 0);
+        if open {
+            return Err(ComplexError::Invalid(format!(
                     "{p}-cell {cell} (vertices {:?}) is twisted or self-intersecting: its {}-faces do not close up around it (∂∂ ≠ 0); check the order of its vertices",
                     lar.cell_vertices(p, cell),
                     p - 1
                 )));
-            }
         }
     }
     Ok(())

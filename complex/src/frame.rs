@@ -10,6 +10,7 @@
 //! of c (interior for convex cells) to that of f.
 
 use crate::cells::Vertices;
+use rayon::prelude::*;
 
 /// Points are padded to three coordinates so all dimensions share one code path.
 pub(crate) type Point = [f64; 3];
@@ -59,6 +60,60 @@ impl Frame {
     }
 }
 
+/// The frames of many p-cells packed flat: per cell its p basis vectors,
+/// its centre and its diameter (3p + 4 numbers, a third less than
+/// `Option<Frame>` for p = 2, 3). A cell without a frame (degenerate) has a
+/// NaN diameter, which a real frame never has.
+pub(crate) struct PackedFrames {
+    dim: usize,
+    data: Vec<f64>,
+}
+
+impl PackedFrames {
+    /// `frame_of(j)` for j in 0..count, computed in parallel.
+    pub fn new(dim: usize, count: usize, frame_of: impl Fn(usize) -> Option<Frame> + Sync) -> Self {
+        let stride = 3 * dim + 4;
+        let mut data = vec![0.0; count * stride];
+        data.par_chunks_mut(stride)
+            .with_min_len(1024)
+            .enumerate()
+            .for_each(|(j, slot)| match frame_of(j) {
+                Some(f) => {
+                    for (r, b) in f.basis.iter().take(dim).enumerate() {
+                        slot[3 * r..3 * r + 3].copy_from_slice(b);
+                    }
+                    slot[3 * dim..3 * dim + 3].copy_from_slice(&f.centre);
+                    slot[3 * dim + 3] = f.diameter;
+                }
+                None => slot[3 * dim + 3] = f64::NAN,
+            });
+        Self { dim, data }
+    }
+
+    /// The frame of cell `j`, as `frame_of(j)` returned it.
+    #[inline]
+    pub fn get(&self, j: usize) -> Option<Frame> {
+        let dim = self.dim;
+        let slot = &self.data[j * (3 * dim + 4)..(j + 1) * (3 * dim + 4)];
+        let diameter = slot[3 * dim + 3];
+        if diameter.is_nan() {
+            return None;
+        }
+        let mut basis = [[0.0; 3]; 3];
+        for (r, b) in basis.iter_mut().take(dim).enumerate() {
+            b.copy_from_slice(&slot[3 * r..3 * r + 3]);
+        }
+        let mut centre = [0.0; 3];
+        centre.copy_from_slice(&slot[3 * dim..3 * dim + 3]);
+        Some(Frame {
+            dim,
+            basis,
+            centre,
+            diameter,
+        })
+    }
+}
+
 /// The frame of a cell with the given sorted vertices, or `None` when the
 /// vertices span fewer than `p` directions (a zero-measure cell).
 pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Frame> {
@@ -77,13 +132,17 @@ pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Fra
     };
     let origin = points[0];
     let mut centre = [0.0; 3];
-    let mut diameter: f64 = 0.0;
+    // sqrt is correctly rounded and monotone, so the largest root is the
+    // root of the largest square: one sqrt per cell instead of one per vertex.
+    let mut diameter_squared: f64 = 0.0;
     for x in points {
         for k in 0..3 {
             centre[k] += x[k];
         }
-        diameter = diameter.max(norm(&sub(x, &origin)));
+        let w = sub(x, &origin);
+        diameter_squared = diameter_squared.max(dot(&w, &w));
     }
+    let diameter = diameter_squared.sqrt();
     for c in &mut centre {
         *c /= points.len() as f64;
     }

@@ -34,16 +34,43 @@ pub struct Lar {
 }
 
 /// Build a binary CSR matrix from sorted vertex sets.
-pub(crate) fn characteristic_matrix(sets: &FlatSets, vertex_count: usize) -> CsMat<u8> {
-    let indices: Vec<usize> = sets.vertices.iter().map(|&v| v as usize).collect();
+pub(crate) fn characteristic_matrix(sets: FlatSets, vertex_count: usize) -> CsMat<u8> {
+    let rows = sets.len();
+    let FlatSets { offsets, vertices } = sets;
+    let indices = widen(&offsets, &vertices, false);
+    drop(vertices);
     let nnz = indices.len();
     // Rows are sorted and in range by construction.
-    CsMat::new(
-        (sets.len(), vertex_count),
-        sets.offsets.clone(),
-        indices,
-        vec![1u8; nnz],
-    )
+    CsMat::new((rows, vertex_count), offsets, indices, vec![1u8; nnz])
+}
+
+/// The vertex lists `vertices[offsets[i]..offsets[i + 1]]` as `usize`
+/// column indices, each list sorted when `sort` is set; in parallel over
+/// blocks of lists.
+pub(crate) fn widen(offsets: &[usize], vertices: &[u32], sort: bool) -> Vec<usize> {
+    const CHUNK: usize = 8192;
+    let lists = offsets.len().saturating_sub(1);
+    let mut out = vec![0usize; vertices.len()];
+    let mut jobs = Vec::with_capacity(lists.div_ceil(CHUNK));
+    let mut rest = out.as_mut_slice();
+    for first in (0..lists).step_by(CHUNK) {
+        let last = (first + CHUNK).min(lists);
+        let (block, tail) = rest.split_at_mut(offsets[last] - offsets[first]);
+        jobs.push((first, last, block));
+        rest = tail;
+    }
+    jobs.into_par_iter().for_each(|(first, last, block)| {
+        let base = offsets[first];
+        for (slot, &v) in block.iter_mut().zip(&vertices[base..offsets[last]]) {
+            *slot = v as usize;
+        }
+        if sort {
+            for i in first..last {
+                block[offsets[i] - base..offsets[i + 1] - base].sort_unstable();
+            }
+        }
+    });
+    out
 }
 
 impl Lar {
@@ -104,7 +131,7 @@ impl Lar {
                 sets.vertices.extend(set);
                 sets.offsets.push(sets.vertices.len());
             }
-            matrices.push(characteristic_matrix(&sets, k0));
+            matrices.push(characteristic_matrix(sets, k0));
         }
         Self::new(vertices, matrices)
     }
@@ -136,6 +163,7 @@ impl Lar {
     }
 
     /// Sorted vertices of p-cell `i`.
+    #[inline]
     pub fn cell_vertices(&self, p: usize, i: usize) -> &[usize] {
         if p == 0 {
             // Row i of the identity M_0.
@@ -178,47 +206,121 @@ impl Lar {
         self.characteristic[p - 1].transpose_view().to_csr()
     }
 
+    /// Vertex → p-cells lists (M_pᵀ as CSR pattern, 32-bit cell ids): a
+    /// counting-sort transpose of M_p with no values and no sprs
+    /// conversion, cells listed in increasing order.
+    fn star_lists(&self, p: usize) -> (Vec<usize>, Vec<u32>) {
+        let m = &self.characteristic[p - 1];
+        let mut start = vec![0usize; self.vertices.len() + 1];
+        for &v in m.indices() {
+            start[v + 1] += 1;
+        }
+        for v in 0..self.vertices.len() {
+            start[v + 1] += start[v];
+        }
+        let mut cells = vec![0u32; m.nnz()];
+        // start[v] serves as v's cursor and ends at v's end, the start of
+        // v + 1: shifting by one slot restores the pointers.
+        for (j, row) in m.indptr().raw_storage().windows(2).enumerate() {
+            for &v in &m.indices()[row[0]..row[1]] {
+                cells[start[v]] = j as u32;
+                start[v] += 1;
+            }
+        }
+        start.rotate_right(1);
+        start[0] = 0;
+        (start, cells)
+    }
+
     /// Sparsity pattern of the unoriented ∂_p as CSR (indptr, column
     /// indices), computed row by row as the filtered product M_{p-1} M_pᵀ.
-    /// Every p-cell containing (p-1)-cell i contains its first vertex, so
-    /// only the p-cells around that vertex can reach the full count.
+    #[cfg(test)]
     pub(crate) fn boundary_pattern(&self, p: usize) -> (Vec<usize>, Vec<usize>) {
-        let by_vertex = self.cells_by_vertex(p);
+        let (indptr, indices, _) = self
+            .boundary_pattern_with(p, |_, columns, out: &mut Vec<()>| {
+                out.extend(columns.iter().map(|_| ()));
+                Ok(())
+            })
+            .unwrap_or_default();
+        (indptr, indices)
+    }
+
+    /// The unoriented ∂_p as CSR (indptr, column indices) together with one
+    /// value per entry: `value(i, columns, out)` appends to `out` the values
+    /// of row i, whose column indices are `columns`. Rows are the filtered
+    /// product M_{p-1} M_pᵀ: every p-cell containing (p-1)-cell i contains
+    /// its first vertex, so only the p-cells around that vertex can reach
+    /// the full count. Blocks of rows run in parallel; the blocks are then
+    /// copied, also in parallel, into the final arrays.
+    pub(crate) fn boundary_pattern_with<T, F>(
+        &self,
+        p: usize,
+        value: F,
+    ) -> Result<(Vec<usize>, Vec<usize>, Vec<T>)>
+    where
+        T: Copy + Default + Send + Sync,
+        F: Fn(usize, &[u32], &mut Vec<T>) -> Result<()> + Sync,
+    {
+        const CHUNK: usize = 8192;
+        let (star_ptr, star_cells) = self.star_lists(p);
         let upper = &self.characteristic[p - 1];
         let rows = self.cell_count(p - 1);
-        const CHUNK: usize = 8192;
-        let row_of = |i: usize, out: &mut Vec<usize>| {
-            let lower = self.cell_vertices(p - 1, i);
-            let Some(&first) = lower.first() else { return };
-            let star = &by_vertex.indices()[by_vertex.indptr().outer_inds_sz(first)];
-            out.extend(star.iter().copied().filter(|&j| {
-                let cell = &upper.indices()[upper.indptr().outer_inds_sz(j)];
-                lower[1..].iter().all(|v| cell.binary_search(v).is_ok())
-            }));
-        };
-        let chunks: Vec<(Vec<usize>, Vec<usize>)> = (0..rows.div_ceil(CHUNK))
+        type Block<T> = (Vec<u32>, Vec<u32>, Vec<T>);
+        let blocks: Vec<Block<T>> = (0..rows.div_ceil(CHUNK))
             .into_par_iter()
             .map(|chunk| {
                 let mut lengths = Vec::with_capacity(CHUNK);
-                let mut entries = Vec::with_capacity(CHUNK * 2);
+                let mut entries: Vec<u32> = Vec::with_capacity(CHUNK * 2);
+                let mut values = Vec::with_capacity(CHUNK * 2);
                 for i in chunk * CHUNK..((chunk + 1) * CHUNK).min(rows) {
                     let before = entries.len();
-                    row_of(i, &mut entries);
-                    lengths.push(entries.len() - before);
+                    let lower = self.cell_vertices(p - 1, i);
+                    if let Some(&first) = lower.first() {
+                        let star = &star_cells[star_ptr[first]..star_ptr[first + 1]];
+                        entries.extend(star.iter().copied().filter(|&j| {
+                            let cell = &upper.indices()[upper.indptr().outer_inds_sz(j as usize)];
+                            lower[1..].iter().all(|v| cell.binary_search(v).is_ok())
+                        }));
+                    }
+                    value(i, &entries[before..], &mut values)?;
+                    lengths.push((entries.len() - before) as u32);
                 }
-                (lengths, entries)
+                Ok((lengths, entries, values))
             })
-            .collect();
-        let mut indptr = Vec::with_capacity(rows + 1);
-        indptr.push(0);
-        let mut indices = Vec::with_capacity(chunks.iter().map(|c| c.1.len()).sum());
-        for (lengths, entries) in chunks {
-            for len in lengths {
-                indptr.push(indptr[indptr.len() - 1] + len);
-            }
-            indices.extend(entries);
+            .collect::<Result<_>>()?;
+        drop((star_ptr, star_cells));
+        let nnz: usize = blocks.iter().map(|b| b.1.len()).sum();
+        let mut indptr = vec![0usize; rows + 1];
+        let mut indices = vec![0usize; nnz];
+        let mut data = vec![T::default(); nnz];
+        let mut jobs = Vec::with_capacity(blocks.len());
+        let (mut p_rest, mut i_rest, mut d_rest) = (
+            &mut indptr[1..],
+            indices.as_mut_slice(),
+            data.as_mut_slice(),
+        );
+        let mut base = 0;
+        for block in &blocks {
+            let (ptr, p_tail) = p_rest.split_at_mut(block.0.len());
+            let (ind, i_tail) = i_rest.split_at_mut(block.1.len());
+            let (dat, d_tail) = d_rest.split_at_mut(block.1.len());
+            (p_rest, i_rest, d_rest) = (p_tail, i_tail, d_tail);
+            jobs.push((block, base, ptr, ind, dat));
+            base += block.1.len();
         }
-        (indptr, indices)
+        jobs.into_par_iter()
+            .for_each(|((lengths, entries, values), base, ptr, ind, dat)| {
+                let mut end = base;
+                for (slot, &len) in ptr.iter_mut().zip(lengths) {
+                    end += len as usize;
+                    *slot = end;
+                }
+                for (slot, &j) in ind.iter_mut().zip(entries) {
+                    *slot = j as usize;
+                }
+                dat.copy_from_slice(values);
+            });
+        Ok((indptr, indices, data))
     }
 }
 

@@ -18,6 +18,7 @@ pub mod complex;
 pub mod dual;
 pub mod error;
 pub mod euler;
+mod fingerprint;
 mod frame;
 pub mod generate;
 pub mod geometry;

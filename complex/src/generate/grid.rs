@@ -167,13 +167,14 @@ impl<'a> Layout<'a> {
     }
 
     /// Lowest-corner vertices of every cell, x fastest.
-    fn cell_origins(&self) -> impl Iterator<Item = usize> + '_ {
+    fn cell_origins(&self) -> impl ExactSizeIterator<Item = usize> + '_ {
         let cells = |a: usize| self.counts.get(a).map_or(1, |c| c - 1);
         let (nx, ny, nz) = (cells(0), cells(1), cells(2));
-        (0..nz).flat_map(move |k| {
-            (0..ny).flat_map(move |j| {
-                (0..nx).map(move |i| i + j * self.strides[1] + k * self.strides[2])
-            })
+        // One flat range (rather than nested loops) so the count is known
+        // up front and the cell lists are allocated once.
+        (0..nx * ny * nz).map(move |c| {
+            let (i, j, k) = (c % nx, (c / nx) % ny, c / (nx * ny));
+            i + j * self.strides[1] + k * self.strides[2]
         })
     }
 

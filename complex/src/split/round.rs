@@ -432,7 +432,7 @@ pub(super) fn round(
             offsets: level.set_ptr,
             vertices: level.set,
         };
-        characteristic.push(characteristic_matrix(&sets, new_counts[0]));
+        characteristic.push(characteristic_matrix(sets, new_counts[0]));
     }
     let lar = Lar::new(vertices, characteristic)?;
 
