@@ -507,6 +507,27 @@ fn multigrid_solver_types_match_the_direct_solution() {
         assert!((1.0..=15.0).contains(&iterations), "{kind}: {out}");
         assert!(!out.contains("warning"), "{kind}: {out}");
     }
+    // The unsmoothed cell prolongation reaches the same solution; its
+    // sparser coarse levels cost more iterations (README: 8 against 7 on
+    // the 16³ cube), which shows the key reached the solver.
+    let iterations = |extra: &[String]| {
+        let mut args = vec!["solver.type=\"multigrid\"".to_string()];
+        args.extend_from_slice(extra);
+        let out = run("cases/box-3d.toml", &args);
+        let l2 = reported(&out, "error", "L2");
+        assert!((l2 - direct).abs() <= 1e-6 * direct, "{l2} vs {direct}");
+        reported(&out, "iterative", "):")
+    };
+    let smoothed = iterations(&[]);
+    let constant = iterations(&["solver.prolongation=\"constant\"".into()]);
+    assert!(
+        constant > smoothed,
+        "constant {constant}, smoothed {smoothed}"
+    );
+    assert_eq!(
+        iterations(&["solver.prolongation=\"smoothed\"".into()]),
+        smoothed
+    );
 }
 
 // ---------------------------------------------------------------- bad input
@@ -671,6 +692,18 @@ fn bad_problem_kind_input_names_the_key() {
         "[mesh]\ngenerator = \"voronoi\"\nn = [30]\n[problem]\nmethod = \"fe\"\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n[solver]\ntype = \"multigrid\"\n",
         2,
         &["grid levels", "use \"amg\""],
+    );
+    refused(
+        "prolongation-name",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [8, 8]\n[problem]\nmethod = \"fv\"\n[solver]\ntype = \"multigrid\"\nprolongation = \"linear\"\n",
+        2,
+        &["prolongation-name.toml:8:16: `solver.prolongation`", "unknown prolongation \"linear\"", "\"constant\""],
+    );
+    refused(
+        "prolongation-direct",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [8, 8]\n[problem]\nmethod = \"fv\"\n[solver]\nprolongation = \"constant\"\n",
+        2,
+        &["`solver.prolongation`", "solver.type = \"multigrid\""],
     );
     refused(
         "multigrid-heat",

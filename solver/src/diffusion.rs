@@ -27,7 +27,7 @@ use crate::iterative::{conjugate_gradient, CgError, CgOptions, CgReport, RowMatr
 use crate::linear::{self, Factorization, SolveError, SolveReport};
 use crate::metric::{self, dec, fd, fe, fv, MetricError, Tensor};
 use crate::multigrid::{
-    self, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
+    self, CellProlongation, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
 };
 use faer::sparse::SparseColMat;
 use hasse_complex::dual::DualKind;
@@ -575,6 +575,34 @@ impl Diffusion {
             }),
             _ => None,
         };
+        self
+    }
+
+    /// How the multigrid chosen by [`Diffusion::with_solver`] prolongs
+    /// cell-centred unknowns on grid levels (no effect on a direct solve or
+    /// on nodal unknowns).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::diffusion::{BoundaryKind, Conductivity, Diffusion, Method};
+    /// use hasse_solver::multigrid::{CellProlongation, Hierarchy, SolverChoice};
+    /// use std::sync::Arc;
+    /// let mesh = rectangle(32, 32, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let problem = Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+    ///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+    ///     .with_solver(SolverChoice::Multigrid(Hierarchy::Grid { cells: vec![32, 32] }), 1e-8, &mesh)
+    ///     .with_cell_prolongation(CellProlongation::Constant { correction: 2.0 });
+    /// let report = problem.solve(&mesh).unwrap().iterations.unwrap();
+    /// assert!(report.relative_residual <= 1e-8);
+    /// ```
+    pub fn with_cell_prolongation(mut self, prolongation: CellProlongation) -> Self {
+        if let Some(Iterative {
+            preconditioner: Preconditioning::Multigrid { options, .. },
+            ..
+        }) = &mut self.iterative
+        {
+            options.cell_prolongation = prolongation;
+        }
         self
     }
 

@@ -1246,9 +1246,13 @@ pub const DIRECT_LIMIT_3D: usize = 20_000;
 /// The automatic rule: a direct factorisation for 1D and 2D problems and for
 /// 3D problems with at most [`DIRECT_LIMIT_3D`] unknowns; multigrid-CG for
 /// larger 3D problems, geometric when a hierarchy is given, else algebraic.
-/// In 2D the factor's fill grows like n log n: at 10⁶ unknowns LLᵀ costs
-/// about as much as multigrid-CG (2.8 s against 2.5 s, `scripts/bench`) and
-/// needs no hierarchy. In 3D factorisation work grows like n²: at 60³ it
+/// In 2D the factor's fill grows like n log n: at 10⁶ cell-centred
+/// unknowns LLᵀ takes 2.4 s (factorisation and solve) against 1.2 s for
+/// multigrid-CG with the smoothed cell prolongation and 0.7 s with the
+/// constant one (`cargo bench --bench multigrid -- 2d-1000`, quiet
+/// machine). Direct stays the rule there: it needs no hierarchy, its cost
+/// does not depend on the coefficients, and it is within 2–3.5× of a solve
+/// that a case asks for with `solver.type = "multigrid"`. In 3D factorisation work grows like n²: at 60³ it
 /// takes 22 s against 0.6 s for multigrid-CG, and extrapolating by n² the
 /// two meet near 2·10⁴ unknowns, where both take a few hundredths of a
 /// second.

@@ -204,7 +204,9 @@ fn with_solver(case: &Case, problem: Diffusion, complex: &Complex) -> Result<Dif
         SolverKind::Amg => SolverChoice::Multigrid(Hierarchy::Algebraic),
         SolverKind::Auto => SolverChoice::Auto(grid),
     };
-    Ok(problem.with_solver(choice, case.solver.tolerance, complex))
+    Ok(problem
+        .with_solver(choice, case.solver.tolerance, complex)
+        .with_cell_prolongation(case.solver.cell_prolongation))
 }
 
 fn is_input_error(e: &DiffusionError) -> bool {

@@ -41,6 +41,7 @@ pub use diagnostic::{Diagnostic, Diagnostics};
 use crate::diffusion::Method;
 use crate::linear::Factorization;
 use crate::mesh_spec::{MeshError, MeshSpec};
+use crate::multigrid::CellProlongation;
 use diagnostic::Collector;
 use expr::{Expression, Scope};
 use hasse_complex::Complex;
@@ -344,6 +345,8 @@ pub struct SolverSpec {
     pub residual_warning: f64,
     /// A relative residual above this fails the run (exit code 1).
     pub residual_limit: f64,
+    /// How a grid hierarchy prolongs cell-centred unknowns.
+    pub cell_prolongation: CellProlongation,
 }
 
 impl Default for SolverSpec {
@@ -354,6 +357,7 @@ impl Default for SolverSpec {
             factorization: None,
             residual_warning: 1e-10,
             residual_limit: 1e-6,
+            cell_prolongation: CellProlongation::Smoothed,
         }
     }
 }

@@ -11,6 +11,7 @@ use super::{
 use crate::diffusion::Method;
 use crate::linear::Factorization;
 use crate::mesh_spec::MeshSpec;
+use crate::multigrid::CellProlongation;
 use crate::refinement::{RefineSpec, Strategy};
 use hasse_complex::DualKind;
 use std::collections::BTreeMap;
@@ -102,6 +103,7 @@ const SOLVER_KEYS: &[&str] = &[
     "factorization",
     "residual_warning",
     "residual_limit",
+    "prolongation",
 ];
 const OUTPUT_KEYS: &[&str] = &["directory", "name", "write"];
 const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "tolerance"];
@@ -1224,6 +1226,33 @@ impl Reader {
                     None
                 }
             };
+        }
+        if let Some(name) = self.string_at(table, "solver", "prolongation") {
+            let span = self
+                .entry(table, "solver", "prolongation")
+                .and_then(|e| e.span());
+            match name.as_str() {
+                "smoothed" => spec.cell_prolongation = CellProlongation::Smoothed,
+                // Twice the coarse correction undoes the Galerkin operator's
+                // stiffness (see the multigrid module).
+                "constant" => {
+                    spec.cell_prolongation = CellProlongation::Constant { correction: 2.0 }
+                }
+                other => self.error(
+                    span.clone(),
+                    "solver.prolongation",
+                    format!("unknown prolongation \"{other}\""),
+                    Some("use \"smoothed\" (the default: mesh-independent iteration counts) or \"constant\" (cheaper setup, counts grow slowly with the mesh)".into()),
+                ),
+            }
+            if !matches!(spec.kind, SolverKind::Multigrid | SolverKind::Auto) {
+                self.error(
+                    span,
+                    "solver.prolongation",
+                    "applies only to the grid levels of solver.type = \"multigrid\" (or \"auto\")",
+                    Some("set solver.type = \"multigrid\" or remove solver.prolongation".into()),
+                );
+            }
         }
         for (key, slot) in [
             ("residual_warning", &mut spec.residual_warning),
