@@ -134,6 +134,28 @@ fn box_3d_mixed_boundaries() {
 }
 
 #[test]
+fn poisson_multigrid_matches_the_direct_solve() {
+    // The shipped 10⁶-cell case at 64²: multigrid-CG to 1e-8 moves the
+    // discrete solution by far less than the 7 printed digits of its error,
+    // so it must report poisson-square's direct FV error at the same grid.
+    let grid = "mesh.n=[64, 64]";
+    let (multigrid, _) = run_case("cases/poisson-multigrid.toml", &[grid], "poisson-mg");
+    let (direct, _) = run_case(
+        "cases/poisson-square.toml",
+        &[grid, "problem.method=\"fv\""],
+        "poisson-direct",
+    );
+    let l2 = reported(&multigrid, "error", "L2");
+    let expected = reported(&direct, "error", "L2");
+    assert!(
+        (l2 - expected).abs() <= 1e-6 * expected,
+        "{l2} vs {expected}"
+    );
+    let iterations = reported(&multigrid, "iterative", "):");
+    assert!((1.0..=15.0).contains(&iterations), "{multigrid}");
+}
+
+#[test]
 fn distorted_quads_mimetic() {
     let (stdout, _) = run_case("cases/distorted-quads.toml", &[], "distorted");
     assert!(reported(&stdout, "error", "L2") < 1e-3, "{stdout}");
