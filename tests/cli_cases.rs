@@ -153,6 +153,9 @@ fn poisson_multigrid_matches_the_direct_solve() {
     );
     let iterations = reported(&multigrid, "iterative", "):");
     assert!((1.0..=15.0).contains(&iterations), "{multigrid}");
+    // The timing line names the multigrid setup for what it is.
+    assert!(reported(&multigrid, "timing", "preconditioner setup") >= 0.0);
+    assert!(!multigrid.contains("factorisation"), "{multigrid}");
 }
 
 #[test]
