@@ -5,11 +5,12 @@
 //! methods read (cached in the complex, so computed first and apart), the
 //! whole `Diffusion::assemble` (Ω, boundary data, source load, pattern and
 //! values) on the warm complex, then its parts through the
-//! public API: the metric Ω, `Canonical::new` (the sparsity pattern and the
-//! scatter map) and `Canonical::assemble` (the values). For the structured
-//! cell-centred cases the same 5/7-point matrix is also built by hand as
-//! triplets and compressed by faer, the floor any assembly is measured
-//! against. Elasticity on tetrahedra shows the dense-block case (12×12
+//! public API: the metric Ω, `Canonical::new` (the sparsity pattern) and
+//! `Canonical::assemble` (the values), each with its page faults. For the
+//! structured cell-centred cases the same 5/7-point matrix is also built by
+//! hand as triplets and compressed by faer, the floor any assembly is
+//! measured against; for 2D Q1 the nodal matrix is built by hand from the
+//! square's element matrix. Elasticity on tetrahedra shows the dense-block case (12×12
 //! element matrices written over 18 edge rows).
 //!
 //! `cargo bench --bench assembly` runs 2D 1000² (FV, FE Q1), 3D 60³ (FV),
@@ -72,7 +73,8 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
 
     let cells = complex.cell_count(d);
     let tensors = vec![isotropic(1.0); cells];
-    let t = Instant::now();
+    let faults = || cpu_and_faults().1;
+    let (t, faults_start) = (Instant::now(), faults());
     let (incidence, metric) = match method {
         Method::Fv => (
             complex.shared_boundary(d),
@@ -84,19 +86,44 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
         ),
     };
     let metric_seconds = seconds(t);
-    let t = Instant::now();
+    let (t, faults_metric) = (Instant::now(), faults());
     let canonical = Canonical::new(incidence, metric).expect("canonical");
     let pattern_seconds = seconds(t);
-    let t = Instant::now();
+    let (t, faults_pattern) = (Instant::now(), faults());
     let matrix = canonical.assemble();
     let values_seconds = seconds(t);
+    let faults_values = faults();
     print!(
-        "{label:<26} unknowns {:>8} nnz {:>9} | geometry {geometry:>6.3}s | Diffusion::assemble {whole:>6.3}s (cpu {:.2}s, {}k page faults) | Ω {metric_seconds:>6.3}s  pattern {pattern_seconds:>6.3}s  values {values_seconds:>6.3}s",
+        "{label:<26} unknowns {:>8} nnz {:>9} | geometry {geometry:>6.3}s | Diffusion::assemble {whole:>6.3}s (cpu {:.2}s, {}k page faults) | Ω {metric_seconds:>6.3}s ({}k)  pattern {pattern_seconds:>6.3}s ({}k)  values {values_seconds:>6.3}s ({}k)",
         matrix.nrows(),
         matrix.val().len(),
         cpu_after - cpu_before,
         (faults_after - faults_before) / 1000,
+        (faults_metric - faults_start) / 1000,
+        (faults_pattern - faults_metric) / 1000,
+        (faults_values - faults_pattern) / 1000,
     );
+    if method == Method::Fe && d == 2 {
+        // Nodal Q1 on the unit grid (no boundary condition): the element
+        // matrix is the same for every cell, so a hand-written assembly is
+        // one triplet list of 16 entries per cell.
+        let n = (cells as f64).sqrt().round() as usize;
+        let t = Instant::now();
+        let hand = plain_q1_matrix(n);
+        let plain_seconds = seconds(t);
+        let difference = max_difference(&matrix, &hand);
+        // Rounding only: the Gauss points, the mapped gradients and A_c⁺
+        // (an SVD) each carry a few ulps; 1e-12 relative is the issue's
+        // "exact to rounding".
+        assert!(
+            difference <= 1e-12 * 8.0 / 3.0,
+            "{label}: hasse's Q1 matrix and the hand-built one differ by {difference:e}"
+        );
+        print!(
+            " | hand-built Q1 triplets {plain_seconds:>6.3}s  ratio {:>5.2}",
+            whole / plain_seconds
+        );
+    }
     if let Some(n) = plain {
         let t = Instant::now();
         let hand = plain_matrix(n, d);
@@ -113,6 +140,34 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
         );
     }
     println!(" | peak {:.2} GiB", peak_memory_gib());
+}
+
+/// The Q1 stiffness (λ = 1) of an n × n unit grid with vertex i + (n + 1) j
+/// at (i, j)/n, built without hasse from the element matrix of a square,
+/// (1/6)·[4 −1 −1 −2; −1 4 −2 −1; −1 −2 4 −1; −2 −1 −1 4] over its corners
+/// (0, 0), (1, 0), (0, 1), (1, 1): independent of the side in 2D.
+fn plain_q1_matrix(n: usize) -> SparseColMat<usize, f64> {
+    use faer::sparse::Triplet;
+    const ELEMENT: [[f64; 4]; 4] = [
+        [4.0, -1.0, -1.0, -2.0],
+        [-1.0, 4.0, -2.0, -1.0],
+        [-1.0, -2.0, 4.0, -1.0],
+        [-2.0, -1.0, -1.0, 4.0],
+    ];
+    let vertices = (n + 1) * (n + 1);
+    let mut triplets = Vec::with_capacity(16 * n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let v = i + (n + 1) * j;
+            let corners = [v, v + 1, v + n + 1, v + n + 2];
+            for (a, &va) in corners.iter().enumerate() {
+                for (b, &vb) in corners.iter().enumerate() {
+                    triplets.push(Triplet::new(va, vb, ELEMENT[a][b] / 6.0));
+                }
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(vertices, vertices, &triplets).expect("valid triplets")
 }
 
 fn elasticity_case(label: &str, complex: &Complex) {

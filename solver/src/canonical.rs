@@ -9,12 +9,13 @@
 //! Assembly is split like a sparse factorisation: the sparsity pattern of
 //! M, and how values reach it, are built once ([`Canonical::new`]);
 //! numeric assembly ([`Canonical::assemble`]) can then be repeated with new
-//! values of the same pattern ([`Canonical::set_metric`]). For a general Ω
-//! each block's local matrix A_{R_b}ᵀ W_b A_{S_b} is scattered into M
-//! through a map built with the pattern. For a diagonal Ω (two-point
-//! fluxes, diagonal Hodge stars) no map is kept: column j of M is
-//! Σ_r w_r a_rj A_r over the rows of A touching j, formed column by column
-//! in parallel from A stored by columns.
+//! values of the same pattern ([`Canonical::set_metric`]). No map from
+//! local entries to M is kept: M is formed column by column in parallel.
+//! For a general Ω column j gathers column j of each local matrix
+//! A_{R_b}ᵀ W_b A_{S_b} whose block touches j (blocks indexed by unknown
+//! with the pattern); for a diagonal Ω (two-point fluxes, diagonal Hodge
+//! stars) column j is Σ_r w_r a_rj A_r over the rows of A touching j,
+//! from A stored by columns.
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
@@ -101,7 +102,7 @@ impl BlockMetric {
     /// The weights w when Ω = diag(w) with block b the 1×1 block (b, b)
     /// for b < w.len() (rows beyond have no block); `None` for any other
     /// layout of blocks. [`Canonical`] assembles such an Ω column by
-    /// column, without a scatter map.
+    /// column, from A stored by columns.
     ///
     /// ```
     /// use hasse_solver::canonical::BlockMetric;
@@ -125,6 +126,40 @@ impl BlockMetric {
             m.push_block(&[r], &[s], &[v]);
         }
         m
+    }
+
+    /// Ω from square blocks over the same rows and columns, laid out back
+    /// to back: block b covers the rows `indices[ptr[b]..ptr[b + 1]]` and
+    /// its values (m_b × m_b row-major, m_b = ptr[b + 1] − ptr[b]) follow
+    /// those of block b − 1 in `values`. Builders that know their block
+    /// sizes in advance write them in place (and in parallel) this way.
+    pub(crate) fn from_symmetric_blocks(
+        size: usize,
+        ptr: &[usize],
+        indices: Vec<usize>,
+        values: Vec<f64>,
+    ) -> Self {
+        let mut next_value = 0;
+        let blocks = ptr
+            .windows(2)
+            .map(|w| {
+                let m = w[1] - w[0];
+                let block = Block {
+                    rows: (w[0], m),
+                    cols: (w[0], m),
+                    values: next_value,
+                };
+                next_value += m * m;
+                block
+            })
+            .collect();
+        debug_assert_eq!(next_value, values.len());
+        Self {
+            size,
+            blocks,
+            indices,
+            values,
+        }
     }
 
     /// Add the block W (|rows| × |cols|, row-major) at rows × cols.
@@ -338,7 +373,7 @@ enum Assembly {
     /// Ω diagonal in row order: column j of M is Σ_r w_r a_rj A_r over
     /// the rows r of A that touch j, each column formed on its own.
     Diagonal(Columns),
-    /// Any blocks: each block's dense local matrix scattered into M.
+    /// Any blocks: column j of M gathered from the blocks touching j.
     Blocks(LocalPattern),
 }
 
@@ -391,10 +426,10 @@ impl Columns {
 /// Block b of Ω touches only the unknowns in the columns of A's rows R_b
 /// (its row side) and S_b (its column side); its contribution
 /// A_{R_b}ᵀ W_b A_{S_b} is a dense matrix over those two sets. Assembly
-/// forms that small matrix and adds each of its entries once, so a dense
-/// element block (a Q1 hexahedron: 12 edge rows, 8 vertices) costs 64
-/// scatter entries, not the 576 products of every row pair with every
-/// incidence pair.
+/// forms M column by column: column j gathers, from every block with j on
+/// its column side, that block's column j of A_{R_b}ᵀ W_b A_{S_b}, so a
+/// dense element block (a Q1 hexahedron: 12 edge rows, 8 vertices) costs a
+/// few products per entry and no map from local entries to M is stored.
 #[derive(Clone, Debug)]
 struct LocalPattern {
     /// Block b's row-side unknowns are `unknowns[ptr[b]..ptr[b] + rows[b]]`
@@ -406,9 +441,10 @@ struct LocalPattern {
     rows: Vec<usize>,
     shared: Vec<bool>,
     unknowns: Vec<usize>,
-    /// Positions in M's value array of every local entry, block after
-    /// block, each block row-major (row side × column side).
-    scatter: Vec<usize>,
+    /// The blocks with unknown j on their column side are
+    /// `blocks_of[block_ptr[j]..block_ptr[j + 1]]`, in block order.
+    block_ptr: Vec<usize>,
+    blocks_of: Vec<usize>,
 }
 
 /// `0..count` cut into a few contiguous ranges per thread, in order. Few
@@ -416,7 +452,7 @@ struct LocalPattern {
 /// page of them costs a page fault;
 /// the results are concatenated in range order, so they do not depend on
 /// the thread count.
-fn ranges(count: usize) -> Vec<std::ops::Range<usize>> {
+pub(crate) fn ranges(count: usize) -> Vec<std::ops::Range<usize>> {
     let parts = (4 * rayon::current_num_threads()).clamp(1, count.max(1));
     let size = count.div_ceil(parts).max(1);
     (0..count)
@@ -465,7 +501,8 @@ impl LocalPattern {
             rows: Vec::with_capacity(metric.block_count()),
             shared: Vec::with_capacity(metric.block_count()),
             unknowns: Vec::with_capacity(chunks.iter().map(|c| c.3.len()).sum()),
-            scatter: Vec::new(),
+            block_ptr: Vec::new(),
+            blocks_of: Vec::new(),
         };
         pattern.ptr.push(0);
         for (rows, shared, lengths, unknowns) in chunks {
@@ -498,11 +535,16 @@ impl LocalPattern {
         )
     }
 
-    /// The sparsity pattern of M: column j holds every row-side unknown of
-    /// every block with j on its column side. Returns (column pointers,
-    /// row indices), rows sorted within each column.
-    fn matrix_pattern(&self, n: usize) -> (Vec<usize>, Vec<usize>) {
-        // Blocks by column-side unknown, in block order.
+    /// The blocks with unknown j on their column side, in block order.
+    fn blocks_of(&self, j: usize) -> &[usize] {
+        &self.blocks_of[self.block_ptr[j]..self.block_ptr[j + 1]]
+    }
+
+    /// Index the blocks by column-side unknown and return the sparsity
+    /// pattern of M: column j holds every row-side unknown of every block
+    /// with j on its column side. Returns (column pointers, row indices),
+    /// rows sorted within each column.
+    fn matrix_pattern(&mut self, n: usize) -> (Vec<usize>, Vec<usize>) {
         let mut block_ptr = vec![0usize; n + 1];
         for b in 0..self.block_count() {
             for &j in self.sides(b).1 {
@@ -521,35 +563,14 @@ impl LocalPattern {
             }
         }
         drop(next);
+        self.block_ptr = block_ptr;
+        self.blocks_of = blocks_of;
+        let this = &*self;
         pattern_by_columns(n, |j, rows| {
-            for &b in &blocks_of[block_ptr[j]..block_ptr[j + 1]] {
-                rows.extend_from_slice(self.sides(b).0);
+            for &b in this.blocks_of(j) {
+                rows.extend_from_slice(this.sides(b).0);
             }
         })
-    }
-
-    /// Fill `scatter` for the pattern (col_ptr, row_idx).
-    fn locate(&mut self, col_ptr: &[usize], row_idx: &[usize]) {
-        let this = &*self;
-        let chunks: Vec<Vec<usize>> = ranges(this.block_count())
-            .into_par_iter()
-            .map(|range| {
-                let (first, last) = (range.start, range.end);
-                let mut out = Vec::new();
-                for b in first..last {
-                    let (left, right) = this.sides(b);
-                    for &i in left {
-                        for &j in right {
-                            let column = &row_idx[col_ptr[j]..col_ptr[j + 1]];
-                            // Present by construction of the pattern.
-                            out.push(col_ptr[j] + column.binary_search(&i).unwrap_or(0));
-                        }
-                    }
-                }
-                out
-            })
-            .collect();
-        self.scatter = chunks.concat();
     }
 }
 
@@ -604,7 +625,7 @@ fn pattern_by_columns(
 /// `data` cut at `offset(range.start)` of each of the consecutive `parts`
 /// (offsets relative to the first part's start), one piece per part, so
 /// that parts can be filled in parallel.
-fn split_at_ranges<'a, T>(
+pub(crate) fn split_at_ranges<'a, T>(
     data: &'a mut [T],
     parts: &[std::ops::Range<usize>],
     offset: impl Fn(usize) -> usize,
@@ -668,7 +689,6 @@ impl Canonical {
             None => {
                 let mut local = LocalPattern::new(&incidence, &metric);
                 let pattern = local.matrix_pattern(n);
-                local.locate(&pattern.0, &pattern.1);
                 (Assembly::Blocks(local), pattern)
             }
         };
@@ -767,67 +787,90 @@ impl Canonical {
         values
     }
 
-    /// M's values block after block: each block's dense A_Rᵀ W A_S added
-    /// in block order.
+    /// M's values column after column in parallel: entry (i, j) adds the
+    /// blocks' (A_Rᵀ W A_S)_ij in block order, each formed as
+    /// Σ_r a_ri (Σ_s W_rs a_sj) with r and s in the block's order, whatever
+    /// the thread count.
     fn block_values(&self, local: &LocalPattern) -> Vec<f64> {
         let mut values = vec![0.0; self.nonzeros()];
-        let row = |r: usize| self.row(r);
-        // W A_S (|R| × |U_S|) and then A_Rᵀ (W A_S) (|U_R| × |U_S|).
-        let mut half = Vec::new();
-        let mut dense = Vec::new();
-        let mut k = 0;
-        for b in 0..self.metric.block_count() {
-            let (rows, cols, w) = self.metric.block(b);
-            let (left, right) = local.sides(b);
-            let (p, q) = (left.len(), right.len());
-            if let ([r], [s]) = (rows, cols) {
-                // One row pair (a diagonal Ω, a face of a two-point flux):
-                // when A's rows list their unknowns as the local lists do
-                // (sorted, distinct), the local matrix is the outer
-                // product a_r w a_sᵀ, with no position searches.
-                let ((ur, ar), (us, as_)) = (row(*r), row(*s));
-                if ur == left && us == right {
-                    let places = &local.scatter[k..k + p * q];
-                    for (i, &x) in ar.iter().enumerate() {
-                        let wx = w[0] * f64::from(x);
-                        for (j, &y) in as_.iter().enumerate() {
-                            values[places[i * q + j]] += wx * f64::from(y);
-                        }
-                    }
-                    k += p * q;
-                    continue;
-                }
-            }
-            half.clear();
-            half.resize(rows.len() * q, 0.0);
-            for (si, &s) in cols.iter().enumerate() {
-                let (unknowns, signs) = row(s);
-                for (&j, &sign) in unknowns.iter().zip(signs) {
-                    let jl = position(right, j);
-                    let sign = f64::from(sign);
-                    for ri in 0..rows.len() {
-                        half[ri * q + jl] += w[ri * cols.len() + si] * sign;
+        let col_ptr = self.symbolic.col_ptr();
+        let row_idx = self.symbolic.row_idx();
+        let parts = ranges(self.unknowns());
+        let slices = split_at_ranges(&mut values, &parts, |j| col_ptr[j]);
+        parts.into_par_iter().zip(slices).for_each_init(
+            || (Vec::new(), Vec::new()),
+            |(half, dense), (range, out)| {
+                let base = col_ptr[range.start];
+                for j in range {
+                    let (first, last) = (col_ptr[j], col_ptr[j + 1]);
+                    let column = &row_idx[first..last];
+                    let column_values = &mut out[first - base..last - base];
+                    for &b in local.blocks_of(j) {
+                        self.add_block_column(local, b, j, column, column_values, half, dense);
                     }
                 }
-            }
-            dense.clear();
-            dense.resize(p * q, 0.0);
-            for (ri, &r) in rows.iter().enumerate() {
-                let (unknowns, signs) = row(r);
-                for (&i, &sign) in unknowns.iter().zip(signs) {
-                    let il = position(left, i);
-                    let sign = f64::from(sign);
-                    for jl in 0..q {
-                        dense[il * q + jl] += sign * half[ri * q + jl];
-                    }
-                }
-            }
-            for (&place, &v) in local.scatter[k..k + p * q].iter().zip(&dense) {
-                values[place] += v;
-            }
-            k += p * q;
-        }
+            },
+        );
         values
+    }
+
+    /// Add column j of block b's A_Rᵀ W A_S to M's column j (`column`
+    /// its sorted rows, `column_values` its values); `half` and `dense`
+    /// are scratch.
+    #[allow(clippy::too_many_arguments)]
+    fn add_block_column(
+        &self,
+        local: &LocalPattern,
+        b: usize,
+        j: usize,
+        column: &[usize],
+        column_values: &mut [f64],
+        half: &mut Vec<f64>,
+        dense: &mut Vec<f64>,
+    ) {
+        let (rows, cols, w) = self.metric.block(b);
+        let (left, _) = local.sides(b);
+        // a_sj for each column-side row s of the block (0 when j ∉ row s).
+        let sign_at = |s: usize| {
+            let (unknowns, signs) = self.row(s);
+            unknowns
+                .iter()
+                .position(|&x| x == j)
+                .map(|k| f64::from(signs[k]))
+        };
+        if let ([r], [s]) = (rows, cols) {
+            // One row pair (a diagonal Ω, a face of a two-point flux): the
+            // column is a_r (w a_sj).
+            if let Some(y) = sign_at(*s) {
+                let (unknowns, signs) = self.row(*r);
+                for (&i, &x) in unknowns.iter().zip(signs) {
+                    let wx = w[0] * f64::from(x);
+                    column_values[sorted_position(column, i)] += wx * y;
+                }
+            }
+            return;
+        }
+        // (W A_S)_{·j}, then A_Rᵀ (W A_S)_{·j} over the block's row side.
+        half.clear();
+        half.resize(rows.len(), 0.0);
+        for (si, &s) in cols.iter().enumerate() {
+            if let Some(sign) = sign_at(s) {
+                for (ri, h) in half.iter_mut().enumerate() {
+                    *h += w[ri * cols.len() + si] * sign;
+                }
+            }
+        }
+        dense.clear();
+        dense.resize(left.len(), 0.0);
+        for (&r, &h) in rows.iter().zip(half.iter()) {
+            let (unknowns, signs) = self.row(r);
+            for (&i, &sign) in unknowns.iter().zip(signs) {
+                dense[position(left, i)] += f64::from(sign) * h;
+            }
+        }
+        for (&i, &v) in left.iter().zip(dense.iter()) {
+            column_values[sorted_position(column, i)] += v;
+        }
     }
 
     /// A u: the differences of `u` across every metric row.
@@ -860,9 +903,14 @@ impl Canonical {
     }
 }
 
-/// Index of `x` in the short sorted list `list` (it is there).
+/// Index of `x` in the short list `list` (it is there).
 fn position(list: &[usize], x: usize) -> usize {
     list.iter().position(|&y| y == x).unwrap_or(0)
+}
+
+/// Index of `x` in the sorted list `list` (it is there).
+fn sorted_position(list: &[usize], x: usize) -> usize {
+    list.partition_point(|&y| y < x)
 }
 
 /// Theorem 1 of the thesis: when A has trivial kernel, any matrix M of the

@@ -586,7 +586,9 @@ pub fn stiffness_metric(complex: &Complex, lame: &[Lame]) -> Result<BlockMetric,
                     }
                 }
             }
-            let (cell_edges, pinv) = fe::edge_pseudo_inverse(&top, c, "elasticity")?;
+            let cell_edges = top.edges_of(c);
+            let pinv =
+                fe::edge_pseudo_inverse(&top, c, &cell_edges, &mut Vec::new(), "elasticity")?;
             let lift = DMatrix::<f64>::identity(d, d).kronecker(&*pinv);
             let omega = lift.transpose() * kc * &lift;
             let size = omega.nrows();

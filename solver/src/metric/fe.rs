@@ -30,7 +30,7 @@
 //! Q1 and the virtual element need cells that fill their space (n = d).
 
 use super::{check_tensors, MetricError, Tensor};
-use crate::canonical::BlockMetric;
+use crate::canonical::{ranges, split_at_ranges, BlockMetric};
 use hasse_complex::Complex;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
@@ -161,8 +161,23 @@ enum Route {
 enum Element {
     P1,
     /// Local vertex positions in tensor order.
-    Q1(Vec<usize>),
+    Q1(TensorOrder),
     Vem,
+}
+
+/// The 2ⁿ local vertex positions (n ≤ 3) of a quadrilateral or hexahedron
+/// in tensor order: a fixed array, since every cell of a Q1 mesh needs one.
+#[derive(Clone, Copy)]
+struct TensorOrder {
+    slots: [usize; 8],
+    len: usize,
+}
+
+impl std::ops::Deref for TensorOrder {
+    type Target = [usize];
+    fn deref(&self) -> &[usize] {
+        &self.slots[..self.len]
+    }
 }
 
 fn stiffness(
@@ -172,25 +187,137 @@ fn stiffness(
 ) -> Result<BlockMetric, MetricError> {
     let top = Topology::new(complex, "FE stiffness")?;
     let n = top.n;
-    check_tensors(tensors, complex.cell_count(n), top.d)?;
-    let locals = (0..complex.cell_count(n))
+    let cells = complex.cell_count(n);
+    check_tensors(tensors, cells, top.d)?;
+    // Without P1 cells every cell pushes one dense block over its edges:
+    // the blocks' sizes are known from the topology, so they are written
+    // straight into Ω's storage.
+    let all_dense = match route {
+        Route::Vem => n > 1,
+        Route::ByShape => !(0..cells).into_par_iter().any(|c| top.is_simplex(c)),
+    };
+    if all_dense {
+        return dense_stiffness(&top, tensors, route);
+    }
+    let locals = (0..cells)
         .into_par_iter()
-        .map(|c| {
+        .map_init(CellScratch::default, |scratch, c| {
             let k = &tensors[c];
-            match top.element(c, route)? {
+            match top.element_with(c, route, &mut scratch.edges)? {
                 Element::P1 => p1_weights(&top, c, k),
-                Element::Q1(order) => {
-                    let kc = q1_stiffness(&top, c, &order, k)?;
-                    edge_block(&top, c, &kc, "Q1")
-                }
-                Element::Vem => {
-                    let kc = vem_stiffness(&top, c, k)?;
-                    edge_block(&top, c, &kc, "VEM")
+                element => {
+                    let m = top.edges_of(c).len();
+                    let mut values = vec![0.0; m * m];
+                    let edges = dense_block(&top, c, element, k, scratch, &mut values)?;
+                    Ok(Local::Dense { edges, values })
                 }
             }
         })
+        .collect::<Vec<Result<_, _>>>()
+        .into_iter()
         .collect::<Result<Vec<_>, _>>()?;
     Ok(gather(complex.cell_count(1), &locals))
+}
+
+/// Scratch vectors reused from cell to cell by one thread.
+#[derive(Default)]
+struct CellScratch {
+    edges: Vec<usize>,
+    /// Local stiffness K_c (vertices × vertices, row-major).
+    kc: Vec<f64>,
+    /// (A_c⁺)ᵀ K_c (edges × vertices).
+    half: Vec<f64>,
+    /// Local incidence pattern, the key of the A_c⁺ cache.
+    key: Vec<usize>,
+}
+
+/// Ω_c of a Q1 or virtual-element cell `c` over its sorted edges (returned),
+/// written over `out` (m × m row-major, m the cell's edge count).
+fn dense_block(
+    top: &Topology,
+    c: usize,
+    element: Element,
+    k: &Tensor,
+    scratch: &mut CellScratch,
+    out: &mut [f64],
+) -> Result<Vec<usize>, MetricError> {
+    let method = match element {
+        Element::Q1(order) => {
+            q1_stiffness(top, c, &order, k, &mut scratch.kc)?;
+            "Q1"
+        }
+        _ => {
+            let kc = vem_stiffness(top, c, k)?;
+            let m = kc.nrows();
+            scratch.kc.clear();
+            scratch
+                .kc
+                .extend((0..m * m).map(|idx| kc[(idx / m, idx % m)]));
+            "VEM"
+        }
+    };
+    top.edges_into(c, &mut scratch.edges);
+    edge_block(top, c, scratch, method, out)?;
+    Ok(std::mem::take(&mut scratch.edges))
+}
+
+/// Ω with one dense block per top cell, in cell order, every cell a Q1 or
+/// virtual element: the block sizes (edges per cell) are counted first, and
+/// each thread then writes its cells' edge lists and blocks in place.
+fn dense_stiffness(
+    top: &Topology,
+    tensors: &[Tensor],
+    route: Route,
+) -> Result<BlockMetric, MetricError> {
+    let cells = top.complex.cell_count(top.n);
+    let sizes: Vec<usize> = (0..cells)
+        .into_par_iter()
+        .map_init(Vec::new, |edges, c| {
+            top.edges_into(c, edges);
+            edges.len()
+        })
+        .collect();
+    let mut edge_ptr = Vec::with_capacity(cells + 1);
+    let mut value_ptr = Vec::with_capacity(cells + 1);
+    edge_ptr.push(0);
+    value_ptr.push(0);
+    for &m in &sizes {
+        edge_ptr.push(edge_ptr[edge_ptr.len() - 1] + m);
+        value_ptr.push(value_ptr[value_ptr.len() - 1] + m * m);
+    }
+    drop(sizes);
+    let mut indices = vec![0usize; edge_ptr[cells]];
+    let mut values = vec![0.0; value_ptr[cells]];
+    let parts = ranges(cells);
+    let index_parts = split_at_ranges(&mut indices, &parts, |c| edge_ptr[c]);
+    let value_parts = split_at_ranges(&mut values, &parts, |c| value_ptr[c]);
+    // Each part stops at its first bad cell; the parts' errors come back
+    // in cell order, so the first one reported is the first bad cell.
+    parts
+        .par_iter()
+        .zip(index_parts)
+        .zip(value_parts)
+        .map(|((range, index_out), value_out)| {
+            let mut scratch = CellScratch::default();
+            let (edge_base, value_base) = (edge_ptr[range.start], value_ptr[range.start]);
+            for c in range.clone() {
+                let element = top.element_with(c, route, &mut scratch.edges)?;
+                let out = &mut value_out[value_ptr[c] - value_base..value_ptr[c + 1] - value_base];
+                scratch.edges = dense_block(top, c, element, &tensors[c], &mut scratch, out)?;
+                index_out[edge_ptr[c] - edge_base..edge_ptr[c + 1] - edge_base]
+                    .copy_from_slice(&scratch.edges);
+            }
+            Ok(())
+        })
+        .collect::<Vec<Result<(), MetricError>>>()
+        .into_iter()
+        .collect::<Result<Vec<()>, MetricError>>()?;
+    Ok(BlockMetric::from_symmetric_blocks(
+        top.complex.cell_count(1),
+        &edge_ptr,
+        indices,
+        values,
+    ))
 }
 
 /// One cell's share of Ω.
@@ -305,19 +432,25 @@ impl<'a> Topology<'a> {
 
     /// Sorted edges of top cell `c`.
     pub(crate) fn edges_of(&self, c: usize) -> Vec<usize> {
+        let mut edges = Vec::new();
+        self.edges_into(c, &mut edges);
+        edges
+    }
+
+    /// Sorted edges of top cell `c`, written over `edges` (a scratch
+    /// vector reused across cells, so that a mesh of many cells does not
+    /// allocate one list per cell).
+    pub(crate) fn edges_into(&self, c: usize, edges: &mut Vec<usize>) {
+        edges.clear();
         match self.n {
-            1 => vec![c],
-            2 => self.facets_of(2, c).0.to_vec(),
+            1 => edges.push(c),
+            2 => edges.extend_from_slice(self.facets_of(2, c).0),
             _ => {
-                let mut edges: Vec<usize> = self
-                    .facets_of(3, c)
-                    .0
-                    .iter()
-                    .flat_map(|&f| self.facets_of(2, f).0.iter().copied())
-                    .collect();
+                for &f in self.facets_of(3, c).0 {
+                    edges.extend_from_slice(self.facets_of(2, f).0);
+                }
                 edges.sort_unstable();
                 edges.dedup();
-                edges
             }
         }
     }
@@ -342,6 +475,16 @@ impl<'a> Topology<'a> {
     }
 
     fn element(&self, c: usize, route: Route) -> Result<Element, MetricError> {
+        self.element_with(c, route, &mut Vec::new())
+    }
+
+    /// [`Topology::element`] with a scratch vector for the cell's edges.
+    fn element_with(
+        &self,
+        c: usize,
+        route: Route,
+        edges: &mut Vec<usize>,
+    ) -> Result<Element, MetricError> {
         if self.is_simplex(c) && (route == Route::ByShape || self.n == 1) {
             return Ok(Element::P1);
         }
@@ -358,7 +501,7 @@ impl<'a> Topology<'a> {
         if route == Route::Vem {
             return Ok(Element::Vem);
         }
-        Ok(match self.tensor_order(c) {
+        Ok(match self.tensor_order(c, edges) {
             Some(order) => Element::Q1(order),
             None => Element::Vem,
         })
@@ -367,13 +510,13 @@ impl<'a> Topology<'a> {
     /// Local vertex positions of a quadrilateral or hexahedron in tensor
     /// order (bit a of the index = side along local axis a), recovered from
     /// its edge graph; `None` when the graph is not a square or a cube.
-    fn tensor_order(&self, c: usize) -> Option<Vec<usize>> {
+    fn tensor_order(&self, c: usize, edges: &mut Vec<usize>) -> Option<TensorOrder> {
         let vertices = self.complex.cell_vertices(self.n, c);
         let m = vertices.len();
         if m != 1 << self.n || self.n < 2 || self.n > 3 {
             return None;
         }
-        let edges = self.edges_of(c);
+        self.edges_into(c, edges);
         if edges.len() != self.n * m / 2 {
             return None;
         }
@@ -397,7 +540,7 @@ impl<'a> Topology<'a> {
             return None;
         }
         let neighbours = |x: usize| &adjacent[x][..self.n];
-        let mut order = vec![usize::MAX; m];
+        let mut order = [usize::MAX; 8];
         order[0] = 0;
         for (axis, &b) in neighbours(0).iter().enumerate() {
             order[1 << axis] = b;
@@ -420,8 +563,9 @@ impl<'a> Topology<'a> {
                 .iter()
                 .find(|&&x| x != back && neighbours(q).contains(&x))?;
         }
+        let order = &order[..m];
         let mut seen = [false; 8];
-        for &o in &order {
+        for &o in order {
             if std::mem::replace(&mut seen[o], true) {
                 return None;
             }
@@ -435,7 +579,9 @@ impl<'a> Topology<'a> {
                 return None;
             }
         }
-        Some(order)
+        let mut slots = [0; 8];
+        slots[..m].copy_from_slice(order);
+        Some(TensorOrder { slots, len: m })
     }
 }
 
@@ -500,29 +646,30 @@ fn p1_weights(top: &Topology, c: usize, k: &Tensor) -> Result<Local, MetricError
         .map(Local::Diagonal)
 }
 
-/// The sorted edges of cell `c` and the pseudo-inverse A_c⁺ (cell vertices
-/// × cell edges, vertices in the cell's sorted order) of its local edge
-/// incidence, signs from the global ∂₁.
+/// The pseudo-inverse A_c⁺ (cell vertices × cell edges, vertices in the
+/// cell's sorted order) of the local edge incidence of cell `c` over its
+/// sorted `edges`, signs from the global ∂₁; `key` is scratch.
 pub(crate) fn edge_pseudo_inverse(
     top: &Topology,
     c: usize,
+    edges: &[usize],
+    key: &mut Vec<usize>,
     method: &'static str,
-) -> Result<(Vec<usize>, Rc<DMatrix<f64>>), MetricError> {
+) -> Result<Rc<DMatrix<f64>>, MetricError> {
     let vertices = top.complex.cell_vertices(top.n, c);
-    let edges = top.edges_of(c);
     // A_c is pure topology: the vertex count and each edge's local (tail,
     // head). Cells with the same local incidence (every cell of a
     // structured grid, up to a few orientation patterns) share A_c⁺, so it
     // is computed once per pattern and thread.
-    let mut key = Vec::with_capacity(1 + 2 * edges.len());
+    key.clear();
     key.push(vertices.len());
-    for &e in &edges {
+    for &e in edges {
         let (t, h) = top.local_ends(e, vertices, c)?;
         key.extend([t, h]);
     }
-    let cached = PSEUDO_INVERSES.with(|cache| cache.borrow().get(&key).cloned());
+    let cached = PSEUDO_INVERSES.with(|cache| cache.borrow_mut().get(key));
     if let Some(pinv) = cached {
-        return Ok((edges, pinv));
+        return Ok(pinv);
     }
     let mut a = DMatrix::zeros(edges.len(), vertices.len());
     for (r, ends) in key[1..].chunks_exact(2).enumerate() {
@@ -536,54 +683,100 @@ pub(crate) fn edge_pseudo_inverse(
             cell: c,
         }
     })?);
-    PSEUDO_INVERSES.with(|cache| {
-        let mut cache = cache.borrow_mut();
-        // Unstructured polytopal meshes have few repeats: bound the memory.
-        if cache.len() >= PSEUDO_INVERSE_CACHE_SIZE {
-            cache.clear();
-        }
-        cache.insert(key, Rc::clone(&pinv));
-    });
-    Ok((edges, pinv))
+    PSEUDO_INVERSES.with(|cache| cache.borrow_mut().insert(key, &pinv));
+    Ok(pinv)
 }
 
 /// Most local incidence patterns kept per thread.
 const PSEUDO_INVERSE_CACHE_SIZE: usize = 1024;
 
-thread_local! {
-    /// A_c⁺ by local incidence pattern (vertex count, then the local tail
-    /// and head of each edge in the cell's edge order).
-    /// Shared (`Rc`): a cell borrows its pattern's A_c⁺ without a copy.
-    static PSEUDO_INVERSES: std::cell::RefCell<std::collections::HashMap<Vec<usize>, Rc<DMatrix<f64>>>> =
-        std::cell::RefCell::new(std::collections::HashMap::new());
+/// A_c⁺ by local incidence pattern (vertex count, then the local tail and
+/// head of each edge in the cell's edge order), with the last pattern
+/// looked up kept apart: neighbouring cells of a structured grid mostly
+/// share it, and comparing one key is cheaper than hashing it.
+#[derive(Default)]
+struct PseudoInverseCache {
+    map: std::collections::HashMap<Vec<usize>, Rc<DMatrix<f64>>>,
+    last_key: Vec<usize>,
+    last: Option<Rc<DMatrix<f64>>>,
 }
 
-/// Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the edges of cell `c`; `kc` is indexed by
-/// the cell's sorted vertex list.
+impl PseudoInverseCache {
+    fn get(&mut self, key: &[usize]) -> Option<Rc<DMatrix<f64>>> {
+        if let Some(last) = &self.last {
+            if self.last_key == key {
+                return Some(Rc::clone(last));
+            }
+        }
+        let found = Rc::clone(self.map.get(key)?);
+        self.remember(key, &found);
+        Some(found)
+    }
+
+    fn insert(&mut self, key: &[usize], pinv: &Rc<DMatrix<f64>>) {
+        // Unstructured polytopal meshes have few repeats: bound the memory.
+        if self.map.len() >= PSEUDO_INVERSE_CACHE_SIZE {
+            self.map.clear();
+        }
+        self.map.insert(key.to_vec(), Rc::clone(pinv));
+        self.remember(key, pinv);
+    }
+
+    fn remember(&mut self, key: &[usize], pinv: &Rc<DMatrix<f64>>) {
+        self.last_key.clear();
+        self.last_key.extend_from_slice(key);
+        self.last = Some(Rc::clone(pinv));
+    }
+}
+
+thread_local! {
+    /// Shared (`Rc`): a cell borrows its pattern's A_c⁺ without a copy.
+    static PSEUDO_INVERSES: std::cell::RefCell<PseudoInverseCache> =
+        std::cell::RefCell::new(PseudoInverseCache::default());
+}
+
+/// Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the edges `scratch.edges` of cell `c`, from
+/// K_c in `scratch.kc` (indexed by the cell's sorted vertex list), written
+/// over `out` (edges × edges, row-major) and made exactly symmetric.
 fn edge_block(
     top: &Topology,
     c: usize,
-    kc: &DMatrix<f64>,
+    scratch: &mut CellScratch,
     method: &'static str,
-) -> Result<Local, MetricError> {
-    let (edges, pinv) = edge_pseudo_inverse(top, c, method)?;
-    let omega = pinv.transpose() * kc * &*pinv;
-    let m = edges.len();
-    // Symmetric up to rounding; made exactly so.
-    let values: Vec<f64> = (0..m * m)
-        .map(|idx| {
-            let (i, j) = (idx / m, idx % m);
-            0.5 * (omega[(i, j)] + omega[(j, i)])
-        })
-        .collect();
-    if values.iter().any(|v| !v.is_finite()) {
+    out: &mut [f64],
+) -> Result<(), MetricError> {
+    let pinv = edge_pseudo_inverse(top, c, &scratch.edges, &mut scratch.key, method)?;
+    let (v, m) = (pinv.nrows(), pinv.ncols());
+    let kc = &scratch.kc;
+    // (A_c⁺)ᵀ K_c first, then times A_c⁺.
+    let half = &mut scratch.half;
+    half.clear();
+    half.resize(m * v, 0.0);
+    for i in 0..m {
+        for b in 0..v {
+            half[i * v + b] = (0..v).map(|a| pinv[(a, i)] * kc[a * v + b]).sum();
+        }
+    }
+    for i in 0..m {
+        for j in 0..m {
+            out[i * m + j] = (0..v).map(|b| half[i * v + b] * pinv[(b, j)]).sum();
+        }
+    }
+    for i in 0..m {
+        for j in 0..i {
+            let mean = 0.5 * (out[i * m + j] + out[j * m + i]);
+            out[i * m + j] = mean;
+            out[j * m + i] = mean;
+        }
+    }
+    if out.iter().any(|v| !v.is_finite()) {
         return Err(MetricError::UnsupportedCell {
             method,
             needs: "a non-degenerate cell (finite local stiffness)",
             cell: c,
         });
     }
-    Ok(Local::Dense { edges, values })
+    Ok(())
 }
 
 /// Sign (±1) of corner `l` along local axis `a`.
@@ -631,18 +824,28 @@ struct GaussPoint {
     point: Point,
 }
 
-/// Gauss points (2 per axis, weight 1 each on [−1, 1]^n) of a Q1 cell with
-/// corners `x` in tensor order.
-fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, MetricError> {
+/// The isoparametric map of a Q1 cell at its 2ⁿ Gauss points: |det J|
+/// (the reference weight is 1) and the physical shape gradients, both in
+/// tensor order. Fixed arrays: every cell of a Q1 mesh needs one.
+struct Q1Map {
+    weights: [f64; 8],
+    gradients: [[Point; 8]; 8],
+}
+
+/// [`Q1Map`] of the cell with corners `x` in tensor order (2 Gauss points
+/// per axis, weight 1 each on [−1, 1]^n).
+fn q1_map(x: &[Point], n: usize, cell: usize) -> Result<Q1Map, MetricError> {
     let bad = MetricError::UnsupportedCell {
         method: "Q1",
         needs: "a quadrilateral or hexahedron whose isoparametric map keeps one orientation (convex, not inverted)",
         cell,
     };
-    let reference = q1_reference(n);
-    let mut out = Vec::with_capacity(1 << n);
+    let mut map = Q1Map {
+        weights: [0.0; 8],
+        gradients: [[[0.0; 3]; 8]; 8],
+    };
     let mut orientation = 0.0;
-    for (values, shape_gradients) in reference {
+    for (q, (_, shape_gradients)) in q1_reference(n).iter().enumerate() {
         let mut jacobian = [[0.0; 3]; 3];
         for (xl, gl) in x.iter().zip(shape_gradients) {
             for (i, row) in jacobian.iter_mut().enumerate().take(n) {
@@ -656,31 +859,40 @@ fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, Metr
             return Err(bad);
         }
         orientation = det.signum();
+        map.weights[q] = det.abs();
         // ∇φ = J⁻ᵀ ∇̂φ.
-        let gradients = shape_gradients
-            .iter()
-            .map(|r| {
-                let mut p = [0.0; 3];
-                for (i, pi) in p.iter_mut().enumerate().take(n) {
-                    *pi = (0..n).map(|a| inverse[a][i] * r[a]).sum();
-                }
-                p
-            })
-            .collect();
-        let mut point = [0.0; 3];
-        for (xl, &v) in x.iter().zip(values) {
-            for i in 0..n {
-                point[i] += v * xl[i];
+        for (p, r) in map.gradients[q].iter_mut().zip(shape_gradients) {
+            for (i, pi) in p.iter_mut().enumerate().take(n) {
+                *pi = (0..n).map(|a| inverse[a][i] * r[a]).sum();
             }
         }
-        out.push(GaussPoint {
-            weight: det.abs(),
-            values: values.clone(),
-            gradients,
-            point,
-        });
     }
-    Ok(out)
+    Ok(map)
+}
+
+/// Gauss points of a Q1 cell with corners `x` in tensor order, with the
+/// shape values and the mapped point (for loads).
+fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, MetricError> {
+    let map = q1_map(x, n, cell)?;
+    let m = 1 << n;
+    Ok(q1_reference(n)
+        .iter()
+        .enumerate()
+        .map(|(q, (values, _))| {
+            let mut point = [0.0; 3];
+            for (xl, &v) in x.iter().zip(values) {
+                for i in 0..n {
+                    point[i] += v * xl[i];
+                }
+            }
+            GaussPoint {
+                weight: map.weights[q],
+                values: values.clone(),
+                gradients: map.gradients[q][..m].to_vec(),
+                point,
+            }
+        })
+        .collect())
 }
 
 /// Shape values and reference gradients at the 2ⁿ Gauss points of
@@ -739,10 +951,14 @@ fn determinant_and_inverse(j: &[[f64; 3]; 3], n: usize) -> (f64, [[f64; 3]; 3]) 
     }
 }
 
-/// Corners of cell `c` in tensor order.
-fn tensor_points(top: &Topology, c: usize, order: &[usize]) -> Vec<Point> {
+/// Corners of cell `c` in tensor order (the first `order.len()` entries).
+fn tensor_points(top: &Topology, c: usize, order: &[usize]) -> [Point; 8] {
     let vertices = top.complex.cell_vertices(top.n, c);
-    order.iter().map(|&o| top.point(vertices[o])).collect()
+    let mut points = [[0.0; 3]; 8];
+    for (p, &o) in points.iter_mut().zip(order) {
+        *p = top.point(vertices[o]);
+    }
+    points
 }
 
 /// A quadrature weight and the shape gradients at its point.
@@ -770,7 +986,7 @@ pub(crate) fn shape_gradients(
             Ok(Some(vec![(measure, gradients)]))
         }
         Element::Q1(order) => {
-            let points = q1_points(&tensor_points(top, c, &order), top.n, c)?;
+            let points = q1_points(&tensor_points(top, c, &order)[..order.len()], top.n, c)?;
             Ok(Some(
                 points
                     .into_iter()
@@ -788,23 +1004,28 @@ pub(crate) fn shape_gradients(
     }
 }
 
+/// The Q1 stiffness of cell `c`, written over `kc` (m × m row-major, m =
+/// 2ⁿ, indexed by the cell's sorted vertex list).
 fn q1_stiffness(
     top: &Topology,
     c: usize,
     order: &[usize],
     k: &Tensor,
-) -> Result<DMatrix<f64>, MetricError> {
+    kc: &mut Vec<f64>,
+) -> Result<(), MetricError> {
     let n = top.n;
     let m = order.len();
-    let mut kc = DMatrix::zeros(m, m);
-    for q in q1_points(&tensor_points(top, c, order), n, c)? {
-        for (l, gl) in q.gradients.iter().enumerate() {
-            for (j, gj) in q.gradients.iter().enumerate() {
-                kc[(order[l], order[j])] += q.weight * k_dot(gl, k, gj, n);
+    let map = q1_map(&tensor_points(top, c, order)[..m], n, c)?;
+    kc.clear();
+    kc.resize(m * m, 0.0);
+    for (&weight, gradients) in map.weights[..m].iter().zip(&map.gradients) {
+        for (l, gl) in gradients[..m].iter().enumerate() {
+            for (j, gj) in gradients[..m].iter().enumerate() {
+                kc[order[l] * m + order[j]] += weight * k_dot(gl, k, gj, n);
             }
         }
     }
-    Ok(kc)
+    Ok(())
 }
 
 fn sub(a: &Point, b: &Point) -> Point {
@@ -1031,7 +1252,7 @@ fn cell_load(
             }
         }
         Element::Q1(order) => {
-            for q in q1_points(&tensor_points(top, c, &order), n, c)? {
+            for q in q1_points(&tensor_points(top, c, &order)[..order.len()], n, c)? {
                 let value = q.weight * evaluate(f, &q.point, d, c)?;
                 for (l, v) in q.values.iter().enumerate() {
                     out[order[l]].1 += value * v;
@@ -1183,6 +1404,33 @@ mod tests {
         let k = Complex::build(v, TopCells::polygons([[0, 1, 2, 3, 4, 5, 6, 7]])).unwrap();
         let top = Topology::new(&k, "test").unwrap();
         assert!(matches!(top.element(0, Route::ByShape), Ok(Element::Vem)));
+    }
+
+    #[test]
+    fn the_first_bad_cell_in_cell_order_is_reported() {
+        // A conductivity near the largest double passes the tensor check
+        // (finite, symmetric, positive) but overflows the local stiffness
+        // of cells 300 and 700 of a 40 × 25 grid. Cells are computed in
+        // parallel parts; the error must still name the first bad cell,
+        // whatever part finishes first.
+        let k = hasse_complex::generate::rectangle(40, 25, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let mut tensors = vec![isotropic(1.0); 1000];
+        tensors[300] = isotropic(f64::MAX);
+        tensors[700] = isotropic(f64::MAX);
+        for _ in 0..5 {
+            let error = stiffness_metric(&k, &tensors).unwrap_err();
+            assert!(
+                matches!(
+                    error,
+                    MetricError::UnsupportedCell {
+                        method: "Q1",
+                        cell: 300,
+                        ..
+                    }
+                ),
+                "{error:?}"
+            );
+        }
     }
 
     #[test]
