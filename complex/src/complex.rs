@@ -243,7 +243,24 @@ impl Complex {
     /// ∂_p in CSC storage, for column (cell → facets) access; built on
     /// first use and kept.
     pub fn boundary_csc(&self, p: usize) -> &CsMat<i8> {
-        self.geometry.facets[p].get_or_init(|| self.boundary(p).to_csc())
+        self.facets_by_cell(p)
+    }
+
+    /// [`Complex::boundary_csc`], shared with the complex (no copy).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    /// let by_cell = k.shared_boundary_csc(2);
+    /// assert!(by_cell.is_csc());
+    /// assert!(std::ptr::eq(&*by_cell, k.boundary_csc(2)));
+    /// ```
+    pub fn shared_boundary_csc(&self, p: usize) -> Arc<CsMat<i8>> {
+        Arc::clone(self.facets_by_cell(p))
+    }
+
+    fn facets_by_cell(&self, p: usize) -> &Arc<CsMat<i8>> {
+        self.geometry.facets[p].get_or_init(|| Arc::new(self.boundary(p).to_csc()))
     }
 
     /// The coboundary δ^p = ∂_{p+1}ᵀ (|K_{p+1}| × |K_p|, CSR), 0 ≤ p < n.

@@ -34,7 +34,7 @@ use rayon::prelude::*;
 use sprs::CsMat;
 use std::borrow::Cow;
 use std::ops::Range;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 /// Highest cell dimension a complex can have (the embedding is at most R³).
 const LEVELS: usize = 4;
@@ -43,7 +43,8 @@ const LEVELS: usize = 4;
 #[derive(Clone, Debug, Default)]
 pub(crate) struct GeometryCache {
     /// ∂_p in CSC storage (index p ≥ 1): the facets of each p-cell.
-    pub(crate) facets: [OnceLock<CsMat<i8>>; LEVELS],
+    /// Shared, so that operators built on ∂_p by columns use it in place.
+    pub(crate) facets: [OnceLock<Arc<CsMat<i8>>>; LEVELS],
     /// Measures and centroids of the p-cells.
     cells: [OnceLock<CellGeometry>; LEVELS],
     /// Unit normals of the (n−1)-cells.

@@ -378,12 +378,16 @@ enum Assembly {
 }
 
 /// A by columns: the rows of A (with a metric block) that touch each
-/// unknown, in increasing order, and their signs.
+/// unknown, in increasing order, and their signs; either built here or
+/// A's CSC form shared with the complex that owns it.
 #[derive(Clone, Debug)]
-struct Columns {
-    ptr: Vec<usize>,
-    rows: Vec<usize>,
-    signs: Vec<i8>,
+enum Columns {
+    Owned {
+        ptr: Vec<usize>,
+        rows: Vec<usize>,
+        signs: Vec<i8>,
+    },
+    Shared(Arc<CsMat<i8>>),
 }
 
 impl Columns {
@@ -409,7 +413,7 @@ impl Columns {
                 next[j] += 1;
             }
         }
-        Self {
+        Self::Owned {
             ptr,
             rows: by_column,
             signs,
@@ -418,8 +422,16 @@ impl Columns {
 
     /// The rows touching unknown j and their signs.
     fn column(&self, j: usize) -> (&[usize], &[i8]) {
-        let range = self.ptr[j]..self.ptr[j + 1];
-        (&self.rows[range.clone()], &self.signs[range])
+        match self {
+            Self::Owned { ptr, rows, signs } => {
+                let range = ptr[j]..ptr[j + 1];
+                (&rows[range.clone()], &signs[range])
+            }
+            Self::Shared(a) => {
+                let range = a.indptr().outer_inds_sz(j);
+                (&a.indices()[range.clone()], &a.data()[range])
+            }
+        }
     }
 }
 
@@ -661,7 +673,30 @@ impl Canonical {
         incidence: impl Into<Arc<CsMat<i8>>>,
         metric: BlockMetric,
     ) -> Result<Self, CanonicalError> {
-        let incidence = incidence.into();
+        Self::build(incidence.into(), None, metric)
+    }
+
+    /// [`Canonical::new`] with A also given in CSC storage, `by_columns`,
+    /// which must be the same matrix (a complex keeps ∂ₙ both ways: see
+    /// `Complex::shared_boundary_csc`). A diagonal Ω over every row of A is
+    /// then assembled from it in place instead of from a copy of A by
+    /// columns. Only the shapes are checked, so this stays in the crate.
+    pub(crate) fn with_columns(
+        incidence: Arc<CsMat<i8>>,
+        by_columns: Arc<CsMat<i8>>,
+        metric: BlockMetric,
+    ) -> Result<Self, CanonicalError> {
+        debug_assert!(by_columns.is_csc());
+        debug_assert_eq!(by_columns.shape(), incidence.shape());
+        debug_assert_eq!(by_columns.nnz(), incidence.nnz());
+        Self::build(incidence, Some(by_columns), metric)
+    }
+
+    fn build(
+        incidence: Arc<CsMat<i8>>,
+        by_columns: Option<Arc<CsMat<i8>>>,
+        metric: BlockMetric,
+    ) -> Result<Self, CanonicalError> {
         let incidence = if incidence.is_csr() {
             incidence
         } else {
@@ -677,7 +712,16 @@ impl Canonical {
         let n = incidence.cols();
         let (assembly, (col_ptr, row_idx)) = match metric.diagonal_weights() {
             Some(weights) => {
-                let columns = Columns::new(&incidence, weights.len());
+                let columns = match by_columns {
+                    Some(by_columns)
+                        if weights.len() == incidence.rows()
+                            && by_columns.is_csc()
+                            && by_columns.shape() == incidence.shape() =>
+                    {
+                        Columns::Shared(by_columns)
+                    }
+                    _ => Columns::new(&incidence, weights.len()),
+                };
                 let a = &*incidence;
                 let pattern = pattern_by_columns(n, |j, out| {
                     for &r in columns.column(j).0 {
@@ -1092,11 +1136,22 @@ mod tests {
                 by_blocks.push_block(&[r], &[r], &[weights[r]]);
             }
             assert!(by_blocks.diagonal_weights().is_none());
+            // With A's CSC form from the complex (used only when every
+            // row has its weight) the result is the same.
+            let shared = Canonical::with_columns(
+                grid.shared_boundary(2),
+                grid.shared_boundary_csc(2),
+                diagonal.clone(),
+            )
+            .unwrap()
+            .assemble();
             let fast = Canonical::new(a.clone(), diagonal).unwrap().assemble();
             let general = Canonical::new(a.clone(), by_blocks).unwrap().assemble();
-            assert_eq!(fast.symbolic().col_ptr(), general.symbolic().col_ptr());
-            assert_eq!(fast.symbolic().row_idx(), general.symbolic().row_idx());
-            assert_eq!(fast.val(), general.val());
+            for other in [&general, &shared] {
+                assert_eq!(fast.symbolic().col_ptr(), other.symbolic().col_ptr());
+                assert_eq!(fast.symbolic().row_idx(), other.symbolic().row_idx());
+                assert_eq!(fast.val(), other.val());
+            }
             let w = DMatrix::from_fn(rows, rows, |i, j| {
                 if i == j && i < blocks {
                     weights[i]

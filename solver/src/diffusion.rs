@@ -25,7 +25,7 @@
 use crate::canonical::{BlockMetric, Canonical, CanonicalError};
 use crate::iterative::{conjugate_gradient, CgError, CgOptions, CgReport, RowMatrix};
 use crate::linear::{self, Factorization, SolveError, SolveReport};
-use crate::metric::{self, dec, fd, fe, fv, MetricError, Tensor};
+use crate::metric::{self, dec, fd, fe, fv, CellTensors, MetricError, Tensor};
 use crate::multigrid::{
     self, CellProlongation, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
 };
@@ -444,6 +444,21 @@ pub(crate) fn tagged_boundary_faces<'a>(
     Ok(last)
 }
 
+/// A conductivity evaluated at the cells, owned.
+enum CellConductivity {
+    Scalar(Vec<f64>),
+    Full(Vec<Tensor>),
+}
+
+impl CellConductivity {
+    fn cells(&self) -> CellTensors<'_> {
+        match self {
+            Self::Scalar(values) => CellTensors::Scalar(values),
+            Self::Full(tensors) => CellTensors::Full(tensors),
+        }
+    }
+}
+
 /// Ω's diagonal entry (summed over its 1×1 blocks) on each of the sorted
 /// `rows`, or `None` where a row has none.
 fn diagonal_on(metric: &BlockMetric, rows: &[usize]) -> Vec<Option<f64>> {
@@ -615,30 +630,34 @@ impl Diffusion {
         }
     }
 
-    fn tensors(&self, complex: &Complex) -> Result<Vec<Tensor>, DiffusionError> {
+    /// The conductivity at every cell centroid: scalars stay scalars (8
+    /// bytes a cell instead of a 72-byte tensor).
+    fn tensors(&self, complex: &Complex) -> Result<CellConductivity, DiffusionError> {
         let n = complex.dim();
         let d = complex.embedding_dim();
         let centroids = complex.centroid(n);
-        let tensors: Vec<Tensor> = (0..complex.cell_count(n))
-            .into_par_iter()
-            .map(|c| {
-                let x = &centroids[c * d..(c + 1) * d];
-                match &self.conductivity {
-                    Conductivity::Scalar(f) => metric::isotropic(f(x)),
-                    Conductivity::Tensor(f) => f(x),
-                }
-            })
-            .collect();
-        metric::check_tensors(&tensors, complex.cell_count(n), d).map_err(|e| match e {
-            MetricError::NotPositive { cell, .. } | MetricError::NonFinite { cell } => {
-                DiffusionError::Coefficient {
-                    point: centroids[cell * d..(cell + 1) * d].to_vec(),
-                    source: e,
-                }
+        let at = |c: usize| &centroids[c * d..(c + 1) * d];
+        let cells = 0..complex.cell_count(n);
+        let conductivity = match &self.conductivity {
+            Conductivity::Scalar(f) => {
+                CellConductivity::Scalar(cells.into_par_iter().map(|c| f(at(c))).collect())
             }
-            other => other.into(),
-        })?;
-        Ok(tensors)
+            Conductivity::Tensor(f) => {
+                CellConductivity::Full(cells.into_par_iter().map(|c| f(at(c))).collect())
+            }
+        };
+        metric::check_tensors(conductivity.cells(), complex.cell_count(n), d).map_err(
+            |e| match e {
+                MetricError::NotPositive { cell, .. } | MetricError::NonFinite { cell } => {
+                    DiffusionError::Coefficient {
+                        point: at(cell).to_vec(),
+                        source: e,
+                    }
+                }
+                other => other.into(),
+            },
+        )?;
+        Ok(conductivity)
     }
 
     fn boundary_faces(&self, complex: &Complex) -> Result<Faces, DiffusionError> {
@@ -668,7 +687,8 @@ impl Diffusion {
     pub fn assemble(&self, complex: &Complex) -> Result<Assembled, DiffusionError> {
         let started = Instant::now();
         let n = complex.dim();
-        let tensors = self.tensors(complex)?;
+        let conductivity = self.tensors(complex)?;
+        let tensors = conductivity.cells();
         let faces = self.boundary_faces(complex)?;
         let location = self.location();
         let cells = complex.cell_count(n);
@@ -678,29 +698,29 @@ impl Diffusion {
         let (incidence, metric, unknowns) = match self.method {
             Method::Fe => (
                 Arc::new(complex.coboundary(0)),
-                fe::stiffness_metric(complex, &tensors)?,
+                fe::stiffness_metric(complex, tensors)?,
                 complex.cell_count(0),
             ),
             Method::Dec(kind) => (
                 Arc::new(complex.coboundary(0)),
-                dec::hodge_metric(complex, kind, &tensors)?,
+                dec::hodge_metric(complex, kind, tensors)?,
                 complex.cell_count(0),
             ),
             Method::Fv => (
                 complex.shared_boundary(n),
                 match &cell_points {
-                    None => fv::two_point(complex, &tensors)?,
-                    Some(points) => fv::two_point_at(complex, &tensors, points)?,
+                    None => fv::two_point(complex, tensors)?,
+                    Some(points) => fv::two_point_at(complex, tensors, points)?,
                 },
                 cells,
             ),
             Method::Fd => (
                 complex.shared_boundary(n),
-                fd::five_point(complex, &tensors)?,
+                fd::five_point(complex, tensors)?,
                 cells,
             ),
             Method::FvMimetic => {
-                let (a, omega, layout) = fv::mimetic_hybrid(complex, &tensors)?;
+                let (a, omega, layout) = fv::mimetic_hybrid(complex, tensors)?;
                 (Arc::new(a), omega, layout.cells + layout.faces)
             }
         };
@@ -774,7 +794,13 @@ impl Diffusion {
             }
             Arc::new(tri.to_csr())
         };
-        let canonical = Canonical::new(incidence, metric_final)?;
+        // The cell-centred methods' A is ∂ₙ itself, which the complex also
+        // keeps by columns.
+        let canonical = if ghosts.is_empty() && matches!(self.method, Method::Fv | Method::Fd) {
+            Canonical::with_columns(incidence, complex.shared_boundary_csc(n), metric_final)?
+        } else {
+            Canonical::new(incidence, metric_final)?
+        };
         // b += Aᵀ Ω w for ghost values w (Dirichlet faces, Robin ghosts).
         if ghost_values.iter().any(|&v| v != 0.0) {
             let lifted = canonical.sum_transpose(&canonical.metric().apply(&ghost_values));

@@ -39,7 +39,7 @@
 //! dual kind.
 
 use super::fe::{gather, k_dot, simplex_gradients, Local, Point, Topology};
-use super::{check_tensors, MetricError, Tensor};
+use super::{check_tensors, CellTensors, MetricError, Tensor};
 use crate::canonical::BlockMetric;
 use hasse_complex::{Complex, DualKind};
 use rayon::prelude::*;
@@ -64,11 +64,12 @@ use rayon::prelude::*;
 /// // The five-point stencil at the centre vertex.
 /// assert!((m[(4, 4)] - 4.0).abs() < 1e-14 && (m[(4, 1)] + 1.0).abs() < 1e-14);
 /// ```
-pub fn hodge_metric(
+pub fn hodge_metric<'a>(
     complex: &Complex,
     kind: DualKind,
-    tensors: &[Tensor],
+    tensors: impl Into<CellTensors<'a>>,
 ) -> Result<BlockMetric, MetricError> {
+    let tensors = tensors.into();
     let top = Topology::new(complex, "DEC Hodge star")?;
     let n = top.n;
     let cells = complex.cell_count(n);
@@ -86,14 +87,14 @@ pub fn hodge_metric(
     let lengths = complex.measure(1);
     let locals = (0..cells)
         .into_par_iter()
-        .map(|c| match isotropic_value(&tensors[c], top.d) {
+        .map(|c| match isotropic_value(&tensors.get(c), top.d) {
             Some(lambda) => Ok(Local::Diagonal(
                 dual_pieces(&top, &centres, c)
                     .into_iter()
                     .map(|(e, piece)| (e, lambda * piece / lengths[e]))
                     .collect(),
             )),
-            None if top.is_simplex(c) => whitney_block(&top, c, &tensors[c]),
+            None if top.is_simplex(c) => whitney_block(&top, c, &tensors.get(c)),
             None => Err(MetricError::UnsupportedCell {
                 method: "DEC with a tensor coefficient",
                 needs: "a simplex (the Whitney star)",
@@ -119,7 +120,11 @@ pub fn hodge_metric(
 /// let whitney = dec::whitney_metric(&k, &vec![isotropic(1.0); 6]).unwrap();
 /// assert_eq!(whitney.block_count(), 6);
 /// ```
-pub fn whitney_metric(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, MetricError> {
+pub fn whitney_metric<'a>(
+    complex: &Complex,
+    tensors: impl Into<CellTensors<'a>>,
+) -> Result<BlockMetric, MetricError> {
+    let tensors = tensors.into();
     let top = Topology::new(complex, "DEC Whitney star")?;
     let cells = complex.cell_count(top.n);
     check_tensors(tensors, cells, top.d)?;
@@ -127,7 +132,7 @@ pub fn whitney_metric(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetr
         .into_par_iter()
         .map(|c| {
             if top.is_simplex(c) {
-                whitney_block(&top, c, &tensors[c])
+                whitney_block(&top, c, &tensors.get(c))
             } else {
                 Err(MetricError::UnsupportedCell {
                     method: "DEC Whitney star",

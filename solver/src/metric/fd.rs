@@ -10,7 +10,7 @@
 //! takes differences across faces, Ω turns them into fluxes and δ = ∂ₙᵀ
 //! sums the fluxes of each cell.
 
-use super::{check_tensors, MetricError, Tensor};
+use super::{check_tensors, CellTensors, MetricError};
 use crate::canonical::BlockMetric;
 use hasse_complex::Complex;
 
@@ -140,7 +140,11 @@ fn face_axis(complex: &Complex, face: usize, b: &Box3) -> Option<usize> {
 /// assert!((m[(4, 5)] + volume / 0.25).abs() < 1e-12);
 /// assert!((m[(4, 7)] + volume / 0.0625).abs() < 1e-12);
 /// ```
-pub fn five_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, MetricError> {
+pub fn five_point<'a>(
+    complex: &Complex,
+    tensors: impl Into<CellTensors<'a>>,
+) -> Result<BlockMetric, MetricError> {
+    let tensors = tensors.into();
     let (n, d) = (complex.dim(), complex.embedding_dim());
     if n == 0 || n != d {
         return Err(MetricError::UnsupportedMesh {
@@ -152,7 +156,7 @@ pub fn five_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, 
     let cells = complex.cell_count(n);
     check_tensors(tensors, cells, d)?;
     if let Some(cell) =
-        (0..cells).find(|&c| (0..d).any(|i| (0..d).any(|j| i != j && tensors[c][i][j] != 0.0)))
+        (0..cells).find(|&c| (0..d).any(|i| (0..d).any(|j| i != j && tensors.get(c)[i][j] != 0.0)))
     {
         return Err(MetricError::UnsupportedMesh {
             method: METHOD,
@@ -182,11 +186,11 @@ pub fn five_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, 
             .filter(|&b| b != axis)
             .map(|b| boxes[k].width(b))
             .product();
-        let (hk, lk) = (boxes[k].width(axis), tensors[k][axis][axis]);
+        let (hk, lk) = (boxes[k].width(axis), tensors.get(k)[axis][axis]);
         sigma.push(match adjacent.as_slice() {
             [_] => lk * w / (hk / 2.0),
             [_, l] => {
-                let (hl, ll) = (boxes[*l].width(axis), tensors[*l][axis][axis]);
+                let (hl, ll) = (boxes[*l].width(axis), tensors.get(*l)[axis][axis]);
                 let lambda = (hk + hl) / (hk / lk + hl / ll);
                 lambda * w / ((hk + hl) / 2.0)
             }

@@ -29,7 +29,7 @@
 //! surface in R³): gradients are taken in the simplex's own tangent space.
 //! Q1 and the virtual element need cells that fill their space (n = d).
 
-use super::{check_tensors, MetricError, Tensor};
+use super::{check_tensors, CellTensors, MetricError, Tensor};
 use crate::canonical::{ranges, split_at_ranges, BlockMetric};
 use hasse_complex::Complex;
 use nalgebra::DMatrix;
@@ -64,8 +64,11 @@ const PSEUDO_INVERSE_TOLERANCE: f64 = 1e-8;
 /// assert!((m[(4, 4)] - 8.0 / 3.0).abs() < 1e-14);
 /// assert!((m[(4, 0)] + 1.0 / 3.0).abs() < 1e-14);
 /// ```
-pub fn stiffness_metric(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, MetricError> {
-    stiffness(complex, tensors, Route::ByShape)
+pub fn stiffness_metric<'a>(
+    complex: &Complex,
+    tensors: impl Into<CellTensors<'a>>,
+) -> Result<BlockMetric, MetricError> {
+    stiffness(complex, tensors.into(), Route::ByShape)
 }
 
 /// Stiffness metric from the lowest-order virtual element method on every
@@ -101,11 +104,11 @@ pub fn stiffness_metric(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMe
 /// assert_eq!(omega.block_count(), 1);
 /// assert!(omega.is_symmetric(1e-14));
 /// ```
-pub fn vem_stiffness_metric(
+pub fn vem_stiffness_metric<'a>(
     complex: &Complex,
-    tensors: &[Tensor],
+    tensors: impl Into<CellTensors<'a>>,
 ) -> Result<BlockMetric, MetricError> {
-    stiffness(complex, tensors, Route::Vem)
+    stiffness(complex, tensors.into(), Route::Vem)
 }
 
 /// Galerkin load vector ∫ f φ_v for every vertex v, with the quadrature of
@@ -182,7 +185,7 @@ impl std::ops::Deref for TensorOrder {
 
 fn stiffness(
     complex: &Complex,
-    tensors: &[Tensor],
+    tensors: CellTensors,
     route: Route,
 ) -> Result<BlockMetric, MetricError> {
     let top = Topology::new(complex, "FE stiffness")?;
@@ -202,7 +205,7 @@ fn stiffness(
     let locals = (0..cells)
         .into_par_iter()
         .map_init(CellScratch::default, |scratch, c| {
-            let k = &tensors[c];
+            let k = &tensors.get(c);
             match top.element_with(c, route, &mut scratch.edges)? {
                 Element::P1 => p1_weights(&top, c, k),
                 element => {
@@ -266,7 +269,7 @@ fn dense_block(
 /// each thread then writes its cells' edge lists and blocks in place.
 fn dense_stiffness(
     top: &Topology,
-    tensors: &[Tensor],
+    tensors: CellTensors,
     route: Route,
 ) -> Result<BlockMetric, MetricError> {
     let cells = top.complex.cell_count(top.n);
@@ -303,7 +306,7 @@ fn dense_stiffness(
             for c in range.clone() {
                 let element = top.element_with(c, route, &mut scratch.edges)?;
                 let out = &mut value_out[value_ptr[c] - value_base..value_ptr[c + 1] - value_base];
-                scratch.edges = dense_block(top, c, element, &tensors[c], &mut scratch, out)?;
+                scratch.edges = dense_block(top, c, element, &tensors.get(c), &mut scratch, out)?;
                 index_out[edge_ptr[c] - edge_base..edge_ptr[c + 1] - edge_base]
                     .copy_from_slice(&scratch.edges);
             }
@@ -1438,7 +1441,7 @@ mod tests {
         let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
         let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
         assert!(matches!(
-            stiffness_metric(&k, &[]),
+            stiffness_metric(&k, &[] as &[Tensor]),
             Err(MetricError::CoefficientCount { count: 0, cells: 1 })
         ));
         assert!(matches!(

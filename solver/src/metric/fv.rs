@@ -22,7 +22,7 @@
 //! geometry of the complex: measures, centroids and the unit normals of the
 //! (n−1)-cells, oriented so that ∂ₙ(F, K) n_F points out of K.
 
-use super::{check_tensors, MetricError, Tensor};
+use super::{check_tensors, CellTensors, MetricError, Tensor};
 use crate::canonical::BlockMetric;
 use hasse_complex::Complex;
 use nalgebra::DMatrix;
@@ -163,7 +163,11 @@ fn check_dimension(complex: &Complex, method: &'static str) -> Result<usize, Met
 /// // Boundary edges: σ = 1·1/½ = 2.
 /// assert!(sigma.iter().enumerate().all(|(f, s)| f == shared || (s - 2.0).abs() < 1e-14));
 /// ```
-pub fn two_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, MetricError> {
+pub fn two_point<'a>(
+    complex: &Complex,
+    tensors: impl Into<CellTensors<'a>>,
+) -> Result<BlockMetric, MetricError> {
+    let tensors = tensors.into();
     const METHOD: &str = "two-point flux (TPFA)";
     let n = check_dimension(complex, METHOD)?;
     check_tensors(tensors, complex.cell_count(n), complex.embedding_dim())?;
@@ -184,7 +188,7 @@ pub fn two_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, M
         let mut area = 0.0;
         for &cell in cells {
             let half = geometry.half(face, cell);
-            resistance += half.resistance(&tensors[cell], cell, METHOD)?;
+            resistance += half.resistance(&tensors.get(cell), cell, METHOD)?;
             area = half.area;
         }
         // A face on no top cell carries no flux.
@@ -250,11 +254,12 @@ pub fn two_point(complex: &Complex, tensors: &[Tensor]) -> Result<BlockMetric, M
 /// // Circumcentres at (1, ±5/12): σ = 2 / (5/12 + 5/12).
 /// assert!((sigma[shared][shared] - 2.4).abs() < 1e-12);
 /// ```
-pub fn two_point_at(
+pub fn two_point_at<'a>(
     complex: &Complex,
-    tensors: &[Tensor],
+    tensors: impl Into<CellTensors<'a>>,
     points: &[f64],
 ) -> Result<BlockMetric, MetricError> {
+    let tensors = tensors.into();
     const METHOD: &str = "two-point flux (TPFA) at given cell points";
     let n = check_dimension(complex, METHOD)?;
     let d = complex.embedding_dim();
@@ -295,7 +300,7 @@ pub fn two_point_at(
             let mut resistance = 0.0;
             for &(cell, sign) in &row {
                 let s = signed_distance(x_face, &points[cell * d..(cell + 1) * d], normal, sign);
-                resistance += s / normal_component(&tensors[cell], normal);
+                resistance += s / normal_component(&tensors.get(cell), normal);
             }
             if !(resistance > 0.0 && resistance.is_finite()) {
                 return Err(MetricError::UnsupportedMesh {
@@ -452,10 +457,11 @@ fn transmissibility(
 /// // Constants are in the kernel: u_K = λ_F = 1 carries no flux.
 /// assert!(op.apply(&vec![1.0; layout.unknowns()]).iter().all(|v| v.abs() < 1e-12));
 /// ```
-pub fn mimetic_hybrid(
+pub fn mimetic_hybrid<'a>(
     complex: &Complex,
-    tensors: &[Tensor],
+    tensors: impl Into<CellTensors<'a>>,
 ) -> Result<(CsMat<i8>, BlockMetric, HybridLayout), MetricError> {
+    let tensors = tensors.into();
     const METHOD: &str = "mimetic finite differences";
     let n = check_dimension(complex, METHOD)?;
     let d = complex.embedding_dim();
@@ -494,10 +500,10 @@ pub fn mimetic_hybrid(
                     offsets[(i, a)] = half.x_face[a] - half.x_cell[a];
                 }
                 areas.push(half.area);
-                resistances.push(half.resistance(&tensors[cell], cell, METHOD)?);
+                resistances.push(half.resistance(&tensors.get(cell), cell, METHOD)?);
             }
             transmissibility(
-                &tensors[cell],
+                &tensors.get(cell),
                 complex.measure(n)[cell],
                 &outward,
                 &offsets,

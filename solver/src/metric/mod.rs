@@ -9,8 +9,10 @@
 //! | FD five/seven-point | top cells | ∂ₙ | (n−1)-cells |
 //! | FV mimetic (hybrid) | top cells and (n−1)-cells | half-face incidence | half-faces |
 //!
-//! Coefficients arrive as one symmetric tensor per top cell (a scalar λ is
-//! λ·I), already evaluated by the problem layer.
+//! Coefficients arrive as one symmetric tensor per top cell, already
+//! evaluated by the problem layer: [`CellTensors`], either one full tensor
+//! per cell or one scalar λ per cell (K = λ·I, stored as 8 bytes a cell
+//! instead of 72).
 //!
 //! [`BlockMetric`]: crate::canonical::BlockMetric
 
@@ -28,6 +30,87 @@ pub type Tensor = [[f64; 3]; 3];
 /// λ·I as a tensor.
 pub fn isotropic(lambda: f64) -> Tensor {
     [[lambda, 0.0, 0.0], [0.0, lambda, 0.0], [0.0, 0.0, lambda]]
+}
+
+/// The coefficient K of every top cell, as the metrics read it: one scalar
+/// λ per cell (K = λ·I) or one symmetric tensor per cell. Slices and
+/// vectors of either convert with `into()`, so every metric takes
+/// `&tensors` for a `Vec<Tensor>` or a `Vec<f64>`.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::{fv, isotropic};
+/// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// // The same two-point fluxes from scalars and from the tensors λ·I.
+/// let from_scalars = fv::two_point(&k, &vec![2.0, 3.0]).unwrap();
+/// let from_tensors = fv::two_point(&k, &vec![isotropic(2.0), isotropic(3.0)]).unwrap();
+/// assert_eq!(from_scalars, from_tensors);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CellTensors<'a> {
+    /// K = λ_c·I in cell c.
+    Scalar(&'a [f64]),
+    /// K of cell c, symmetric; the leading d×d block is used in R^d.
+    Full(&'a [Tensor]),
+}
+
+impl CellTensors<'_> {
+    /// Number of cells with a coefficient.
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Scalar(values) => values.len(),
+            Self::Full(tensors) => tensors.len(),
+        }
+    }
+
+    /// Whether no cell has a coefficient.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// K of cell `c` as a tensor.
+    pub fn get(&self, c: usize) -> Tensor {
+        match self {
+            Self::Scalar(values) => isotropic(values[c]),
+            Self::Full(tensors) => tensors[c],
+        }
+    }
+}
+
+impl<'a> From<&'a [Tensor]> for CellTensors<'a> {
+    fn from(tensors: &'a [Tensor]) -> Self {
+        Self::Full(tensors)
+    }
+}
+
+impl<'a> From<&'a Vec<Tensor>> for CellTensors<'a> {
+    fn from(tensors: &'a Vec<Tensor>) -> Self {
+        Self::Full(tensors)
+    }
+}
+
+impl<'a, const N: usize> From<&'a [Tensor; N]> for CellTensors<'a> {
+    fn from(tensors: &'a [Tensor; N]) -> Self {
+        Self::Full(tensors)
+    }
+}
+
+impl<'a> From<&'a [f64]> for CellTensors<'a> {
+    fn from(values: &'a [f64]) -> Self {
+        Self::Scalar(values)
+    }
+}
+
+impl<'a> From<&'a Vec<f64>> for CellTensors<'a> {
+    fn from(values: &'a Vec<f64>) -> Self {
+        Self::Scalar(values)
+    }
+}
+
+impl<'a, const N: usize> From<&'a [f64; N]> for CellTensors<'a> {
+    fn from(values: &'a [f64; N]) -> Self {
+        Self::Scalar(values)
+    }
 }
 
 /// Why a metric could not be built.
@@ -56,7 +139,12 @@ pub enum MetricError {
 }
 
 /// Check one tensor per top cell, symmetric positive definite in R^d.
-pub fn check_tensors(tensors: &[Tensor], cells: usize, d: usize) -> Result<(), MetricError> {
+pub fn check_tensors<'a>(
+    tensors: impl Into<CellTensors<'a>>,
+    cells: usize,
+    d: usize,
+) -> Result<(), MetricError> {
+    let tensors = tensors.into();
     if tensors.len() != cells {
         return Err(MetricError::CoefficientCount {
             count: tensors.len(),
@@ -64,10 +152,9 @@ pub fn check_tensors(tensors: &[Tensor], cells: usize, d: usize) -> Result<(), M
         });
     }
     // In parallel; the first bad cell in cell order is the one reported.
-    match tensors
-        .par_iter()
-        .enumerate()
-        .find_map_first(|(cell, t)| tensor_problem(t, cell, d))
+    match (0..cells)
+        .into_par_iter()
+        .find_map_first(|cell| tensor_problem(&tensors.get(cell), cell, d))
     {
         Some(problem) => Err(problem),
         None => Ok(()),
