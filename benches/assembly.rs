@@ -6,7 +6,7 @@
 //! whole `Diffusion::assemble` (Ω, boundary data, source load, pattern and
 //! values) on the warm complex, then its parts through the
 //! public API: the metric Ω, `Canonical::new` (the sparsity pattern) and
-//! `Canonical::assemble` (the values), each with its page faults. For the
+//! `Canonical::assemble_owned` (the values), each with its page faults. For the
 //! structured cell-centred cases the same 5/7-point matrix is also built by
 //! hand as triplets and compressed by faer, the floor any assembly is
 //! measured against; for 2D Q1 the nodal matrix is built by hand from the
@@ -87,10 +87,10 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
     };
     let metric_seconds = seconds(t);
     let (t, faults_metric) = (Instant::now(), faults());
-    let canonical = Canonical::new(incidence, metric).expect("canonical");
+    let mut canonical = Canonical::new(incidence, metric).expect("canonical");
     let pattern_seconds = seconds(t);
     let (t, faults_pattern) = (Instant::now(), faults());
-    let matrix = canonical.assemble();
+    let matrix = canonical.assemble_owned();
     let values_seconds = seconds(t);
     let faults_values = faults();
     print!(

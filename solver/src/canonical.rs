@@ -20,7 +20,7 @@
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
 use sprs::CsMat;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 /// Errors in building a canonical operator.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -361,7 +361,10 @@ pub struct Canonical {
     /// Shared, so that a boundary matrix of the complex is used in place.
     incidence: Arc<CsMat<i8>>,
     metric: BlockMetric,
-    symbolic: SymbolicSparseColMat<usize>,
+    /// The pattern of M, built with the operator; [`Canonical::assemble_owned`]
+    /// hands it over to the matrix, and a later assembly builds it again.
+    symbolic: OnceLock<SymbolicSparseColMat<usize>>,
+    nonzeros: usize,
     /// How values reach M (boxed: it is large and `Canonical` sits in
     /// enums next to small variants).
     assembly: Box<Assembly>,
@@ -552,11 +555,8 @@ impl LocalPattern {
         &self.blocks_of[self.block_ptr[j]..self.block_ptr[j + 1]]
     }
 
-    /// Index the blocks by column-side unknown and return the sparsity
-    /// pattern of M: column j holds every row-side unknown of every block
-    /// with j on its column side. Returns (column pointers, row indices),
-    /// rows sorted within each column.
-    fn matrix_pattern(&mut self, n: usize) -> (Vec<usize>, Vec<usize>) {
+    /// Index the blocks by column-side unknown (n unknowns).
+    fn index_blocks(&mut self, n: usize) {
         let mut block_ptr = vec![0usize; n + 1];
         for b in 0..self.block_count() {
             for &j in self.sides(b).1 {
@@ -577,13 +577,32 @@ impl LocalPattern {
         drop(next);
         self.block_ptr = block_ptr;
         self.blocks_of = blocks_of;
-        let this = &*self;
+    }
+
+    /// The sparsity pattern of M: column j holds every row-side unknown of
+    /// every block with j on its column side. Returns (column pointers, row
+    /// indices), rows sorted within each column.
+    fn matrix_pattern(&self, n: usize) -> (Vec<usize>, Vec<usize>) {
         pattern_by_columns(n, |j, rows| {
-            for &b in this.blocks_of(j) {
-                rows.extend_from_slice(this.sides(b).0);
+            for &b in self.blocks_of(j) {
+                rows.extend_from_slice(self.sides(b).0);
             }
         })
     }
+}
+
+/// The pattern of M = Aᵀ Ω A for the way its values are formed.
+fn matrix_pattern(incidence: &CsMat<i8>, assembly: &Assembly) -> SymbolicSparseColMat<usize> {
+    let n = incidence.cols();
+    let (col_ptr, row_idx) = match assembly {
+        Assembly::Diagonal(columns) => pattern_by_columns(n, |j, out| {
+            for &r in columns.column(j).0 {
+                out.extend_from_slice(&incidence.indices()[incidence.indptr().outer_inds_sz(r)]);
+            }
+        }),
+        Assembly::Blocks(local) => local.matrix_pattern(n),
+    };
+    SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx)
 }
 
 /// The pattern (column pointers, row indices) of an n-column matrix whose
@@ -710,7 +729,7 @@ impl Canonical {
         }
         metric.validate()?;
         let n = incidence.cols();
-        let (assembly, (col_ptr, row_idx)) = match metric.diagonal_weights() {
+        let assembly = match metric.diagonal_weights() {
             Some(weights) => {
                 let columns = match by_columns {
                     Some(by_columns)
@@ -722,27 +741,29 @@ impl Canonical {
                     }
                     _ => Columns::new(&incidence, weights.len()),
                 };
-                let a = &*incidence;
-                let pattern = pattern_by_columns(n, |j, out| {
-                    for &r in columns.column(j).0 {
-                        out.extend_from_slice(&a.indices()[a.indptr().outer_inds_sz(r)]);
-                    }
-                });
-                (Assembly::Diagonal(columns), pattern)
+                Assembly::Diagonal(columns)
             }
             None => {
                 let mut local = LocalPattern::new(&incidence, &metric);
-                let pattern = local.matrix_pattern(n);
-                (Assembly::Blocks(local), pattern)
+                local.index_blocks(n);
+                Assembly::Blocks(local)
             }
         };
-        let symbolic = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let symbolic = matrix_pattern(&incidence, &assembly);
         Ok(Self {
             incidence,
             metric,
-            symbolic,
+            nonzeros: symbolic.row_idx().len(),
+            symbolic: OnceLock::from(symbolic),
             assembly: Box::new(assembly),
         })
+    }
+
+    /// The pattern of M, built again if [`Canonical::assemble_owned`] gave
+    /// it away.
+    fn pattern(&self) -> &SymbolicSparseColMat<usize> {
+        self.symbolic
+            .get_or_init(|| matrix_pattern(&self.incidence, &self.assembly))
     }
 
     /// Number of unknowns (columns of A).
@@ -778,7 +799,7 @@ impl Canonical {
 
     /// Number of stored entries of M.
     pub fn nonzeros(&self) -> usize {
-        self.symbolic.row_idx().len()
+        self.nonzeros
     }
 
     /// M = Aᵀ Ω A (full symmetric storage when Ω is symmetric).
@@ -787,13 +808,43 @@ impl Canonical {
     /// block after block, so the sums (and so the bits) are the same for
     /// any thread count.
     pub fn assemble(&self) -> SparseColMat<usize, f64> {
-        let values = match (&*self.assembly, self.metric.diagonal_weights()) {
+        SparseColMat::new(self.pattern().clone(), self.values())
+    }
+
+    /// [`Canonical::assemble`] for the last (or only) assembly: the matrix
+    /// takes the operator's copy of the pattern instead of a new one (at
+    /// 10⁶ cells, 50–80 MB of fresh memory and its page faults). A later
+    /// `assemble` builds the pattern again.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::canonical::{BlockMetric, Canonical};
+    /// let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let faces = k.cell_count(1);
+    /// let mut op = Canonical::new(k.shared_boundary(2), BlockMetric::diagonal(&vec![1.0; faces])).unwrap();
+    /// let last = op.assemble_owned();
+    /// // A later assembly builds the same pattern again.
+    /// let again = op.assemble();
+    /// assert_eq!(last.symbolic().row_idx(), again.symbolic().row_idx());
+    /// assert_eq!(last.val(), again.val());
+    /// ```
+    pub fn assemble_owned(&mut self) -> SparseColMat<usize, f64> {
+        let values = self.values();
+        let symbolic = match self.symbolic.take() {
+            Some(symbolic) => symbolic,
+            None => matrix_pattern(&self.incidence, &self.assembly),
+        };
+        SparseColMat::new(symbolic, values)
+    }
+
+    /// M's values in the order of its pattern.
+    fn values(&self) -> Vec<f64> {
+        match (&*self.assembly, self.metric.diagonal_weights()) {
             (Assembly::Diagonal(columns), Some(weights)) => self.diagonal_values(columns, weights),
             (Assembly::Blocks(local), _) => self.block_values(local),
             // `set_metric` keeps the block layout, and with it the variant.
             (Assembly::Diagonal(_), None) => unreachable!("a diagonal pattern with a block metric"),
-        };
-        SparseColMat::new(self.symbolic.clone(), values)
+        }
     }
 
     /// Row r of A: its unknowns and signs.
@@ -808,8 +859,8 @@ impl Canonical {
     /// thread count.
     fn diagonal_values(&self, columns: &Columns, weights: &[f64]) -> Vec<f64> {
         let mut values = vec![0.0; self.nonzeros()];
-        let col_ptr = self.symbolic.col_ptr();
-        let row_idx = self.symbolic.row_idx();
+        let pattern = self.pattern();
+        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
         let parts = ranges(self.unknowns());
         let slices = split_at_ranges(&mut values, &parts, |j| col_ptr[j]);
         parts.into_par_iter().zip(slices).for_each(|(range, out)| {
@@ -837,8 +888,8 @@ impl Canonical {
     /// the thread count.
     fn block_values(&self, local: &LocalPattern) -> Vec<f64> {
         let mut values = vec![0.0; self.nonzeros()];
-        let col_ptr = self.symbolic.col_ptr();
-        let row_idx = self.symbolic.row_idx();
+        let pattern = self.pattern();
+        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
         let parts = ranges(self.unknowns());
         let slices = split_at_ranges(&mut values, &parts, |j| col_ptr[j]);
         parts.into_par_iter().zip(slices).for_each_init(
@@ -1176,6 +1227,31 @@ mod tests {
         let m = op.assemble();
         let column = &m.symbolic().row_idx()[m.symbolic().col_ptr()[0]..m.symbolic().col_ptr()[1]];
         assert!(!column.contains(&5));
+    }
+
+    #[test]
+    fn the_last_assembly_takes_the_pattern_and_a_later_one_rebuilds_it() {
+        // Q1 blocks on a 3×2 grid (block path) and two-point weights
+        // (diagonal path): the owned assembly and the assemblies before and
+        // after it, which rebuild the pattern, agree to the last bit.
+        let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+        let q1 = crate::metric::fe::stiffness_metric(&grid, &[1.0; 6]).unwrap();
+        let tpfa = crate::metric::fv::two_point(&grid, &[1.0; 6]).unwrap();
+        for (a, metric) in [
+            (Arc::new(grid.coboundary(0)), q1),
+            (grid.shared_boundary(2), tpfa),
+        ] {
+            let mut op = Canonical::new(a, metric).unwrap();
+            let before = op.assemble();
+            let owned = op.assemble_owned();
+            let after = op.assemble();
+            for m in [&owned, &after] {
+                assert_eq!(m.symbolic().col_ptr(), before.symbolic().col_ptr());
+                assert_eq!(m.symbolic().row_idx(), before.symbolic().row_idx());
+                assert_eq!(m.val(), before.val());
+            }
+            assert_eq!(op.nonzeros(), before.val().len());
+        }
     }
 
     #[test]

@@ -796,7 +796,7 @@ impl Diffusion {
         };
         // The cell-centred methods' A is ∂ₙ itself, which the complex also
         // keeps by columns.
-        let canonical = if ghosts.is_empty() && matches!(self.method, Method::Fv | Method::Fd) {
+        let mut canonical = if ghosts.is_empty() && matches!(self.method, Method::Fv | Method::Fd) {
             Canonical::with_columns(incidence, complex.shared_boundary_csc(n), metric_final)?
         } else {
             Canonical::new(incidence, metric_final)?
@@ -808,7 +808,7 @@ impl Diffusion {
                 *b += l;
             }
         }
-        let matrix = canonical.assemble();
+        let matrix = canonical.assemble_owned();
         let pure_neumann = fixed.iter().all(Option::is_none)
             && ghosts.is_empty()
             && (location != Location::CellCentred

@@ -386,7 +386,7 @@ impl Elasticity {
         let vertices = complex.cell_count(0);
         let lame = self.lame(complex)?;
         let metric = stiffness_metric(complex, &lame)?;
-        let canonical = Canonical::new(incidence(complex), metric)?;
+        let mut canonical = Canonical::new(incidence(complex), metric)?;
 
         let mut rhs = Vec::with_capacity(d * vertices);
         for a in 0..d {
@@ -429,7 +429,7 @@ impl Elasticity {
                 }
             }
         }
-        let matrix = canonical.assemble();
+        let matrix = canonical.assemble_owned();
         Ok(ElasticSystem {
             dim: d,
             canonical,

@@ -152,10 +152,32 @@ pub fn check_tensors<'a>(
         });
     }
     // In parallel; the first bad cell in cell order is the one reported.
-    match (0..cells)
-        .into_par_iter()
-        .find_map_first(|cell| tensor_problem(&tensors.get(cell), cell, d))
-    {
+    let problem = match tensors {
+        // λ·I is positive definite exactly when λ > 0; the error is the
+        // one `tensor_problem` gives for λ·I (its first minor is λ).
+        CellTensors::Scalar(values) => {
+            values
+                .par_iter()
+                .enumerate()
+                .find_map_first(|(cell, &lambda)| {
+                    if !lambda.is_finite() {
+                        Some(MetricError::NonFinite { cell })
+                    } else if lambda <= 0.0 {
+                        Some(MetricError::NotPositive {
+                            cell,
+                            value: lambda,
+                        })
+                    } else {
+                        None
+                    }
+                })
+        }
+        CellTensors::Full(all) => all
+            .par_iter()
+            .enumerate()
+            .find_map_first(|(cell, t)| tensor_problem(t, cell, d)),
+    };
+    match problem {
         Some(problem) => Err(problem),
         None => Ok(()),
     }
@@ -190,4 +212,51 @@ fn tensor_problem(t: &Tensor, cell: usize, d: usize) -> Option<MetricError> {
             cell,
             value: bad * scale,
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scalar_coefficients_are_checked_like_their_isotropic_tensors() {
+        // λ·I is positive definite exactly when λ > 0; the reported value
+        // is λ itself (the first leading minor), and the first bad cell in
+        // cell order is named.
+        let cases: [(&[f64], Option<MetricError>); 5] = [
+            (&[1.0, 2.0, 1e-200], None),
+            (
+                &[1.0, -2.0, 0.0],
+                Some(MetricError::NotPositive {
+                    cell: 1,
+                    value: -2.0,
+                }),
+            ),
+            (
+                &[1.0, 1.0, 0.0],
+                Some(MetricError::NotPositive {
+                    cell: 2,
+                    value: 0.0,
+                }),
+            ),
+            (&[f64::NAN, -1.0], Some(MetricError::NonFinite { cell: 0 })),
+            (
+                &[1.0, f64::INFINITY],
+                Some(MetricError::NonFinite { cell: 1 }),
+            ),
+        ];
+        for (values, expected) in cases {
+            let tensors: Vec<Tensor> = values.iter().map(|&v| isotropic(v)).collect();
+            for d in 1..=3 {
+                let scalar = check_tensors(values, values.len(), d).err();
+                let full = check_tensors(&tensors, values.len(), d).err();
+                assert_eq!(scalar, expected, "{values:?} in R^{d}");
+                assert_eq!(full, expected, "{values:?} in R^{d}");
+            }
+        }
+        assert_eq!(
+            check_tensors(&[1.0, 2.0][..], 3, 2),
+            Err(MetricError::CoefficientCount { count: 2, cells: 3 })
+        );
+    }
 }
