@@ -268,6 +268,21 @@ impl Complex {
         self.boundary(p + 1).transpose_view().to_csr()
     }
 
+    /// [`Complex::coboundary`], built on first use and then shared (no
+    /// copy), for operators that keep δ^p as their A and for repeated
+    /// readers of it (the nodal metrics, loads and operator of one solve).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    /// let delta = k.shared_coboundary(0);
+    /// assert_eq!(*delta, k.coboundary(0));
+    /// assert!(std::sync::Arc::ptr_eq(&delta, &k.shared_coboundary(0)));
+    /// ```
+    pub fn shared_coboundary(&self, p: usize) -> Arc<CsMat<i8>> {
+        Arc::clone(self.geometry.coboundaries[p].get_or_init(|| Arc::new(self.coboundary(p))))
+    }
+
     /// Orientation of each top cell relative to the frame of its sorted
     /// vertex list (+1 same, −1 reversed). In R^n every top cell ends up
     /// positively oriented; on embedded manifolds the orientation is

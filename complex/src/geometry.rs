@@ -45,6 +45,9 @@ pub(crate) struct GeometryCache {
     /// ∂_p in CSC storage (index p ≥ 1): the facets of each p-cell.
     /// Shared, so that operators built on ∂_p by columns use it in place.
     pub(crate) facets: [OnceLock<Arc<CsMat<i8>>>; LEVELS],
+    /// δ^p = ∂_{p+1}ᵀ in CSR storage (index p), shared with the operators
+    /// that use it as their A.
+    pub(crate) coboundaries: [OnceLock<Arc<CsMat<i8>>>; LEVELS],
     /// Measures and centroids of the p-cells.
     cells: [OnceLock<CellGeometry>; LEVELS],
     /// Unit normals of the (n−1)-cells.

@@ -477,59 +477,71 @@ pub(crate) fn ranges(count: usize) -> Vec<std::ops::Range<usize>> {
 }
 
 impl LocalPattern {
-    /// The local unknown sets of every block, in block order.
+    /// The local unknown sets of every block, in block order. Each
+    /// block's sets are counted first and then written straight into the
+    /// one list (in parallel both times): fresh pages cost a fault each, and
+    /// a second copy of the lists would cost as much as forming them.
     fn new(incidence: &CsMat<i8>, metric: &BlockMetric) -> Self {
-        let row = |r: usize| &incidence.indices()[incidence.indptr().outer_inds_sz(r)];
-        type Chunk = (Vec<usize>, Vec<bool>, Vec<usize>, Vec<usize>);
-        let chunks: Vec<Chunk> = ranges(metric.block_count())
-            .into_par_iter()
-            .map(|range| {
-                let (first, last) = (range.start, range.end);
-                let mut rows = Vec::with_capacity(last - first);
-                let mut shared = Vec::with_capacity(last - first);
-                let mut lengths = Vec::with_capacity(last - first);
-                let mut unknowns = Vec::new();
-                for b in first..last {
+        let count = metric.block_count();
+        // The distinct unknowns of the rows `list` of A, sorted, into `out`.
+        let side = |list: &[usize], out: &mut Vec<usize>| {
+            out.clear();
+            for &x in list {
+                out.extend_from_slice(&incidence.indices()[incidence.indptr().outer_inds_sz(x)]);
+            }
+            out.sort_unstable();
+            out.dedup();
+        };
+        let mut rows = vec![0usize; count];
+        let mut shared = vec![false; count];
+        let mut ptr = vec![0usize; count + 1];
+        rows.par_iter_mut()
+            .zip(shared.par_iter_mut())
+            .zip(ptr[1..].par_iter_mut())
+            .enumerate()
+            .for_each_init(Vec::new, |scratch, (b, ((row_count, same), total))| {
+                let (r, s, _) = metric.block(b);
+                side(r, scratch);
+                *row_count = scratch.len();
+                *same = r == s;
+                *total = if *same {
+                    *row_count
+                } else {
+                    side(s, scratch);
+                    *row_count + scratch.len()
+                };
+            });
+        for b in 0..count {
+            ptr[b + 1] += ptr[b];
+        }
+        let mut unknowns = vec![0usize; ptr[count]];
+        let parts = ranges(count);
+        let pieces = split_at_ranges(&mut unknowns, &parts, |b| ptr[b]);
+        parts
+            .par_iter()
+            .zip(pieces)
+            .for_each_init(Vec::new, |scratch, (range, out)| {
+                let base = ptr[range.start];
+                for b in range.clone() {
                     let (r, s, _) = metric.block(b);
-                    let start = unknowns.len();
-                    let same = r == s;
-                    let sides: &[&[usize]] = if same { &[r] } else { &[r, s] };
-                    for (k, side) in sides.iter().enumerate() {
-                        let begin = unknowns.len();
-                        for &x in *side {
-                            unknowns.extend_from_slice(row(x));
-                        }
-                        unknowns[begin..].sort_unstable();
-                        let distinct = dedup_tail(&mut unknowns, begin);
-                        if k == 0 {
-                            rows.push(distinct);
-                        }
+                    let start = ptr[b] - base;
+                    side(r, scratch);
+                    out[start..start + scratch.len()].copy_from_slice(scratch);
+                    if !shared[b] {
+                        let middle = start + rows[b];
+                        side(s, scratch);
+                        out[middle..middle + scratch.len()].copy_from_slice(scratch);
                     }
-                    shared.push(same);
-                    lengths.push(unknowns.len() - start);
                 }
-                (rows, shared, lengths, unknowns)
-            })
-            .collect();
-        let mut pattern = Self {
-            ptr: Vec::with_capacity(metric.block_count() + 1),
-            rows: Vec::with_capacity(metric.block_count()),
-            shared: Vec::with_capacity(metric.block_count()),
-            unknowns: Vec::with_capacity(chunks.iter().map(|c| c.3.len()).sum()),
+            });
+        Self {
+            ptr,
+            rows,
+            shared,
+            unknowns,
             block_ptr: Vec::new(),
             blocks_of: Vec::new(),
-        };
-        pattern.ptr.push(0);
-        for (rows, shared, lengths, unknowns) in chunks {
-            pattern.rows.extend_from_slice(&rows);
-            pattern.shared.extend_from_slice(&shared);
-            for l in lengths {
-                let end = pattern.ptr[pattern.ptr.len() - 1] + l;
-                pattern.ptr.push(end);
-            }
-            pattern.unknowns.extend_from_slice(&unknowns);
         }
-        pattern
     }
 
     fn block_count(&self) -> usize {
@@ -669,20 +681,6 @@ pub(crate) fn split_at_ranges<'a, T>(
         rest = tail;
     }
     pieces
-}
-
-/// Remove repeated values from the sorted `v[begin..]`; returns how many
-/// distinct values remain there.
-fn dedup_tail(v: &mut Vec<usize>, begin: usize) -> usize {
-    let mut write = begin;
-    for read in begin..v.len() {
-        if write == begin || v[read] != v[write - 1] {
-            v[write] = v[read];
-            write += 1;
-        }
-    }
-    v.truncate(write);
-    write - begin
 }
 
 impl Canonical {

@@ -697,12 +697,12 @@ impl Diffusion {
 
         let (incidence, metric, unknowns) = match self.method {
             Method::Fe => (
-                Arc::new(complex.coboundary(0)),
+                complex.shared_coboundary(0),
                 fe::stiffness_metric(complex, tensors)?,
                 complex.cell_count(0),
             ),
             Method::Dec(kind) => (
-                Arc::new(complex.coboundary(0)),
+                complex.shared_coboundary(0),
                 dec::hodge_metric(complex, kind, tensors)?,
                 complex.cell_count(0),
             ),

@@ -521,7 +521,7 @@ fn dimension(complex: &Complex) -> Result<usize, ElasticityError> {
 /// ```
 pub fn incidence(complex: &Complex) -> CsMat<i8> {
     let d = complex.embedding_dim();
-    let delta = complex.coboundary(0);
+    let delta = complex.shared_coboundary(0);
     let (edges, vertices) = delta.shape();
     let mut tri = TriMat::with_capacity((d * edges, d * vertices), d * delta.nnz());
     for a in 0..d {

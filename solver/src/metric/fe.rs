@@ -367,7 +367,7 @@ pub(crate) struct Topology<'a> {
     /// Embedding dimension.
     pub(crate) d: usize,
     /// δ⁰ (rows: edges), to read each edge's tail (−1) and head (+1).
-    delta0: CsMat<i8>,
+    delta0: std::sync::Arc<CsMat<i8>>,
     /// ∂_p in CSC storage for p = 2..=n, at index p − 2.
     facets: Vec<&'a CsMat<i8>>,
 }
@@ -386,7 +386,7 @@ impl<'a> Topology<'a> {
             complex,
             n,
             d: complex.embedding_dim(),
-            delta0: complex.coboundary(0),
+            delta0: complex.shared_coboundary(0),
             facets: (2..=n).map(|p| complex.boundary_csc(p)).collect(),
         })
     }
