@@ -126,17 +126,20 @@ impl std::fmt::Display for Ordering {
 /// |---|---|---|---|---|---|
 /// | 2D 100² | 10⁴ | 0.011 | 0.033 | 21 | 20 |
 /// | 2D 300² | 9·10⁴ | 0.14–0.17 | 0.45 | 42 | 33 |
-/// | 2D 1000² | 10⁶ | 2.4–2.8 | 6.8 | 55 | 42 |
+/// | 2D 1000² | 10⁶ | 2.4–2.8 | 6.8–7.4 | 55 | 42 |
 /// | Delaunay P1 | 5·10⁵ | 1.7–2.4 | 3.4–4.3 | 68 | 47 |
 /// | 3D 20³ | 8·10³ | 0.04 | 0.06–0.07 | 143 | 91 |
 /// | 3D 40³ | 6.4·10⁴ | 0.87–1.38 | 0.86–0.96 | 414 | 281 |
-/// | 3D 60³ | 2.2·10⁵ | 10.9–18.0 | 5.6–9.2 | 912 | 498 |
+/// | 3D 60³ | 2.2·10⁵ | 10.9–18.8 | 5.5–9.2 | 912 | 498 |
 ///
-/// In 2D the factorisation is cheap and METIS's own time (4 s of the 6.8 s
-/// at 1000²) outweighs the smaller factor, so size alone would be the wrong
-/// rule; AMD's fill per unknown separates the 2D-like graphs (≤ 68) from
-/// the 3D ones that gain (≥ 414), and the threshold sits between 143 (3D
-/// 20³, where ND's analysis costs more than it saves) and 414.
+/// (The spread is other work on the machine; the entries are exact.) The
+/// automatic rule adds AMD's analysis (0.7 s at 60³) to nested
+/// dissection's. In 2D the factorisation is cheap and METIS's own time
+/// (4 s of the 6.8 s at 1000²) outweighs the smaller factor, so size alone
+/// would be the wrong rule; AMD's fill per unknown separates the 2D-like
+/// graphs (≤ 68) from the 3D ones that gain (≥ 414), and the threshold
+/// sits between 143 (3D 20³, where ND's analysis costs more than it
+/// saves) and 414.
 pub const ND_MIN_FILL_PER_UNKNOWN: usize = 300;
 
 /// Why a solve failed.
