@@ -12,9 +12,12 @@
 //! - `mg-pc`: the same with the piecewise-constant cell prolongation and
 //!   the coarse correction doubled (sparser coarse levels, cheaper setup).
 //! - `direct`: complex, assembly, faer LLᵀ through hasse (analysis,
-//!   factorisation, solve).
+//!   factorisation, solve) with the automatic fill-reducing ordering.
 //! - `plain`: the same 5/7-point matrix built by hand as triplets and
-//!   factorised with faer LLᵀ, without hasse.
+//!   factorised with faer's own LLᵀ (AMD ordering), without hasse.
+//! - `amd`, `nd`: the hand-built matrix factorised through hasse's
+//!   `DirectSolver` with the AMD or the nested-dissection (METIS) ordering:
+//!   analysis, factorisation, solve, factor entries and peak memory.
 //! - `export`: the assembled matrix and right-hand side in Matrix Market
 //!   format, for `scripts/pyamg_baseline.py` (pyamg smoothed aggregation).
 //!
@@ -29,6 +32,8 @@
 //! - `direct`: complex, FE assembly, LLᵀ through `solve_with_fixed`.
 //! - `plain`: the P1 cotangent matrix on the interior vertices built from
 //!   coordinates and vertex triples alone, factorised by faer's own LLᵀ.
+//! - `amd`, `nd`: that matrix through `DirectSolver` with AMD or nested
+//!   dissection, as for the structured cases.
 //! - `export`: the system on the interior vertices for pyamg.
 //! - `check`: hasse's FE and DEC matrices, load and solution against the
 //!   plain ones, entry by entry (it panics when they disagree).
@@ -58,7 +63,7 @@ use hasse_solver::diffusion::{
     Preconditioning,
 };
 use hasse_solver::iterative::CgOptions;
-use hasse_solver::linear::{relative_residual, DirectSolver, Factorization};
+use hasse_solver::linear::{relative_residual, DirectSolver, Factorization, Ordering};
 use hasse_solver::multigrid::{CellProlongation, Hierarchy, MultigridOptions};
 use std::io::Write;
 use std::sync::Arc;
@@ -134,6 +139,7 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 &system.rhs,
                 &system.fixed,
                 Factorization::Llt,
+                Ordering::Automatic,
                 Some(&settings),
             )
             .expect("MG-CG");
@@ -154,8 +160,11 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             let x = factor.solve(&system.rhs).expect("solve");
             let solve_s = seconds(t);
             format!(
-                "unknowns={} complex={complex_s:.3} assembly={assembly_s:.3} factor={factor_s:.3} solve={solve_s:.3} residual={:.2e}",
+                "unknowns={} ordering={} complex={complex_s:.3} assembly={assembly_s:.3} analysis={:.3} factor={factor_s:.3} solve={solve_s:.3} entries={} residual={:.2e}",
                 system.rhs.len(),
+                short_name(solver.ordering()),
+                solver.symbolic_seconds,
+                solver.factor_entries().unwrap_or(0),
                 relative_residual(system.matrix.as_ref(), &x, &system.rhs)
             )
         }
@@ -163,23 +172,18 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             let t = Instant::now();
             let matrix = plain_matrix(n, d);
             let build_s = seconds(t);
-            let rhs = vec![n.pow(d as u32) as f64; matrix.nrows()]
-                .iter()
-                .map(|v| 1.0 / v)
-                .collect::<Vec<_>>();
-            let t = Instant::now();
-            let solver =
-                DirectSolver::analyse(matrix.as_ref(), Factorization::Llt).expect("analysis");
-            let factor = solver.factorize(matrix.as_ref()).expect("SPD");
-            let factor_s = seconds(t);
-            let t = Instant::now();
-            let x = factor.solve(&rhs).expect("solve");
-            let solve_s = seconds(t);
+            let rhs = plain_rhs(&matrix, n, d);
+            let (x, factor_s, solve_s) = plain_faer_llt(&matrix, &rhs);
             format!(
                 "unknowns={} assembly={build_s:.3} factor={factor_s:.3} solve={solve_s:.3} residual={:.2e}",
                 rhs.len(),
                 relative_residual(matrix.as_ref(), &x, &rhs)
             )
+        }
+        "amd" | "nd" => {
+            let matrix = plain_matrix(n, d);
+            let rhs = plain_rhs(&matrix, n, d);
+            ordered_llt(&matrix, &rhs, phase)
         }
         "export" => {
             let (system, _, _) = build(d, n);
@@ -188,12 +192,57 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             write_vector_market(&format!("{path}.rhs.mtx"), &system.rhs).expect("write rhs");
             format!("file={path}.mtx")
         }
-        other => panic!("unknown phase {other}: mg, direct, plain or export"),
+        other => panic!("unknown phase {other}: mg, mg-pc, direct, plain, amd, nd or export"),
     };
     format!(
         "RESULT {case} {phase} {fields} total={:.3} peak_gib={:.3}",
         seconds(started),
         peak_memory_gib()
+    )
+}
+
+/// b = h^d: the load of f = 1 on a cell.
+fn plain_rhs(matrix: &SparseColMat<usize, f64>, n: usize, d: usize) -> Vec<f64> {
+    vec![1.0 / n.pow(d as u32) as f64; matrix.nrows()]
+}
+
+fn short_name(ordering: Option<Ordering>) -> &'static str {
+    match ordering {
+        Some(Ordering::NestedDissection) => "nd",
+        Some(Ordering::Amd) => "amd",
+        _ => "other",
+    }
+}
+
+/// LLᵀ of `matrix` through `DirectSolver` with the ordering of phase `amd`
+/// or `nd`; the peak memory is the analysis, factorisation and solve's own
+/// (the matrix build before it is forgotten).
+fn ordered_llt(matrix: &SparseColMat<usize, f64>, rhs: &[f64], phase: &str) -> String {
+    let ordering = match phase {
+        "nd" => Ordering::NestedDissection,
+        _ => Ordering::Amd,
+    };
+    let reset = reset_peak_memory();
+    let t = Instant::now();
+    let solver = DirectSolver::analyse_with(matrix.as_ref(), Factorization::Llt, ordering)
+        .expect("analysis");
+    let analysis_s = seconds(t);
+    let t = Instant::now();
+    let factor = solver.factorize(matrix.as_ref()).expect("SPD");
+    let numeric_s = seconds(t);
+    let t = Instant::now();
+    let x = factor.solve(rhs).expect("solve");
+    let solve_s = seconds(t);
+    let residual = relative_residual(matrix.as_ref(), &x, rhs);
+    assert!(residual <= 1e-10, "{phase}: relative residual {residual:e}");
+    format!(
+        "unknowns={} nnz={} ordering={} analysis={analysis_s:.3} numeric={numeric_s:.3} factor={:.3} solve={solve_s:.3} entries={} residual={residual:.2e} solve_peak_gib={:.3}",
+        rhs.len(),
+        matrix.compute_nnz(),
+        short_name(solver.ordering()),
+        analysis_s + numeric_s,
+        solver.factor_entries().unwrap_or(0),
+        if reset { peak_memory_gib() } else { f64::NAN },
     )
 }
 
@@ -244,8 +293,11 @@ fn main() {
     let env = |k: &str| std::env::var(k).is_ok_and(|v| v == "1");
     let mut cases: Vec<(&str, Vec<&str>)> = if benching {
         vec![
-            ("2d-1000", vec!["mg", "mg-pc", "direct", "plain"]),
-            ("3d-60", vec!["mg", "mg-pc", "direct", "plain"]),
+            (
+                "2d-1000",
+                vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"],
+            ),
+            ("3d-60", vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]),
             (
                 "3d-100",
                 if env("HASSE_BENCH_DIRECT_100") {
@@ -256,21 +308,24 @@ fn main() {
             ),
             (
                 "delaunay-1m",
-                vec!["check", "amg", "dec", "direct", "plain"],
+                vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"],
             ),
         ]
     } else {
         vec![
-            ("2d-64", vec!["mg", "mg-pc", "direct", "plain"]),
-            ("3d-16", vec!["mg", "mg-pc", "direct", "plain"]),
+            ("2d-64", vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]),
+            ("3d-16", vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]),
             (
                 "delaunay-20k",
-                vec!["check", "amg", "dec", "direct", "plain"],
+                vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"],
             ),
         ]
     };
     if benching && env("HASSE_BENCH_LARGE") {
-        cases.push(("2d-2000", vec!["mg", "mg-pc", "direct", "plain"]));
+        cases.push((
+            "2d-2000",
+            vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"],
+        ));
     }
     // HASSE_BENCH_CASES="delaunay-1m 3d-60" runs only these cases, with
     // the listed phases, or all phases of their kind for other sizes.
@@ -285,9 +340,9 @@ fn main() {
                     .cloned()
                     .unwrap_or_else(|| {
                         let phases = if parse_delaunay(name).is_some() {
-                            vec!["check", "amg", "dec", "direct", "plain"]
+                            vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"]
                         } else {
-                            vec!["mg", "mg-pc", "direct", "plain"]
+                            vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]
                         };
                         (name, phases)
                     })
@@ -565,6 +620,20 @@ fn vector_difference(a: &[f64], b: &[f64]) -> f64 {
 
 fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {
     let started = Instant::now();
+    if phase == "amd" || phase == "nd" {
+        let (points, triangles) = {
+            let (points, complex, _) = delaunay_complex(side);
+            (points, triangles_of(&complex))
+        };
+        let (matrix, rhs, _) = plain_p1(&points, &triangles);
+        drop((points, triangles));
+        let fields = ordered_llt(&matrix, &rhs, phase);
+        return format!(
+            "RESULT {case} {phase} {fields} total={:.3} peak_gib={:.3}",
+            seconds(started),
+            peak_memory_gib()
+        );
+    }
     if phase == "plain" {
         // The triangles come from hasse's complex (spade is not a
         // dependency the benches can reach); everything after this block
@@ -622,6 +691,7 @@ fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {
                 &rhs,
                 &fixed,
                 Factorization::Llt,
+                Ordering::Automatic,
                 iterative.as_ref(),
             )
             .expect("solve");
@@ -645,7 +715,9 @@ fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {
                     // `call` adds the elimination of the Dirichlet rows and
                     // the residual check to analysis, factorisation and solve.
                     format!(
-                        "{common} factor={:.3} solve={:.3} call={call_s:.3} residual={:.2e} {peaks}",
+                        "{common} ordering={} analysis={:.3} factor={:.3} solve={:.3} call={call_s:.3} residual={:.2e} {peaks}",
+                        short_name(report.ordering),
+                        report.symbolic_seconds,
                         report.symbolic_seconds + report.numeric_seconds,
                         report.solve_seconds,
                         report.relative_residual
@@ -682,9 +754,15 @@ fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {
             let fe_diff = matrix_difference(&fe_matrix, &plain);
             let dec_diff = matrix_difference(&dec_matrix, &plain);
             let rhs_diff = vector_difference(&plain_rhs, &fe_rhs);
-            let (x_hasse, _, _) =
-                solve_with_fixed(&fe.matrix, &fe.rhs, &fe.fixed, Factorization::Llt, None)
-                    .expect("LLᵀ");
+            let (x_hasse, _, _) = solve_with_fixed(
+                &fe.matrix,
+                &fe.rhs,
+                &fe.fixed,
+                Factorization::Llt,
+                Ordering::Automatic,
+                None,
+            )
+            .expect("LLᵀ");
             let (x_plain, _, _) = plain_faer_llt(&plain, &plain_rhs);
             let x_hasse: Vec<f64> = free.iter().map(|&i| x_hasse[i]).collect();
             let x_diff = vector_difference(&x_plain, &x_hasse);
@@ -700,7 +778,7 @@ fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {
             );
             fields
         }
-        other => panic!("unknown phase {other}: amg, dec, direct, plain, export or check"),
+        other => panic!("unknown phase {other}: amg, dec, direct, plain, amd, nd, export or check"),
     };
     let build_peak = fields
         .split_whitespace()

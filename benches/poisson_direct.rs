@@ -4,7 +4,9 @@
 //! For each grid it prints: complex build, metric (Ω) construction,
 //! assembly of Aᵀ Ω A, symbolic + numeric factorisation and solve through
 //! hasse; then the same five/seven-point matrix assembled directly as
-//! triplets and factorised with faer's LLᵀ. Ratios are hasse / plain.
+//! triplets and factorised the same way (LLᵀ through `DirectSolver` with
+//! the automatic ordering, which each line names; `benches/multigrid.rs`
+//! compares the orderings). Ratios are hasse / plain.
 //!
 //! `cargo bench --bench poisson_direct` runs the headline sizes (2D
 //! 1000×1000, 3D 60³; several GB of memory and minutes of time);
@@ -22,7 +24,7 @@ use std::time::Instant;
 mod measure;
 use measure::{peak_memory_gib, plain_matrix, seconds};
 
-fn factor_and_solve(matrix: &SparseColMat<usize, f64>) -> (f64, f64, f64, Vec<f64>) {
+fn factor_and_solve(matrix: &SparseColMat<usize, f64>) -> (f64, f64, f64, String) {
     let rhs = vec![1.0; matrix.nrows()];
     let t = Instant::now();
     let solver = DirectSolver::analyse(matrix.as_ref(), Factorization::Llt).expect("analysis");
@@ -31,8 +33,9 @@ fn factor_and_solve(matrix: &SparseColMat<usize, f64>) -> (f64, f64, f64, Vec<f6
     let factor = solver.factorize(matrix.as_ref()).expect("SPD");
     let numeric = seconds(t);
     let t = Instant::now();
-    let x = factor.solve(&rhs).expect("solve");
-    (symbolic, numeric, seconds(t), x)
+    factor.solve(&rhs).expect("solve");
+    let ordering = solver.ordering().map_or("COLAMD".into(), |o| o.to_string());
+    (symbolic, numeric, seconds(t), ordering)
 }
 
 fn run(label: &str, complex: &Complex, n: usize, method: &str) {
@@ -70,21 +73,21 @@ fn run(label: &str, complex: &Complex, n: usize, method: &str) {
     } else {
         matrix
     };
-    let (symbolic, numeric, solve, _) = factor_and_solve(&matrix);
+    let (symbolic, numeric, solve, ordering) = factor_and_solve(&matrix);
     let assembly = metric_time + pattern_time + values_time;
     let hasse_total = assembly + symbolic + numeric + solve;
     println!(
-        "{label:<22} {method:<3} unknowns {:>9}  Ω {metric_time:>7.3}s  pattern {pattern_time:>7.3}s  values {values_time:>7.3}s  symbolic {symbolic:>7.3}s  numeric {numeric:>7.3}s  solve {solve:>7.3}s",
+        "{label:<22} {method:<3} unknowns {:>9}  Ω {metric_time:>7.3}s  pattern {pattern_time:>7.3}s  values {values_time:>7.3}s  symbolic {symbolic:>7.3}s  numeric {numeric:>7.3}s  solve {solve:>7.3}s  ({ordering})",
         matrix.nrows()
     );
     if method == "fv" {
         let t = Instant::now();
         let plain = plain_matrix(n, d);
         let plain_build = seconds(t);
-        let (ps, pn, pv, _) = factor_and_solve(&plain);
+        let (ps, pn, pv, plain_ordering) = factor_and_solve(&plain);
         let plain_total = plain_build + ps + pn + pv;
         println!(
-            "{label:<22} plain faer: build {plain_build:.3}s  symbolic {ps:.3}s  numeric {pn:.3}s  solve {pv:.3}s | assembly/factorisation {:.3} | hasse total / plain total {:.3}",
+            "{label:<22} plain: build {plain_build:.3}s  symbolic {ps:.3}s  numeric {pn:.3}s  solve {pv:.3}s ({plain_ordering}) | assembly/factorisation {:.3} | hasse total / plain total {:.3}",
             assembly / (symbolic + numeric),
             hasse_total / plain_total
         );

@@ -1,9 +1,9 @@
 """Turn the `RESULT case phase key=value ...` lines of benches/multigrid.rs
 and scripts/pyamg_baseline.py (stdin) into one table: hasse next to its
 baseline, with the ratio hasse / baseline (below 1: hasse is faster or
-smaller). Structured cases (phases mg, mg-pc, direct, plain) and Delaunay
-cases (phases amg, dec, direct, plain, check) get their own rows; a failed
-phase shows as — in its rows."""
+smaller). Structured cases (phases mg, mg-pc, direct, plain, amd, nd) and
+Delaunay cases (phases amg, dec, direct, plain, amd, nd, check) get their own
+rows; a failed phase shows as — in its rows."""
 import sys
 from collections import defaultdict
 
@@ -44,6 +44,28 @@ def add(*parts):
     return None if any(p is None for p in parts) else sum(parts)
 
 
+ORDERING = {"nd": "nested dissection", "amd": "AMD"}
+
+
+def ordering_rows(label, r):
+    """LLᵀ of the hand-built matrix through hasse with nested dissection
+    (phase nd) next to faer's own LLᵀ (plain, AMD) and hasse with AMD (amd),
+    all in the same run."""
+    nd, amd, plain = (r.get(p, {}) for p in ("nd", "amd", "plain"))
+    if not nd and not amd:
+        return []
+    mega = lambda d: None if num(d, "entries") is None else num(d, "entries") / 1e6
+    return [
+        (label, "LLᵀ analysis+factorisation, nested dissection", fmt(num(nd, "factor")), "plain faer LLᵀ (AMD)", fmt(num(plain, "factor")), ratio(num(nd, "factor"), num(plain, "factor"))),
+        (label, "  same, nested dissection", fmt(num(nd, "factor")), "hasse LLᵀ, AMD", fmt(num(amd, "factor")), ratio(num(nd, "factor"), num(amd, "factor"))),
+        (label, "  analysis alone (METIS + symbolic)", fmt(num(nd, "analysis")), "AMD + symbolic", fmt(num(amd, "analysis")), ratio(num(nd, "analysis"), num(amd, "analysis"))),
+        (label, "  numeric factorisation alone", fmt(num(nd, "numeric")), "AMD", fmt(num(amd, "numeric")), ratio(num(nd, "numeric"), num(amd, "numeric"))),
+        (label, "  solve", fmt(num(nd, "solve")), "AMD", fmt(num(amd, "solve")), ratio(num(nd, "solve"), num(amd, "solve"))),
+        (label, "  factor entries", fmt(mega(nd), "M"), "AMD", fmt(mega(amd), "M"), ratio(mega(nd), mega(amd))),
+        (label, "  peak memory, analysis+factorisation+solve", fmt(num(nd, "solve_peak_gib"), "GiB"), "AMD", fmt(num(amd, "solve_peak_gib"), "GiB"), ratio(num(nd, "solve_peak_gib"), num(amd, "solve_peak_gib"))),
+    ]
+
+
 def delaunay_rows(label, r):
     """Nodal P1 on a Delaunay mesh (phases amg, dec, direct, plain, check and
     pyamg): the FE assembly, DEC assembly and LLᵀ next to the hand-built
@@ -59,7 +81,8 @@ def delaunay_rows(label, r):
     if check:
         agreement = f"FE {check.get('fe_vs_plain', '?')}, DEC {check.get('dec_vs_plain', '?')}, u {check.get('solution_vs_plain', '?')}"
         out.append((label, "  max rel. difference to the plain system", agreement, f"plain P1, nnz {check.get('nnz', '?')}", "—", "—"))
-    out.append((label, "LLᵀ analysis+factorisation (FE)", fmt(num(direct, "factor")), "faer LLᵀ, plain matrix", fmt(num(plain, "factor")), ratio(num(direct, "factor"), num(plain, "factor"))))
+    used = ORDERING.get(direct.get("ordering"), "?")
+    out.append((label, f"LLᵀ analysis+factorisation (FE, {used})", fmt(num(direct, "factor")), "faer LLᵀ, plain matrix", fmt(num(plain, "factor")), ratio(num(direct, "factor"), num(plain, "factor"))))
     out.append((label, f"LLᵀ solve (r={direct.get('residual', '?')})", fmt(num(direct, "solve")), f"faer LLᵀ (r={plain.get('residual', '?')})", fmt(num(plain, "solve")), ratio(num(direct, "solve"), num(plain, "solve"))))
     amg_total = add(num(amg, "setup"), num(amg, "solve"))
     for name, run in (("FE", fe), ("DEC", dec)):
@@ -79,7 +102,7 @@ def delaunay_rows(label, r):
     hasse_direct = add(num(direct, "assembly"), num(direct, "factor"), num(direct, "solve"))
     plain_total = add(num(plain, "assembly"), num(plain, "factor"), num(plain, "solve"))
     out.append((label, "FE assembly + LLᵀ + solve", fmt(hasse_direct), "plain build+LLᵀ+solve", fmt(plain_total), ratio(hasse_direct, plain_total)))
-    return out
+    return out + ordering_rows(label, r)
 
 
 rows = []
@@ -91,11 +114,12 @@ for case in runs:
         rows += delaunay_rows(f"{case} ({n})", r)
         continue
     mg, direct, plain, amg = (r.get(p, {}) for p in ("mg", "direct", "plain", "pyamg"))
-    n = mg.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or "?"
+    n = mg.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or r.get("nd", {}).get("unknowns") or "?"
     label = f"{case} ({n})"
     assembly = num(mg, "assembly") or num(direct, "assembly")
     rows.append((label, "assembly (Ω, AᵀΩA, b)", fmt(assembly), "plain triplets", fmt(num(plain, "assembly")), ratio(assembly, num(plain, "assembly"))))
-    rows.append((label, "LLᵀ analysis+factorisation", fmt(num(direct, "factor")), "plain faer LLᵀ", fmt(num(plain, "factor")), ratio(num(direct, "factor"), num(plain, "factor"))))
+    used = ORDERING.get(direct.get("ordering"), "?")
+    rows.append((label, f"LLᵀ analysis+factorisation ({used})", fmt(num(direct, "factor")), "plain faer LLᵀ (AMD)", fmt(num(plain, "factor")), ratio(num(direct, "factor"), num(plain, "factor"))))
     rows.append((label, "LLᵀ solve", fmt(num(direct, "solve")), "plain faer LLᵀ", fmt(num(plain, "solve")), ratio(num(direct, "solve"), num(plain, "solve"))))
     mg_setup, mg_solve = num(mg, "setup"), num(mg, "solve")
     mg_total = None if mg_setup is None else mg_setup + mg_solve
@@ -112,6 +136,7 @@ for case in runs:
     rows.append((label, "assembly + MG-CG", fmt(None if mg_total is None else assembly + mg_total), "plain faer build+LLᵀ+solve", fmt(plain_total), ratio(None if mg_total is None else assembly + mg_total, plain_total)))
     rows.append((label, "peak memory, MG run", fmt(num(mg, "peak_gib"), "GiB"), "pyamg process", fmt(num(amg, "peak_gib"), "GiB"), ratio(num(mg, "peak_gib"), num(amg, "peak_gib"))))
     rows.append((label, "peak memory, direct run", fmt(num(direct, "peak_gib"), "GiB"), "plain faer process", fmt(num(plain, "peak_gib"), "GiB"), ratio(num(direct, "peak_gib"), num(plain, "peak_gib"))))
+    rows += ordering_rows(label, r)
 
 head = ("case (unknowns)", "hasse", "", "baseline", "", "hasse/baseline")
 widths = [max(len(str(r[i])) for r in rows + [head]) for i in range(6)]

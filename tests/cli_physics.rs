@@ -530,6 +530,44 @@ fn multigrid_solver_types_match_the_direct_solution() {
     );
 }
 
+/// `solver.ordering` reaches the direct solve: the summary line names the
+/// ordering, and the nested-dissection and AMD solutions of the same
+/// system agree (both are backward-stable Cholesky factorisations of one
+/// SPD matrix, so the printed 7-digit errors coincide).
+#[test]
+fn the_solve_line_names_the_ordering() {
+    let line = |out: &str| {
+        out.lines()
+            .find(|l| l.starts_with("unknowns"))
+            .unwrap_or_else(|| panic!("no unknowns line in\n{out}"))
+            .to_string()
+    };
+    // 1089 unknowns: the automatic rule keeps AMD.
+    let auto = run("cases/poisson-square.toml", &[]);
+    assert!(
+        line(&auto).contains("solver sparse LLᵀ (faer), AMD ordering"),
+        "{auto}"
+    );
+    let nd = run(
+        "cases/poisson-square.toml",
+        &["solver.ordering=\"nested-dissection\"".into()],
+    );
+    assert!(
+        line(&nd).contains("solver sparse LLᵀ (faer), nested dissection (METIS) ordering"),
+        "{nd}"
+    );
+    assert_eq!(reported(&nd, "error", "L2"), reported(&auto, "error", "L2"));
+    // The transient solver analyses once per run and says which ordering.
+    let heat = run(
+        "cases/heat-square.toml",
+        &["solver.ordering=\"nested-dissection\"".into()],
+    );
+    assert!(
+        line(&heat).contains("nested dissection (METIS) ordering"),
+        "{heat}"
+    );
+}
+
 // ---------------------------------------------------------------- bad input
 
 /// Write `text` as a case, run it, expect exit code `code` and every
@@ -704,6 +742,30 @@ fn bad_problem_kind_input_names_the_key() {
         "[mesh]\ngenerator = \"rectangle\"\nn = [8, 8]\n[problem]\nmethod = \"fv\"\n[solver]\nprolongation = \"constant\"\n",
         2,
         &["`solver.prolongation`", "solver.type = \"multigrid\""],
+    );
+    refused(
+        "ordering-name",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [8, 8]\n[problem]\nmethod = \"fv\"\n[solver]\nordering = \"metis\"\n",
+        2,
+        &["ordering-name.toml:7:12: `solver.ordering`", "unknown ordering \"metis\"", "\"nested-dissection\""],
+    );
+    refused(
+        "ordering-multigrid",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [8, 8]\n[problem]\nmethod = \"fv\"\n[solver]\ntype = \"amg\"\nordering = \"amd\"\n",
+        2,
+        &["`solver.ordering`", "factorises nothing"],
+    );
+    refused(
+        "ordering-lu",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [8, 8]\n[problem]\nmethod = \"fv\"\n[solver]\nfactorization = \"lu\"\nordering = \"nested-dissection\"\n",
+        2,
+        &["`solver.ordering`", "COLAMD"],
+    );
+    refused(
+        "ordering-darcy",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"darcy\"\n[solver]\nordering = \"amd\"\n",
+        2,
+        &["`solver.ordering`", "kind = \"darcy\""],
     );
     refused(
         "multigrid-heat",

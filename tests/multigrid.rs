@@ -17,7 +17,7 @@ use hasse_solver::diffusion::{
     Preconditioning,
 };
 use hasse_solver::iterative::{CgError, CgOptions, Preconditioner, RowMatrix};
-use hasse_solver::linear::Factorization;
+use hasse_solver::linear::{Factorization, Ordering};
 use hasse_solver::multigrid::{Hierarchy, Multigrid, MultigridError, MultigridOptions};
 use std::sync::Arc;
 
@@ -274,6 +274,7 @@ fn bits_do_not_depend_on_the_thread_count() {
                     &system.rhs,
                     &system.fixed,
                     Factorization::Llt,
+                    Ordering::Automatic,
                     Some(&settings),
                 )
                 .unwrap()

@@ -528,6 +528,8 @@ impl DarcySystem {
         }
         let report = SolveReport {
             factorization: Factorization::Ldlt,
+            // The constrained ordering above, not one of linear::Ordering.
+            ordering: None,
             unknowns: size,
             nonzeros: a.compute_nnz(),
             symbolic_seconds,

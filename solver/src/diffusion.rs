@@ -24,7 +24,7 @@
 
 use crate::canonical::{BlockMetric, Canonical, CanonicalError};
 use crate::iterative::{conjugate_gradient, CgError, CgOptions, CgReport, RowMatrix};
-use crate::linear::{self, Factorization, SolveError, SolveReport};
+use crate::linear::{self, Factorization, Ordering, SolveError, SolveReport};
 use crate::metric::{self, dec, fd, fe, fv, CellTensors, MetricError, Tensor};
 use crate::multigrid::{
     self, CellProlongation, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
@@ -155,6 +155,9 @@ pub struct Diffusion {
     pub boundary: Vec<BoundaryCondition>,
     /// Direct factorisation (default: LLᵀ, the systems are SPD).
     pub factorization: Factorization,
+    /// Fill-reducing ordering of the direct factorisation (default:
+    /// automatic).
+    pub ordering: Ordering,
     /// Where the cell values of [`Method::Fv`] live (default: centroids).
     pub cell_points: CellPoints,
     /// Largest relative imbalance Σ b / Σ |b| accepted for pure-Neumann data
@@ -527,6 +530,7 @@ impl Diffusion {
             source,
             boundary: Vec::new(),
             factorization: Factorization::Llt,
+            ordering: Ordering::Automatic,
             cell_points: CellPoints::Centroids,
             neumann_tolerance: 1e-2,
             iterative: None,
@@ -1063,6 +1067,7 @@ impl Diffusion {
             &rhs,
             &fixed,
             self.factorization,
+            self.ordering,
             self.iterative.as_ref(),
         )?;
         if pure_neumann {
@@ -1297,13 +1302,15 @@ pub fn lumped_vertex_volumes(complex: &Complex) -> Vec<f64> {
 /// Solve M u = b with the unknowns in `fixed` held at their values: the
 /// fixed columns move to the right-hand side and the fixed rows are
 /// dropped, so the reduced system stays symmetric (positive definite when
-/// M is). Directly by `factorization`, or by conjugate gradients when
-/// `iterative` is given (its initial guess restricted to the free unknowns).
+/// M is). Directly by `factorization` with the fill-reducing `ordering`, or
+/// by conjugate gradients when `iterative` is given (its initial guess
+/// restricted to the free unknowns).
 pub fn solve_with_fixed(
     matrix: &SparseColMat<usize, f64>,
     rhs: &[f64],
     fixed: &[Option<f64>],
     factorization: Factorization,
+    ordering: Ordering,
     iterative: Option<&Iterative>,
 ) -> Result<(Vec<f64>, SolveReport, Option<CgReport>), DiffusionError> {
     let n = rhs.len();
@@ -1352,6 +1359,7 @@ pub fn solve_with_fixed(
     if free.is_empty() {
         let report = SolveReport {
             factorization,
+            ordering: None,
             unknowns: 0,
             nonzeros: 0,
             symbolic_seconds: 0.0,
@@ -1372,7 +1380,7 @@ pub fn solve_with_fixed(
     };
     let (x, report, iterations) = match iterative {
         None => {
-            let (x, report) = linear::solve(&reduced, &reduced_rhs, factorization)?;
+            let (x, report) = linear::solve_with(&reduced, &reduced_rhs, factorization, ordering)?;
             (x, report, None)
         }
         Some(settings) => {
@@ -1406,6 +1414,7 @@ pub fn solve_with_fixed(
             };
             let report = SolveReport {
                 factorization,
+                ordering: None,
                 unknowns: free.len(),
                 nonzeros,
                 symbolic_seconds: 0.0,

@@ -35,7 +35,7 @@
 
 use crate::canonical::{BlockMetric, Canonical, CanonicalError};
 use crate::diffusion::{self, lumped_vertex_volumes, DiffusionError, ScalarFn, VectorFn};
-use crate::linear::{Factorization, SolveError, SolveReport};
+use crate::linear::{Factorization, Ordering, SolveError, SolveReport};
 use crate::metric::fe::{self, Topology};
 use crate::metric::MetricError;
 use faer::sparse::SparseColMat;
@@ -149,6 +149,8 @@ pub struct Elasticity {
     pub plane: PlaneModel,
     /// Direct factorisation (default LLᵀ: the reduced system is SPD).
     pub factorization: Factorization,
+    /// Its fill-reducing ordering (default automatic).
+    pub ordering: Ordering,
 }
 
 /// Why an elasticity problem could not be solved.
@@ -293,6 +295,7 @@ impl Elasticity {
             boundary: Vec::new(),
             plane: PlaneModel::Strain,
             factorization: Factorization::Llt,
+            ordering: Ordering::Automatic,
         }
     }
 
@@ -449,6 +452,7 @@ impl Elasticity {
             &system.rhs,
             &system.fixed,
             self.factorization,
+            self.ordering,
             None,
         )
         .map_err(|e| match e {

@@ -20,6 +20,7 @@ pub mod maxwell;
 pub mod mesh_spec;
 pub mod metric;
 pub mod multigrid;
+pub mod ordering;
 pub mod output;
 pub mod refinement;
 pub mod run;

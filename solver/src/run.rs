@@ -30,7 +30,7 @@ use crate::diffusion::{
     self, BoundaryKind, Conductivity, Diffusion, DiffusionError, Errors, Location, ScalarFn,
     TensorFn, VectorFn,
 };
-use crate::linear::Factorization;
+use crate::linear::{Factorization, Ordering};
 use crate::metric::Tensor;
 use hasse_complex::Complex;
 use std::fmt;
@@ -66,6 +66,9 @@ pub struct RunResult {
     pub flux_error: Option<f64>,
     pub relative_residual: Option<f64>,
     pub factorization: Option<Factorization>,
+    /// The fill-reducing ordering of that factorisation, when it is one of
+    /// [`Ordering`]'s (not for LU or a solver's own ordering).
+    pub ordering: Option<Ordering>,
     /// Phase name and seconds.
     pub timings: Vec<(String, f64)>,
     /// Messages worth a user's attention (large residual, pure Neumann…).
@@ -172,6 +175,7 @@ pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion 
     if let Some(f) = case.solver.factorization {
         problem.factorization = f;
     }
+    problem.ordering = case.solver.ordering;
     if spec.circumcentres {
         problem.cell_points = diffusion::CellPoints::Circumcentres;
     }
@@ -411,6 +415,7 @@ fn solve_diffusion(
             .iterations
             .is_none()
             .then_some(report.factorization),
+        ordering: report.ordering,
         timings,
         warnings,
         pure_neumann: solution.pure_neumann,
@@ -620,6 +625,7 @@ fn gradient(
         flux_error: None,
         relative_residual: None,
         factorization: None,
+        ordering: None,
         timings: vec![("sample + Ω δ".into(), seconds)],
         warnings: Vec::new(),
         pure_neumann: false,
@@ -639,6 +645,9 @@ impl fmt::Display for RunResult {
             write!(f, "unknowns   {}", self.unknowns)?;
             if let Some(fact) = self.factorization {
                 write!(f, ", solver {fact}")?;
+                if let Some(ordering) = self.ordering {
+                    write!(f, ", {ordering} ordering")?;
+                }
             }
             if let Some(r) = self.relative_residual {
                 write!(f, ", relative residual {r:.2e}")?;
@@ -695,6 +704,7 @@ impl RunResult {
             "cells_per_dimension": complex.cell_counts(),
             "unknowns": self.unknowns,
             "factorization": self.factorization.map(|f| f.to_string()),
+            "ordering": self.ordering.map(|o| o.to_string()),
             "relative_residual": self.relative_residual,
             "errors": errors,
             "flux_error": self.flux_error,

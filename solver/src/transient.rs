@@ -20,7 +20,7 @@ use crate::diffusion::{
     lumped_vertex_volumes, BoundaryKind, Conductivity, Diffusion, DiffusionError, Location, Method,
     ScalarFn,
 };
-use crate::linear::{DirectSolver, Factorization, SolveError};
+use crate::linear::{DirectSolver, Factorization, Ordering, SolveError};
 use crate::output::{Cochain, Step};
 use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::Complex;
@@ -123,6 +123,8 @@ pub struct Heat {
     pub start: f64,
     /// Factorisation of M/Δt + θK (default LLᵀ: it is SPD).
     pub factorization: Factorization,
+    /// Its fill-reducing ordering (default automatic).
+    pub ordering: Ordering,
 }
 
 /// The computed time levels and how long they took.
@@ -137,6 +139,9 @@ pub struct History {
     pub fields: Vec<Vec<f64>>,
     /// Symbolic analysis plus numeric factorisation of M/Δt + θK, seconds.
     pub factorization_seconds: f64,
+    /// The fill-reducing ordering the factorisation used (`None` for LU or
+    /// when every unknown is fixed).
+    pub ordering: Option<Ordering>,
     /// Mean seconds per step (right-hand side, data and solve; not the time
     /// spent in the observer of [`Heat::run_observed`]).
     pub seconds_per_step: f64,
@@ -187,6 +192,7 @@ impl Heat {
             dt,
             start: 0.0,
             factorization: Factorization::Llt,
+            ordering: Ordering::Automatic,
         }
     }
 
@@ -212,6 +218,7 @@ impl Heat {
     pub fn at(&self, t: f64) -> Diffusion {
         let mut problem = Diffusion::new(self.method, self.conductivity.clone(), self.source.at(t));
         problem.factorization = self.factorization;
+        problem.ordering = self.ordering;
         for (tag, kind) in &self.boundary {
             let kind = match kind {
                 HeatBoundary::Dirichlet(g) => BoundaryKind::Dirichlet(g.at(t)),
@@ -390,11 +397,13 @@ impl Heat {
         let started = Instant::now();
         let reduced = SparseColMat::try_new_from_triplets(free.len(), free.len(), &triplets)
             .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
-        let factor = if free.is_empty() {
-            None
+        // Analysed once: every step reuses this factor.
+        let (factor, ordering) = if free.is_empty() {
+            (None, None)
         } else {
-            let solver = DirectSolver::analyse(reduced.as_ref(), self.factorization)?;
-            Some(solver.factorize(reduced.as_ref())?)
+            let solver =
+                DirectSolver::analyse_with(reduced.as_ref(), self.factorization, self.ordering)?;
+            (Some(solver.factorize(reduced.as_ref())?), solver.ordering())
         };
         let factorization_seconds = started.elapsed().as_secs_f64();
 
@@ -514,6 +523,7 @@ impl Heat {
             times,
             fields,
             factorization_seconds,
+            ordering,
             seconds_per_step,
             solve_seconds_per_step: per_step(solve_seconds),
             steps,

@@ -39,7 +39,7 @@ mod reader;
 pub use diagnostic::{Diagnostic, Diagnostics};
 
 use crate::diffusion::Method;
-use crate::linear::Factorization;
+use crate::linear::{Factorization, Ordering};
 use crate::mesh_spec::{MeshError, MeshSpec};
 use crate::multigrid::CellProlongation;
 use diagnostic::Collector;
@@ -347,6 +347,9 @@ pub struct SolverSpec {
     pub residual_limit: f64,
     /// How a grid hierarchy prolongs cell-centred unknowns.
     pub cell_prolongation: CellProlongation,
+    /// Fill-reducing ordering of the direct factorisation
+    /// (`solver.ordering`).
+    pub ordering: Ordering,
 }
 
 impl Default for SolverSpec {
@@ -358,6 +361,7 @@ impl Default for SolverSpec {
             residual_warning: 1e-10,
             residual_limit: 1e-6,
             cell_prolongation: CellProlongation::Smoothed,
+            ordering: Ordering::Automatic,
         }
     }
 }

@@ -9,7 +9,7 @@ use super::{
     GradientSpec, OutputSpec, Problem, SolverKind, SolverSpec,
 };
 use crate::diffusion::Method;
-use crate::linear::Factorization;
+use crate::linear::{Factorization, Ordering};
 use crate::mesh_spec::MeshSpec;
 use crate::multigrid::CellProlongation;
 use crate::refinement::{RefineSpec, Strategy};
@@ -104,6 +104,7 @@ const SOLVER_KEYS: &[&str] = &[
     "residual_warning",
     "residual_limit",
     "prolongation",
+    "ordering",
 ];
 const OUTPUT_KEYS: &[&str] = &["directory", "name", "write"];
 const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "tolerance"];
@@ -1251,6 +1252,48 @@ impl Reader {
                     "solver.prolongation",
                     "applies only to the grid levels of solver.type = \"multigrid\" (or \"auto\")",
                     Some("set solver.type = \"multigrid\" or remove solver.prolongation".into()),
+                );
+            }
+        }
+        if let Some(name) = self.string_at(table, "solver", "ordering") {
+            let span = self
+                .entry(table, "solver", "ordering")
+                .and_then(|e| e.span());
+            match name.as_str() {
+                "auto" => spec.ordering = Ordering::Automatic,
+                "amd" => spec.ordering = Ordering::Amd,
+                "nested-dissection" => spec.ordering = Ordering::NestedDissection,
+                other => self.error(
+                    span.clone(),
+                    "solver.ordering",
+                    format!("unknown ordering \"{other}\""),
+                    Some("use \"auto\" (the default), \"amd\" (approximate minimum degree) or \"nested-dissection\" (METIS)".into()),
+                ),
+            }
+            let kind = problem_kind(root);
+            if !matches!(kind, "diffusion" | "heat" | "elasticity") {
+                self.error(
+                    span,
+                    "solver.ordering",
+                    format!("applies to the direct solves of diffusion, heat and elasticity cases; kind = \"{kind}\" orders its systems itself"),
+                    Some("remove solver.ordering".into()),
+                );
+            } else if matches!(spec.kind, SolverKind::Multigrid | SolverKind::Amg) {
+                self.error(
+                    span,
+                    "solver.ordering",
+                    "orders a direct factorisation; multigrid-preconditioned CG factorises nothing",
+                    Some(
+                        "set solver.type = \"direct\" (or \"auto\") or remove solver.ordering"
+                            .into(),
+                    ),
+                );
+            } else if spec.factorization == Some(Factorization::Lu) {
+                self.error(
+                    span,
+                    "solver.ordering",
+                    "LU orders its columns by COLAMD; the ordering applies to llt, ldlt and lblt",
+                    Some("remove solver.ordering or choose another solver.factorization".into()),
                 );
             }
         }

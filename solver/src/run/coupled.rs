@@ -103,6 +103,7 @@ pub(super) fn solve(
         flux_error: None,
         relative_residual: None,
         factorization: Some(problem.factorization),
+        ordering: None,
         timings: vec![("assembly + solve".to_string(), total)],
         warnings: Vec::new(),
         pure_neumann: false,

@@ -263,6 +263,7 @@ pub(super) fn solve(
         flux_error,
         relative_residual: Some(solution.report.relative_residual),
         factorization: Some(solution.report.factorization),
+        ordering: solution.report.ordering,
         timings,
         warnings,
         pure_neumann: false,

@@ -47,6 +47,7 @@ fn problem(case: &Case, spec: &ElasticitySpec) -> Elasticity {
     if let Some(f) = case.solver.factorization {
         problem.factorization = f;
     }
+    problem.ordering = case.solver.ordering;
     problem
 }
 
@@ -137,6 +138,7 @@ pub(super) fn solve(
         flux_error: None,
         relative_residual: Some(u.report.relative_residual),
         factorization: Some(u.report.factorization),
+        ordering: u.report.ordering,
         timings,
         warnings,
         pure_neumann: false,

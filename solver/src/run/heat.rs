@@ -41,6 +41,7 @@ fn heat_problem(case: &Case, spec: &HeatSpec) -> Heat {
     if let Some(f) = case.solver.factorization {
         heat.factorization = f;
     }
+    heat.ordering = case.solver.ordering;
     heat
 }
 
@@ -256,6 +257,7 @@ pub(super) fn solve_streaming<'a>(
         flux_error: None,
         relative_residual: None,
         factorization: Some(heat.factorization),
+        ordering: history.ordering,
         timings,
         warnings: Vec::new(),
         pure_neumann: false,

@@ -138,6 +138,7 @@ pub(super) fn solve(
         flux_error: None,
         relative_residual: Some(worst_residual),
         factorization: Some(crate::linear::Factorization::Llt),
+        ordering: None,
         timings: vec![
             ("assembly".to_string(), assembly_seconds),
             ("eigensolve".to_string(), solve_seconds),
