@@ -198,9 +198,26 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
             }
         }
         for (j, (&s, &m)) in sum.iter().zip(coarse.measure(p)).enumerate() {
+            // Measures are sums of simplices over vectors of the cell's
+            // size δ (its bounding-box diagonal), each rounded to about
+            // ε·δ^p: a sliver (area ≪ δ²) carries that absolute error, so
+            // the bound is relative to max(|c|, δ^p), not to |c| alone.
+            let vertices = coarse.cell_vertices(p, j);
+            let d = coarse.embedding_dim();
+            let diagonal = (0..d)
+                .map(|a| {
+                    let (lo, hi) = vertices.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &v| {
+                        let x = coarse.vertices().point(v)[a];
+                        (lo.min(x), hi.max(x))
+                    });
+                    (hi - lo) * (hi - lo)
+                })
+                .sum::<f64>()
+                .sqrt();
+            let scale = m.max(diagonal.powi(p as i32));
             assert!(
-                (s - m).abs() <= 1e-12 * m,
-                "p = {p}, cell {j}: pieces {s} vs {m}"
+                (s - m).abs() <= 1e-12 * scale,
+                "p = {p}, cell {j}: pieces {s} vs {m} (size {diagonal})"
             );
         }
         // ζ maps every coarse cell to at least one piece.
