@@ -16,8 +16,7 @@ use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::{generate, Complex};
 use hasse_solver::canonical::Canonical;
 use hasse_solver::linear::{DirectSolver, Factorization};
-use hasse_solver::metric::{fe, fv, isotropic};
-use std::sync::Arc;
+use hasse_solver::metric::{fe, fv};
 use std::time::Instant;
 
 #[path = "common/measure.rs"]
@@ -42,23 +41,24 @@ fn run(label: &str, complex: &Complex, n: usize, method: &str) {
     let d = complex.dim();
     let t = Instant::now();
     let cells = complex.cell_count(d);
-    let tensors = vec![isotropic(1.0); cells];
+    // A scalar conductivity, as `Diffusion` keeps it.
+    let tensors = vec![1.0; cells];
     let (incidence, metric) = match method {
         "fv" => (
             complex.shared_boundary(d),
             fv::two_point(complex, &tensors).expect("metric"),
         ),
         _ => (
-            Arc::new(complex.coboundary(0)),
+            complex.shared_coboundary(0),
             fe::stiffness_metric(complex, &tensors).expect("metric"),
         ),
     };
     let metric_time = seconds(t);
     let t = Instant::now();
-    let canonical = Canonical::new(incidence, metric).expect("canonical");
+    let mut canonical = Canonical::new(incidence, metric).expect("canonical");
     let pattern_time = seconds(t);
     let t = Instant::now();
-    let matrix = canonical.assemble();
+    let matrix = canonical.assemble_owned();
     let values_time = seconds(t);
     // Nodal FE keeps every vertex (no Dirichlet elimination here); pin one
     // vertex through a tiny diagonal shift so LLᵀ applies to both methods.
