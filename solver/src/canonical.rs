@@ -62,17 +62,29 @@ struct Block {
 /// omega.push_block(&[1], &[1], &[5.0]);
 /// assert_eq!(omega.apply(&[1.0, 1.0, 1.0]), vec![1.0, 5.0, 1.0]);
 /// ```
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default)]
 pub struct BlockMetric {
     size: usize,
     /// Empty while Ω is diagonal in row order, block b being the 1×1
     /// block (b, b) (two-point fluxes, diagonal Hodge stars): then
-    /// `indices` is 0..k and `values` the k weights, 16 bytes a row instead
-    /// of 64 with a block record. The first block that breaks the pattern
-    /// writes the records of the earlier ones.
+    /// `indices` is empty too and `values` holds the k weights, 8 bytes a
+    /// row instead of 64 with a block record. The first block that breaks
+    /// the pattern writes the records of the earlier ones.
     blocks: Vec<Block>,
     indices: Vec<usize>,
     values: Vec<f64>,
+    /// 0..k, built only if a diagonal metric is read block by block
+    /// ([`BlockMetric::block`] returns index slices); cleared by pushes.
+    identity: OnceLock<Vec<usize>>,
+}
+
+impl PartialEq for BlockMetric {
+    fn eq(&self, other: &Self) -> bool {
+        self.size == other.size
+            && self.blocks == other.blocks
+            && self.indices == other.indices
+            && self.values == other.values
+    }
 }
 
 impl BlockMetric {
@@ -94,8 +106,9 @@ impl BlockMetric {
         Self {
             size: weights.len(),
             blocks: Vec::new(),
-            indices: (0..weights.len()).collect(),
+            indices: Vec::new(),
             values: weights,
+            identity: OnceLock::new(),
         }
     }
 
@@ -159,6 +172,7 @@ impl BlockMetric {
             blocks,
             indices,
             values,
+            identity: OnceLock::new(),
         }
     }
 
@@ -168,11 +182,13 @@ impl BlockMetric {
             let next = self.values.len();
             if let ([r], [c], [v]) = (rows, cols, values) {
                 if *r == next && *c == next {
-                    self.indices.push(next);
                     self.values.push(*v);
+                    self.identity = OnceLock::new();
                     return;
                 }
             }
+            self.indices = (0..next).collect();
+            self.identity = OnceLock::new();
             // Rows and columns of a diagonal block share its one index.
             self.blocks = (0..next)
                 .map(|b| Block {
@@ -227,7 +243,10 @@ impl BlockMetric {
     /// Rows, columns and values of block `b`.
     pub fn block(&self, b: usize) -> (&[usize], &[usize], &[f64]) {
         if self.blocks.is_empty() {
-            let index = &self.indices[b..b + 1];
+            let identity = self
+                .identity
+                .get_or_init(|| (0..self.values.len()).collect());
+            let index = &identity[b..b + 1];
             return (index, index, &self.values[b..b + 1]);
         }
         let block = &self.blocks[b];
@@ -340,7 +359,11 @@ impl BlockMetric {
     }
 
     fn same_pattern(&self, other: &Self) -> bool {
-        self.size == other.size && self.blocks == other.blocks && self.indices == other.indices
+        self.size == other.size
+            && self.blocks == other.blocks
+            && self.indices == other.indices
+            // Diagonal layouts keep no indices: their lengths say it.
+            && self.values.len() == other.values.len()
     }
 }
 
