@@ -260,7 +260,7 @@ impl Complex {
     }
 
     fn facets_by_cell(&self, p: usize) -> &Arc<CsMat<i8>> {
-        self.geometry.facets[p].get_or_init(|| Arc::new(to_csc(self.boundary(p))))
+        self.geometry.facets[p].get_or_init(|| Arc::new(self.boundary(p).to_csc()))
     }
 
     /// The coboundary δ^p = ∂_{p+1}ᵀ (|K_{p+1}| × |K_p|, CSR), 0 ≤ p < n.
@@ -754,77 +754,6 @@ fn check_coherence(top: &CsMat<i8>, fills: bool) -> Result<()> {
     Ok(())
 }
 
-/// The CSR matrix `m` in CSC storage: a counting-sort transpose whose
-/// writes are split by column ranges over the threads, each scanning every
-/// row in order (so rows stay increasing within a column). sprs's
-/// `to_csc` is one serial pass; at 10⁶ cells this is the one transpose
-/// every cell-centred solve and the primal geometry wait for.
-fn to_csc(m: &CsMat<i8>) -> CsMat<i8> {
-    if !m.is_csr() {
-        return m.to_csc();
-    }
-    let (rows, cols) = m.shape();
-    let row_entries = |i: usize| {
-        let range = m.indptr().outer_inds_sz(i);
-        m.indices()[range.clone()].iter().zip(&m.data()[range])
-    };
-    let mut ptr = vec![0usize; cols + 1];
-    for i in 0..rows {
-        for (&j, _) in row_entries(i) {
-            ptr[j + 1] += 1;
-        }
-    }
-    for j in 0..cols {
-        ptr[j + 1] += ptr[j];
-    }
-    let nnz = ptr[cols];
-    // Column ranges of about equal entry counts, one per thread.
-    let threads = rayon::current_num_threads().clamp(1, cols.max(1));
-    let mut bounds = vec![0usize];
-    for t in 1..threads {
-        let target = nnz * t / threads;
-        let j = ptr.partition_point(|&p| p < target).min(cols);
-        if j > bounds[bounds.len() - 1] {
-            bounds.push(j);
-        }
-    }
-    bounds.push(cols);
-    let mut row_of = vec![0usize; nnz];
-    let mut value = vec![0i8; nnz];
-    let mut row_pieces = Vec::new();
-    let mut value_pieces = Vec::new();
-    let (mut row_rest, mut value_rest) = (&mut row_of[..], &mut value[..]);
-    for w in bounds.windows(2) {
-        let len = ptr[w[1]] - ptr[w[0]];
-        let (r, rr) = row_rest.split_at_mut(len);
-        let (v, vr) = value_rest.split_at_mut(len);
-        row_pieces.push(r);
-        value_pieces.push(v);
-        row_rest = rr;
-        value_rest = vr;
-    }
-    bounds
-        .par_windows(2)
-        .zip(row_pieces)
-        .zip(value_pieces)
-        .for_each(|((w, row_out), value_out)| {
-            let (first, last) = (w[0], w[1]);
-            let base = ptr[first];
-            let mut next: Vec<usize> = ptr[first..last].iter().map(|&p| p - base).collect();
-            for i in 0..rows {
-                for (&j, &v) in row_entries(i) {
-                    if (first..last).contains(&j) {
-                        let k = &mut next[j - first];
-                        row_out[*k] = i;
-                        value_out[*k] = v;
-                        *k += 1;
-                    }
-                }
-            }
-        });
-    CsMat::try_new_csc((rows, cols), ptr, row_of, value).unwrap_or_else(|_| m.to_csc())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -832,34 +761,6 @@ mod tests {
     fn dense(m: &CsMat<i8>) -> Vec<Vec<i8>> {
         let d = m.to_dense();
         d.rows().into_iter().map(|r| r.to_vec()).collect()
-    }
-
-    #[test]
-    fn boundaries_by_columns_are_the_transpose_exactly() {
-        // The parallel counting-sort transpose against sprs's serial one:
-        // same pointers, rows and signs, on every ∂_p of 2D and 3D grids
-        // and a Kuhn triangulation (cells with 2, 3, 4 and 6 facets).
-        let axis = crate::generate::uniform_axis(5, 0.0, 1.0).unwrap();
-        let complexes = [
-            crate::generate::rectangle(7, 3, [0.0, 1.0], [0.0, 1.0]).unwrap(),
-            crate::generate::box3(4, 3, 2, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap(),
-            crate::generate::kuhn(&[axis.clone(), axis.clone(), axis]).unwrap(),
-        ];
-        for k in &complexes {
-            for p in 1..=k.dim() {
-                let ours = k.boundary_csc(p);
-                let theirs = k.boundary(p).to_csc();
-                assert!(ours.is_csc());
-                assert_eq!(ours.shape(), theirs.shape());
-                assert_eq!(
-                    ours.indptr().raw_storage(),
-                    theirs.indptr().raw_storage(),
-                    "p = {p}"
-                );
-                assert_eq!(ours.indices(), theirs.indices(), "p = {p}");
-                assert_eq!(ours.data(), theirs.data(), "p = {p}");
-            }
-        }
     }
 
     #[test]
