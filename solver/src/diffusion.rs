@@ -843,7 +843,7 @@ impl Diffusion {
         let n = complex.dim();
         let d = complex.embedding_dim();
         let cells = complex.cell_count(n);
-        let mut rhs = vec![0.0; unknowns];
+        let mut rhs = crate::canonical::zeroed(unknowns);
         match self.method {
             Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x))?,
             Method::Dec(kind) => rhs = dec::load(complex, kind, &|x| (self.source)(x))?,
@@ -1289,7 +1289,7 @@ fn apply_at_unknown(
 pub fn lumped_vertex_volumes(complex: &Complex) -> Vec<f64> {
     let n = complex.dim();
     let volume = complex.measure(n);
-    let mut w = vec![0.0; complex.cell_count(0)];
+    let mut w = crate::canonical::zeroed(complex.cell_count(0));
     for (c, &vol) in volume.iter().enumerate() {
         let verts = complex.cell_vertices(n, c);
         for &v in verts {

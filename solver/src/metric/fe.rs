@@ -145,7 +145,7 @@ pub fn load(
         .into_par_iter()
         .map(|c| cell_load(&top, c, f))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut out = vec![0.0; complex.cell_count(0)];
+    let mut out = crate::canonical::zeroed(complex.cell_count(0));
     for part in parts {
         for (v, x) in part {
             out[v] += x;
