@@ -514,63 +514,53 @@ pub(crate) fn ranges(count: usize) -> Vec<std::ops::Range<usize>> {
 }
 
 impl LocalPattern {
-    /// The local unknown sets of every block, in block order. Each
-    /// block's sets are counted first and then written straight into the
-    /// one list (in parallel both times): fresh pages cost a fault each, and
-    /// a second copy of the lists would cost as much as forming them.
+    /// The local unknown sets of every block, in block order, written
+    /// straight into one list by [`compressed_lists`].
     fn new(incidence: &CsMat<i8>, metric: &BlockMetric) -> Self {
-        let count = metric.block_count();
-        // The distinct unknowns of the rows `list` of A, sorted, into `out`.
+        // Append the distinct unknowns of the rows `list` of A, sorted.
         let side = |list: &[usize], out: &mut Vec<usize>| {
-            out.clear();
+            let begin = out.len();
             for &x in list {
                 out.extend_from_slice(&incidence.indices()[incidence.indptr().outer_inds_sz(x)]);
             }
-            out.sort_unstable();
-            out.dedup();
-        };
-        let mut rows = vec![0usize; count];
-        let mut shared = vec![false; count];
-        let mut ptr = vec![0usize; count + 1];
-        rows.par_iter_mut()
-            .zip(shared.par_iter_mut())
-            .zip(ptr[1..].par_iter_mut())
-            .enumerate()
-            .for_each_init(Vec::new, |scratch, (b, ((row_count, same), total))| {
-                let (r, s, _) = metric.block(b);
-                side(r, scratch);
-                *row_count = scratch.len();
-                *same = r == s;
-                *total = if *same {
-                    *row_count
-                } else {
-                    side(s, scratch);
-                    *row_count + scratch.len()
-                };
-            });
-        for b in 0..count {
-            ptr[b + 1] += ptr[b];
-        }
-        let mut unknowns = vec![0usize; ptr[count]];
-        let parts = ranges(count);
-        let pieces = split_at_ranges(&mut unknowns, &parts, |b| ptr[b]);
-        parts
-            .par_iter()
-            .zip(pieces)
-            .for_each_init(Vec::new, |scratch, (range, out)| {
-                let base = ptr[range.start];
-                for b in range.clone() {
-                    let (r, s, _) = metric.block(b);
-                    let start = ptr[b] - base;
-                    side(r, scratch);
-                    out[start..start + scratch.len()].copy_from_slice(scratch);
-                    if !shared[b] {
-                        let middle = start + rows[b];
-                        side(s, scratch);
-                        out[middle..middle + scratch.len()].copy_from_slice(scratch);
-                    }
+            out[begin..].sort_unstable();
+            let mut end = begin;
+            for k in begin..out.len() {
+                if end == begin || out[k] != out[end - 1] {
+                    out[end] = out[k];
+                    end += 1;
                 }
-            });
+            }
+            out.truncate(end);
+        };
+        let shared: Vec<bool> = (0..metric.block_count())
+            .into_par_iter()
+            .map(|b| {
+                let (r, s, _) = metric.block(b);
+                r == s
+            })
+            .collect();
+        let (ptr, unknowns) = compressed_lists(metric.block_count(), |b, out| {
+            let (r, s, _) = metric.block(b);
+            side(r, out);
+            if !shared[b] {
+                side(s, out);
+            }
+        });
+        // The row side's length: the whole list when shared, else counted
+        // again (unsymmetric blocks are the rare case).
+        let rows = (0..metric.block_count())
+            .into_par_iter()
+            .map_init(Vec::new, |scratch, b| {
+                if shared[b] {
+                    ptr[b + 1] - ptr[b]
+                } else {
+                    scratch.clear();
+                    side(metric.block(b).0, scratch);
+                    scratch.len()
+                }
+            })
+            .collect();
         Self {
             ptr,
             rows,
@@ -658,48 +648,59 @@ fn matrix_pattern(incidence: &CsMat<i8>, assembly: &Assembly) -> SymbolicSparseC
 /// column j holds the rows `candidates(j, out)` appends to `out` (repeats
 /// allowed), sorted within each column. A column's candidates are few (a
 /// vertex's cells times their vertices), so sorting them in a small
-/// scratch vector beats an n-sized marker per task. The columns are
-/// counted first and then written straight into the one row array: fresh
-/// pages cost a fault each on this kind of machine, and a second copy of
-/// the pattern would cost as much as the sorting.
+/// scratch vector beats an n-sized marker per task.
 fn pattern_by_columns(
     n: usize,
     candidates: impl Fn(usize, &mut Vec<usize>) + Sync,
 ) -> (Vec<usize>, Vec<usize>) {
-    let distinct = |j: usize, scratch: &mut Vec<usize>| {
+    compressed_lists(n, |j, out| {
+        candidates(j, out);
+        out.sort_unstable();
+        out.dedup();
+    })
+}
+
+/// n lists in one array (pointers, items): list j is what `fill(j, out)`
+/// leaves in the cleared `out`. Every list is formed twice, once to count
+/// it and once to write it straight into place, in parallel both times:
+/// fresh pages cost a fault each on this kind of machine, and a second
+/// copy of the lists would cost as much as forming them again.
+fn compressed_lists(
+    n: usize,
+    fill: impl Fn(usize, &mut Vec<usize>) + Sync,
+) -> (Vec<usize>, Vec<usize>) {
+    let list = |j: usize, scratch: &mut Vec<usize>| {
         scratch.clear();
-        candidates(j, scratch);
-        scratch.sort_unstable();
-        scratch.dedup();
+        fill(j, scratch);
     };
     let parts = ranges(n);
-    let mut col_ptr = vec![0usize; n + 1];
-    let counts = split_at_ranges(&mut col_ptr[1..], &parts, |j| j);
+    let mut ptr = vec![0usize; n + 1];
+    let counts = split_at_ranges(&mut ptr[1..], &parts, |j| j);
     parts
         .par_iter()
         .zip(counts)
         .for_each_init(Vec::new, |scratch, (range, counts)| {
             for (j, count) in range.clone().zip(counts) {
-                distinct(j, scratch);
+                list(j, scratch);
                 *count = scratch.len();
             }
         });
     for j in 0..n {
-        col_ptr[j + 1] += col_ptr[j];
+        ptr[j + 1] += ptr[j];
     }
-    let mut row_idx = vec![0usize; col_ptr[n]];
-    let columns = split_at_ranges(&mut row_idx, &parts, |j| col_ptr[j]);
+    let mut items = vec![0usize; ptr[n]];
+    let pieces = split_at_ranges(&mut items, &parts, |j| ptr[j]);
     parts
         .par_iter()
-        .zip(columns)
+        .zip(pieces)
         .for_each_init(Vec::new, |scratch, (range, out)| {
-            let base = col_ptr[range.start];
+            let base = ptr[range.start];
             for j in range.clone() {
-                distinct(j, scratch);
-                out[col_ptr[j] - base..col_ptr[j + 1] - base].copy_from_slice(scratch);
+                list(j, scratch);
+                out[ptr[j] - base..ptr[j + 1] - base].copy_from_slice(scratch);
             }
         });
-    (col_ptr, row_idx)
+    (ptr, items)
 }
 
 /// `data` cut at `offset(range.start)` of each of the consecutive `parts`
@@ -740,8 +741,6 @@ impl Canonical {
         by_columns: Arc<CsMat<i8>>,
         metric: BlockMetric,
     ) -> Result<Self, CanonicalError> {
-        debug_assert!(by_columns.is_csc());
-        debug_assert_eq!(by_columns.shape(), incidence.shape());
         debug_assert_eq!(by_columns.nnz(), incidence.nnz());
         Self::build(incidence, Some(by_columns), metric)
     }
