@@ -636,7 +636,7 @@ impl Diffusion {
 
     /// The conductivity at every cell centroid: scalars stay scalars (8
     /// bytes a cell instead of a 72-byte tensor).
-    fn tensors(&self, complex: &Complex) -> Result<CellConductivity, DiffusionError> {
+    fn cell_conductivity(&self, complex: &Complex) -> Result<CellConductivity, DiffusionError> {
         let n = complex.dim();
         let d = complex.embedding_dim();
         let centroids = complex.centroid(n);
@@ -691,7 +691,7 @@ impl Diffusion {
     pub fn assemble(&self, complex: &Complex) -> Result<Assembled, DiffusionError> {
         let started = Instant::now();
         let n = complex.dim();
-        let conductivity = self.tensors(complex)?;
+        let conductivity = self.cell_conductivity(complex)?;
         let tensors = conductivity.cells();
         let faces = self.boundary_faces(complex)?;
         let location = self.location();

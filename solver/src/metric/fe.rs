@@ -209,10 +209,11 @@ fn stiffness(
             match top.element_with(c, route, &mut scratch.edges)? {
                 Element::P1 => p1_weights(&top, c, k),
                 element => {
-                    let m = top.edges_of(c).len();
-                    let mut values = vec![0.0; m * m];
-                    let edges = dense_block(&top, c, element, k, scratch, &mut values)?;
-                    Ok(Local::Dense { edges, values })
+                    dense_block(&top, c, element, k, scratch)?;
+                    Ok(Local::Dense {
+                        edges: scratch.edges.clone(),
+                        values: scratch.omega.clone(),
+                    })
                 }
             }
         })
@@ -232,18 +233,19 @@ struct CellScratch {
     half: Vec<f64>,
     /// Local incidence pattern, the key of the A_c⁺ cache.
     key: Vec<usize>,
+    /// Ω_c (edges × edges, row-major).
+    omega: Vec<f64>,
 }
 
-/// Ω_c of a Q1 or virtual-element cell `c` over its sorted edges (returned),
-/// written over `out` (m × m row-major, m the cell's edge count).
+/// Ω_c of a Q1 or virtual-element cell `c` into `scratch.omega`, over its
+/// sorted edges, left in `scratch.edges`.
 fn dense_block(
     top: &Topology,
     c: usize,
     element: Element,
     k: &Tensor,
     scratch: &mut CellScratch,
-    out: &mut [f64],
-) -> Result<Vec<usize>, MetricError> {
+) -> Result<(), MetricError> {
     let method = match element {
         Element::Q1(order) => {
             q1_stiffness(top, c, &order, k, &mut scratch.kc)?;
@@ -260,8 +262,7 @@ fn dense_block(
         }
     };
     top.edges_into(c, &mut scratch.edges);
-    edge_block(top, c, scratch, method, out)?;
-    Ok(std::mem::take(&mut scratch.edges))
+    edge_block(top, c, scratch, method)
 }
 
 /// Ω with one dense block per top cell, in cell order, every cell a Q1 or
@@ -305,16 +306,17 @@ fn dense_stiffness(
             let (edge_base, value_base) = (edge_ptr[range.start], value_ptr[range.start]);
             for c in range.clone() {
                 let element = top.element_with(c, route, &mut scratch.edges)?;
-                let out = &mut value_out[value_ptr[c] - value_base..value_ptr[c + 1] - value_base];
-                scratch.edges = dense_block(top, c, element, &tensors.get(c), &mut scratch, out)?;
+                dense_block(top, c, element, &tensors.get(c), &mut scratch)?;
+                value_out[value_ptr[c] - value_base..value_ptr[c + 1] - value_base]
+                    .copy_from_slice(&scratch.omega);
                 index_out[edge_ptr[c] - edge_base..edge_ptr[c + 1] - edge_base]
                     .copy_from_slice(&scratch.edges);
             }
             Ok(())
         })
-        .collect::<Vec<Result<(), MetricError>>>()
+        .collect::<Vec<_>>()
         .into_iter()
-        .collect::<Result<Vec<()>, MetricError>>()?;
+        .collect::<Result<(), MetricError>>()?;
     Ok(BlockMetric::from_symmetric_blocks(
         top.complex.cell_count(1),
         &edge_ptr,
@@ -740,17 +742,20 @@ thread_local! {
 
 /// Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the edges `scratch.edges` of cell `c`, from
 /// K_c in `scratch.kc` (indexed by the cell's sorted vertex list), written
-/// over `out` (edges × edges, row-major) and made exactly symmetric.
+/// into `scratch.omega` (edges × edges, row-major) and made exactly
+/// symmetric.
 fn edge_block(
     top: &Topology,
     c: usize,
     scratch: &mut CellScratch,
     method: &'static str,
-    out: &mut [f64],
 ) -> Result<(), MetricError> {
     let pinv = edge_pseudo_inverse(top, c, &scratch.edges, &mut scratch.key, method)?;
     let (v, m) = (pinv.nrows(), pinv.ncols());
     let kc = &scratch.kc;
+    let out = &mut scratch.omega;
+    out.clear();
+    out.resize(m * m, 0.0);
     // (A_c⁺)ᵀ K_c first, then times A_c⁺.
     let half = &mut scratch.half;
     half.clear();
