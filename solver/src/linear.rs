@@ -20,7 +20,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::{SparseColMat, SparseColMatRef};
+use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par, Side};
 use std::sync::Arc;
 use std::time::Instant;
@@ -324,6 +324,32 @@ impl DirectSolver {
         kind: Factorization,
         ordering: Ordering,
     ) -> Result<Self, SolveError> {
+        Self::analyse_pattern(matrix.symbolic(), kind, ordering)
+    }
+
+    /// Symbolic analysis of a sparsity pattern alone: the analysis never
+    /// reads values, so it can run before (or while) they are computed,
+    /// when the pattern is known from topology. Every matrix later
+    /// factorised must have exactly this pattern.
+    ///
+    /// ```
+    /// use faer::sparse::{SparseColMat, Triplet};
+    /// use hasse_solver::linear::{DirectSolver, Factorization, Ordering};
+    ///
+    /// let a = SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &[
+    ///     Triplet::new(0, 0, 2.0), Triplet::new(1, 0, -1.0),
+    ///     Triplet::new(0, 1, -1.0), Triplet::new(1, 1, 2.0),
+    /// ]).unwrap();
+    /// let solver =
+    ///     DirectSolver::analyse_pattern(a.symbolic(), Factorization::Llt, Ordering::Amd).unwrap();
+    /// let x = solver.factorize(a.as_ref()).unwrap().solve(&[1.0, 1.0]).unwrap();
+    /// assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 1.0).abs() < 1e-14);
+    /// ```
+    pub fn analyse_pattern(
+        matrix: SymbolicSparseColMatRef<'_, usize>,
+        kind: Factorization,
+        ordering: Ordering,
+    ) -> Result<Self, SolveError> {
         if matrix.nrows() != matrix.ncols() {
             return Err(SolveError::NotSquare {
                 rows: matrix.nrows(),
@@ -342,20 +368,20 @@ impl DirectSolver {
                 },
                 _ => CholeskySymbolicParams::default(),
             };
-            factorize_symbolic_cholesky(matrix.symbolic(), Side::Lower, order, params)
+            factorize_symbolic_cholesky(matrix, Side::Lower, order, params)
                 .map(Arc::new)
                 .map_err(|e| SolveError::Symbolic(format!("{e:?}")))
         };
         let (analysis, ordering) = match (kind, ordering) {
             (Factorization::Lu, _) => (
                 Analysis::Lu(
-                    SymbolicLu::try_new(matrix.symbolic())
+                    SymbolicLu::try_new(matrix)
                         .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?,
                 ),
                 None,
             ),
             (_, Ordering::NestedDissection) => {
-                let perm = ordering::nested_dissection(matrix.symbolic())?;
+                let perm = ordering::nested_dissection(matrix)?;
                 let analysed = symbolic(SymmetricOrdering::Custom(perm.as_ref()))?;
                 (
                     Analysis::symmetric(kind, analysed),
@@ -367,7 +393,7 @@ impl DirectSolver {
                 if amd.len_val() < ND_MIN_FILL_PER_UNKNOWN.saturating_mul(size) {
                     (Analysis::Llt(amd), Some(Ordering::Amd))
                 } else {
-                    match ordering::nested_dissection(matrix.symbolic()) {
+                    match ordering::nested_dissection(matrix) {
                         Ok(perm) => {
                             let nd = symbolic(SymmetricOrdering::Custom(perm.as_ref()))?;
                             // Whichever stores less; on every measured
@@ -634,6 +660,18 @@ pub fn solve_with(
     ordering: Ordering,
 ) -> Result<(Vec<f64>, SolveReport), SolveError> {
     let solver = DirectSolver::analyse_with(matrix.as_ref(), kind, ordering)?;
+    solve_analysed(&solver, matrix, rhs)
+}
+
+/// Factorise and solve once with an analysis made beforehand (of this
+/// matrix's pattern, see [`DirectSolver::analyse_pattern`]), and report;
+/// the report's symbolic time is the analysis's own.
+pub fn solve_analysed(
+    solver: &DirectSolver,
+    matrix: &SparseColMat<usize, f64>,
+    rhs: &[f64],
+) -> Result<(Vec<f64>, SolveReport), SolveError> {
+    let kind = solver.kind();
     let factor = solver.factorize(matrix.as_ref())?;
     let started = Instant::now();
     let x = factor.solve(rhs)?;
