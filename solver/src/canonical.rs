@@ -630,6 +630,22 @@ impl LocalPattern {
     }
 }
 
+/// The pattern of M = Aᵀ W A for every diagonal W with a weight on each
+/// row of A (`incidence` by rows, `by_columns` the same matrix by
+/// columns): the pattern [`Canonical`] gives such an operator, known from
+/// topology before any weight is computed.
+pub(crate) fn diagonal_pattern(
+    incidence: &CsMat<i8>,
+    by_columns: &Arc<CsMat<i8>>,
+) -> SymbolicSparseColMat<usize> {
+    debug_assert!(incidence.is_csr() && by_columns.is_csc());
+    debug_assert_eq!(incidence.shape(), by_columns.shape());
+    matrix_pattern(
+        incidence,
+        &Assembly::Diagonal(Columns::Shared(Arc::clone(by_columns))),
+    )
+}
+
 /// The pattern of M = Aᵀ Ω A for the way its values are formed.
 fn matrix_pattern(incidence: &CsMat<i8>, assembly: &Assembly) -> SymbolicSparseColMat<usize> {
     let n = incidence.cols();
@@ -1063,6 +1079,27 @@ pub fn metric_from_matrix(
 mod tests {
     use super::*;
     use nalgebra::DMatrix;
+
+    #[test]
+    fn the_diagonal_pattern_is_the_cells_coupled_through_faces() {
+        // Three cells in a row, four faces: ∂ by faces has rows (1), (−1, 1),
+        // (−1, 1), (−1); ∂ᵀ∂ is tridiagonal whatever the face weights.
+        let rows = CsMat::new(
+            (4, 3),
+            vec![0, 1, 3, 5, 6],
+            vec![0, 0, 1, 1, 2, 2],
+            vec![1i8, -1, 1, -1, 1, -1],
+        );
+        let by_columns = Arc::new(rows.to_csc());
+        let pattern = diagonal_pattern(&rows, &by_columns);
+        assert_eq!(pattern.col_ptr(), &[0, 2, 5, 7]);
+        assert_eq!(pattern.row_idx(), &[0, 1, 0, 1, 2, 1, 2]);
+        // The operator with real weights has that pattern too.
+        let metric = BlockMetric::diagonal(&[2.0, 0.5, 3.0, 1.0]);
+        let m = Canonical::new(rows, metric).unwrap().assemble();
+        assert_eq!(m.symbolic().col_ptr(), pattern.col_ptr());
+        assert_eq!(m.symbolic().row_idx(), pattern.row_idx());
+    }
 
     #[test]
     fn theorem_one_reproduces_any_matrix_when_the_kernel_is_trivial() {

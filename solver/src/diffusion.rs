@@ -24,12 +24,12 @@
 
 use crate::canonical::{BlockMetric, Canonical, CanonicalError};
 use crate::iterative::{conjugate_gradient, CgError, CgOptions, CgReport, RowMatrix};
-use crate::linear::{self, Factorization, Ordering, SolveError, SolveReport};
+use crate::linear::{self, DirectSolver, Factorization, Ordering, SolveError, SolveReport};
 use crate::metric::{self, dec, fd, fe, fv, CellTensors, MetricError, Tensor};
 use crate::multigrid::{
     self, CellProlongation, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
 };
-use faer::sparse::SparseColMat;
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use hasse_complex::dual::DualKind;
 use hasse_complex::Complex;
 use rayon::prelude::*;
@@ -264,6 +264,10 @@ pub struct Solution {
     pub flux: Vec<f64>,
     pub report: SolveReport,
     pub assembly_seconds: f64,
+    /// Whether the direct solve's symbolic analysis ran beside the assembly
+    /// (from M's pattern known from topology), so that its seconds overlap
+    /// `assembly_seconds` instead of adding to them.
+    pub analysed_during_assembly: bool,
     /// Whether the problem was pure Neumann (solution normalised to zero mean).
     pub pure_neumann: bool,
     /// Relative imbalance of pure-Neumann data removed before solving.
@@ -1012,12 +1016,32 @@ impl Diffusion {
 
     /// Assemble and solve on `complex`.
     pub fn solve(&self, complex: &Complex) -> Result<Solution, DiffusionError> {
+        // Assembly and the checks before a solve; only their result is
+        // needed by the factorisation.
+        let prepare = || -> Result<(Assembled, f64, f64), DiffusionError> {
+            let mut system = self.assemble(complex)?;
+            let neumann_imbalance = self.make_compatible(complex, &mut system)?;
+            if !system.pure_neumann {
+                check_anchored(complex, system.location, &system.matrix, &system.fixed)?;
+            }
+            let condition_bound = diagonal_condition_bound(&system.matrix, &system.fixed);
+            Ok((system, neumann_imbalance, condition_bound))
+        };
+        // The analysis reads only M's pattern; when topology alone fixes it,
+        // it runs on one thread while the geometry, Ω, the values and the
+        // checks are computed on the other.
+        let (prepared, analysis) = if self.pattern_from_topology() {
+            rayon::join(prepare, || self.analyse_topology(complex))
+        } else {
+            (prepare(), None)
+        };
+        let (system, neumann_imbalance, condition_bound) = prepared?;
         let Assembled {
             location,
             canonical,
             matrix,
-            mut rhs,
-            mut fixed,
+            rhs,
+            fixed,
             pure_neumann,
             flux_rows,
             ghost_values,
@@ -1025,50 +1049,20 @@ impl Diffusion {
             cell_points,
             assembly_seconds,
             ..
-        } = self.assemble(complex)?;
+        } = system;
         let unknowns = rhs.len();
-        let mut neumann_imbalance = 0.0;
-        if pure_neumann {
-            let components = complex.betti_numbers_over(hasse_complex::Field::Z2)[0];
-            if components != 1 {
-                return Err(DiffusionError::Disconnected { components });
-            }
-            let total: f64 = rhs.iter().sum();
-            let scale: f64 = rhs.iter().map(|b| b.abs()).sum();
-            let relative = if scale > 0.0 {
-                total.abs() / scale
-            } else {
-                0.0
-            };
-            if relative > self.neumann_tolerance {
-                return Err(DiffusionError::IncompatibleNeumann {
-                    imbalance: total,
-                    relative,
-                });
-            }
-            neumann_imbalance = relative;
-            // Remove the quadrature imbalance in proportion to each unknown's
-            // weight, so the system is compatible.
-            let weights = self.mean_weights(complex, location, unknowns);
-            let wsum: f64 = weights.iter().sum();
-            for (b, w) in rhs.iter_mut().zip(&weights) {
-                *b -= total * w / wsum;
-            }
-            // Pin one unknown; the zero-mean shift is applied after the solve.
-            fixed[0] = Some(0.0);
-        }
-
-        if !pure_neumann {
-            check_anchored(complex, location, &matrix, &fixed)?;
-        }
-        let condition_bound = diagonal_condition_bound(&matrix, &fixed);
-        let (mut values, report, iterations) = solve_with_fixed(
+        let analysis = analysis
+            .filter(|a| fixed.iter().all(Option::is_none) && a.fits(&matrix))
+            .map(|a| a.solver);
+        let analysed_during_assembly = analysis.is_some();
+        let (mut values, report, iterations) = solve_fixed(
             &matrix,
             &rhs,
             &fixed,
             self.factorization,
             self.ordering,
             self.iterative.as_ref(),
+            analysis,
         )?;
         if pure_neumann {
             let weights = self.mean_weights(complex, location, unknowns);
@@ -1095,11 +1089,75 @@ impl Diffusion {
             report,
             iterations,
             assembly_seconds,
+            analysed_during_assembly,
             pure_neumann,
             neumann_imbalance,
             cell_points,
             condition_bound,
         })
+    }
+
+    /// A pure-Neumann system made solvable: a connected complex is
+    /// required, the data's imbalance Σb must be within the tolerance and is
+    /// removed in proportion to each unknown's weight, and unknown 0 is
+    /// pinned (the zero-mean shift follows the solve). Returns the relative
+    /// imbalance removed (0 when the system is not pure Neumann).
+    fn make_compatible(
+        &self,
+        complex: &Complex,
+        system: &mut Assembled,
+    ) -> Result<f64, DiffusionError> {
+        if !system.pure_neumann {
+            return Ok(0.0);
+        }
+        let components = complex.betti_numbers_over(hasse_complex::Field::Z2)[0];
+        if components != 1 {
+            return Err(DiffusionError::Disconnected { components });
+        }
+        let rhs = &mut system.rhs;
+        let total: f64 = rhs.iter().sum();
+        let scale: f64 = rhs.iter().map(|b| b.abs()).sum();
+        let relative = if scale > 0.0 {
+            total.abs() / scale
+        } else {
+            0.0
+        };
+        if relative > self.neumann_tolerance {
+            return Err(DiffusionError::IncompatibleNeumann {
+                imbalance: total,
+                relative,
+            });
+        }
+        let weights = self.mean_weights(complex, system.location, rhs.len());
+        let wsum: f64 = weights.iter().sum();
+        for (b, w) in rhs.iter_mut().zip(&weights) {
+            *b -= total * w / wsum;
+        }
+        system.fixed[0] = Some(0.0);
+        Ok(relative)
+    }
+
+    /// Whether M's pattern is known before assembly: for the cell-centred
+    /// two-point methods it is that of ∂ₙᵀ∂ₙ (cells coupled through their
+    /// faces), whatever the conductivity and the boundary conditions, whose
+    /// ghost rows touch one cell each and so add only to the diagonal.
+    fn pattern_from_topology(&self) -> bool {
+        self.iterative.is_none() && matches!(self.method, Method::Fv | Method::Fd)
+    }
+
+    /// The pattern of ∂ₙᵀ∂ₙ and its symbolic analysis for this problem's
+    /// factorisation and ordering. `None` when the analysis fails: the solve
+    /// then analyses the assembled matrix and reports the failure itself.
+    fn analyse_topology(&self, complex: &Complex) -> Option<TopologyAnalysis> {
+        let n = complex.dim();
+        let pattern = crate::canonical::diagonal_pattern(
+            &complex.shared_boundary(n),
+            &complex.shared_boundary_csc(n),
+        );
+        let solver =
+            DirectSolver::analyse_pattern(pattern.as_ref(), self.factorization, self.ordering)
+                .ok()?;
+        Some(TopologyAnalysis { pattern, solver })
     }
 
     /// The cell points of [`Method::Fv`] when they are not the centroids.
@@ -1313,6 +1371,39 @@ pub fn solve_with_fixed(
     ordering: Ordering,
     iterative: Option<&Iterative>,
 ) -> Result<(Vec<f64>, SolveReport, Option<CgReport>), DiffusionError> {
+    solve_fixed(matrix, rhs, fixed, factorization, ordering, iterative, None)
+}
+
+/// A symbolic analysis made from topology before M was assembled, and the
+/// pattern it was made for.
+struct TopologyAnalysis {
+    pattern: SymbolicSparseColMat<usize>,
+    solver: DirectSolver,
+}
+
+impl TopologyAnalysis {
+    /// Whether it holds for `matrix`: same pattern, entry for entry.
+    fn fits(&self, matrix: &SparseColMat<usize, f64>) -> bool {
+        let assembled = matrix.symbolic();
+        assembled.nrows() == self.pattern.nrows()
+            && assembled.col_ptr() == self.pattern.col_ptr()
+            && assembled.col_nnz().is_none()
+            && assembled.row_idx() == self.pattern.row_idx()
+    }
+}
+
+/// [`solve_with_fixed`], with an analysis made beforehand (of `matrix`'s
+/// pattern: see [`TopologyAnalysis::fits`]) used by a direct solve when no
+/// unknown is held.
+fn solve_fixed(
+    matrix: &SparseColMat<usize, f64>,
+    rhs: &[f64],
+    fixed: &[Option<f64>],
+    factorization: Factorization,
+    ordering: Ordering,
+    iterative: Option<&Iterative>,
+    analysis: Option<DirectSolver>,
+) -> Result<(Vec<f64>, SolveReport, Option<CgReport>), DiffusionError> {
     let n = rhs.len();
     let mut free_index = vec![usize::MAX; n];
     let mut free = Vec::new();
@@ -1380,7 +1471,12 @@ pub fn solve_with_fixed(
     };
     let (x, report, iterations) = match iterative {
         None => {
-            let (x, report) = linear::solve_with(&reduced, &reduced_rhs, factorization, ordering)?;
+            let (x, report) = match analysis {
+                Some(analysis) if all_free => {
+                    linear::solve_analysed(&analysis, matrix, &reduced_rhs)?
+                }
+                _ => linear::solve_with(&reduced, &reduced_rhs, factorization, ordering)?,
+            };
             (x, report, None)
         }
         Some(settings) => {
