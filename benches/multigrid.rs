@@ -13,6 +13,9 @@
 //!   the coarse correction doubled (sparser coarse levels, cheaper setup).
 //! - `direct`: complex, assembly, faer LLᵀ through hasse (analysis,
 //!   factorisation, solve) with the automatic fill-reducing ordering.
+//! - `solve`: complex, then `Diffusion::solve` as a case file runs it
+//!   (the analysis of M's pattern beside the assembly, factorisation,
+//!   solve, fluxes and checks), timed whole.
 //! - `plain`: the same 5/7-point matrix built by hand as triplets and
 //!   factorised with faer's own LLᵀ (AMD ordering), without hasse.
 //! - `amd`, `nd`: the hand-built matrix factorised through hasse's
@@ -168,6 +171,28 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 relative_residual(system.matrix.as_ref(), &x, &system.rhs)
             )
         }
+        "solve" => {
+            // Diffusion::solve as a case file runs it: assembly with the
+            // analysis beside it, factorisation, solve, fluxes and checks.
+            let t = Instant::now();
+            let complex = mesh(d, n);
+            let complex_s = seconds(t);
+            let t = Instant::now();
+            let solution = problem().solve(&complex).expect("solve");
+            let whole_s = seconds(t);
+            let report = &solution.report;
+            format!(
+                "unknowns={} ordering={} complex={complex_s:.3} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} residual={:.2e}",
+                solution.values.len(),
+                short_name(report.ordering),
+                solution.assembly_seconds,
+                report.symbolic_seconds,
+                report.numeric_seconds,
+                report.solve_seconds,
+                solution.analysed_during_assembly,
+                report.relative_residual
+            )
+        }
         "plain" => {
             let t = Instant::now();
             let matrix = plain_matrix(n, d);
@@ -192,7 +217,9 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             write_vector_market(&format!("{path}.rhs.mtx"), &system.rhs).expect("write rhs");
             format!("file={path}.mtx")
         }
-        other => panic!("unknown phase {other}: mg, mg-pc, direct, plain, amd, nd or export"),
+        other => {
+            panic!("unknown phase {other}: mg, mg-pc, direct, solve, plain, amd, nd or export")
+        }
     };
     format!(
         "RESULT {case} {phase} {fields} total={:.3} peak_gib={:.3}",
@@ -295,13 +322,16 @@ fn main() {
         vec![
             (
                 "2d-1000",
-                vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"],
+                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
             ),
-            ("3d-60", vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]),
+            (
+                "3d-60",
+                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
+            ),
             (
                 "3d-100",
                 if env("HASSE_BENCH_DIRECT_100") {
-                    vec!["mg", "mg-pc", "direct", "plain"]
+                    vec!["mg", "mg-pc", "direct", "solve", "plain"]
                 } else {
                     vec!["mg", "mg-pc"]
                 },
@@ -313,8 +343,14 @@ fn main() {
         ]
     } else {
         vec![
-            ("2d-64", vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]),
-            ("3d-16", vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]),
+            (
+                "2d-64",
+                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
+            ),
+            (
+                "3d-16",
+                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
+            ),
             (
                 "delaunay-20k",
                 vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"],
@@ -324,7 +360,7 @@ fn main() {
     if benching && env("HASSE_BENCH_LARGE") {
         cases.push((
             "2d-2000",
-            vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"],
+            vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
         ));
     }
     // HASSE_BENCH_CASES="delaunay-1m 3d-60" runs only these cases, with
@@ -342,7 +378,7 @@ fn main() {
                         let phases = if parse_delaunay(name).is_some() {
                             vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"]
                         } else {
-                            vec!["mg", "mg-pc", "direct", "plain", "amd", "nd"]
+                            vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"]
                         };
                         (name, phases)
                     })

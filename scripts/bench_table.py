@@ -1,7 +1,7 @@
 """Turn the `RESULT case phase key=value ...` lines of benches/multigrid.rs
 and scripts/pyamg_baseline.py (stdin) into one table: hasse next to its
 baseline, with the ratio hasse / baseline (below 1: hasse is faster or
-smaller). Structured cases (phases mg, mg-pc, direct, plain, amd, nd) and
+smaller). Structured cases (phases mg, mg-pc, direct, solve, plain, amd, nd) and
 Delaunay cases (phases amg, dec, direct, plain, amd, nd, check) get their own
 rows; a failed phase shows as — in its rows."""
 import sys
@@ -121,6 +121,10 @@ for case in runs:
     used = ORDERING.get(direct.get("ordering"), "?")
     rows.append((label, f"LLᵀ analysis+factorisation ({used})", fmt(num(direct, "factor")), "plain faer LLᵀ (AMD)", fmt(num(plain, "factor")), ratio(num(direct, "factor"), num(plain, "factor"))))
     rows.append((label, "LLᵀ solve", fmt(num(direct, "solve")), "plain faer LLᵀ", fmt(num(plain, "solve")), ratio(num(direct, "solve"), num(plain, "solve"))))
+    whole = r.get("solve", {})
+    if whole:
+        beside = " (analysis beside assembly)" if whole.get("beside") == "true" else ""
+        rows.append((label, f"whole Diffusion::solve{beside}", fmt(num(whole, "whole")), "plain faer LLᵀ analysis+factorisation", fmt(num(plain, "factor")), ratio(num(whole, "whole"), num(plain, "factor"))))
     mg_setup, mg_solve = num(mg, "setup"), num(mg, "solve")
     mg_total = None if mg_setup is None else mg_setup + mg_solve
     amg_total = None if num(amg, "setup") is None else num(amg, "setup") + num(amg, "solve")
