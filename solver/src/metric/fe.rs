@@ -174,6 +174,10 @@ enum Element {
 struct TensorOrder {
     slots: [usize; 8],
     len: usize,
+    /// (tail, head) of each sorted edge of the cell as positions in its
+    /// sorted vertex list: the cell's local incidence, found on the way
+    /// (bytes, so that the element stays small to pass around).
+    ends: [[u8; 2]; 12],
 }
 
 impl std::ops::Deref for TensorOrder {
@@ -247,9 +251,12 @@ fn dense_block(
     scratch: &mut CellScratch,
 ) -> Result<(), MetricError> {
     let method = match element {
+        // Q1 cells exist in 2D and 3D only (`Topology::tensor_order`).
+        Element::Q1(order) if top.n == 2 => {
+            return q1_block::<4, 4>(top, c, &order, k, scratch);
+        }
         Element::Q1(order) => {
-            q1_stiffness(top, c, &order, k, &mut scratch.kc)?;
-            "Q1"
+            return q1_block::<8, 12>(top, c, &order, k, scratch);
         }
         _ => {
             let kc = vem_stiffness(top, c, k)?;
@@ -405,6 +412,16 @@ impl<'a> Topology<'a> {
         let range = self.delta0.indptr().outer_inds_sz(e);
         let vertices = &self.delta0.indices()[range.clone()];
         let signs = &self.delta0.data()[range];
+        // Every edge of a nodal metric has one tail and one head: read
+        // them from δ⁰ alone (this runs several times per cell).
+        if let ([a, b], [sa, sb]) = (vertices, signs) {
+            if *sa < 0 && *sb > 0 {
+                return (*a, *b);
+            }
+            if *sa > 0 && *sb < 0 {
+                return (*b, *a);
+            }
+        }
         let ends = self.complex.cell_vertices(1, e);
         let (mut tail, mut head) = (ends[0], ends[ends.len() - 1]);
         for (&v, &s) in vertices.iter().zip(signs) {
@@ -425,8 +442,10 @@ impl<'a> Topology<'a> {
         cell: usize,
     ) -> Result<(usize, usize), MetricError> {
         let (t, h) = self.ends(e);
-        match (vertices.binary_search(&t), vertices.binary_search(&h)) {
-            (Ok(a), Ok(b)) => Ok((a, b)),
+        // A cell has a handful of vertices: a scan beats a binary search.
+        let find = |v: usize| vertices.iter().position(|&x| x == v);
+        match (find(t), find(h)) {
+            (Some(a), Some(b)) => Ok((a, b)),
             _ => Err(MetricError::UnsupportedMesh {
                 method: "nodal metric",
                 needs: "cells whose edges join their own vertices",
@@ -465,10 +484,14 @@ impl<'a> Topology<'a> {
     }
 
     pub(crate) fn point(&self, v: usize) -> Point {
-        let mut x = [0.0; 3];
-        let p = self.complex.vertices().point(v);
-        x[..p.len()].copy_from_slice(p);
-        x
+        // Fixed lengths: a copy of unknown length is a call to memcpy,
+        // and this runs for every corner of every cell.
+        match *self.complex.vertices().point(v) {
+            [x] => [x, 0.0, 0.0],
+            [x, y] => [x, y, 0.0],
+            [x, y, z, ..] => [x, y, z],
+            [] => [0.0; 3],
+        }
     }
 
     fn points(&self, c: usize) -> Vec<Point> {
@@ -529,10 +552,11 @@ impl<'a> Topology<'a> {
         // runs for every cell of a Q1 mesh (stiffness and load).
         let mut adjacent = [[0usize; 3]; 8];
         let mut degree = [0usize; 8];
-        let mut ends = [(0usize, 0usize); 12];
+        let mut ends = [[0u8; 2]; 12];
         for (k, &e) in edges.iter().enumerate() {
             let (a, b) = self.local_ends(e, vertices, c).ok()?;
-            ends[k] = (a, b);
+            // a, b < m ≤ 8.
+            ends[k] = [a as u8, b as u8];
             for (x, y) in [(a, b), (b, a)] {
                 if degree[x] == self.n {
                     return None;
@@ -579,14 +603,18 @@ impl<'a> Topology<'a> {
         for (l, &o) in order.iter().enumerate() {
             slot[o] = l;
         }
-        for &(a, b) in &ends[..edges.len()] {
-            if (slot[a] ^ slot[b]).count_ones() != 1 {
+        for &[a, b] in &ends[..edges.len()] {
+            if (slot[usize::from(a)] ^ slot[usize::from(b)]).count_ones() != 1 {
                 return None;
             }
         }
         let mut slots = [0; 8];
         slots[..m].copy_from_slice(order);
-        Some(TensorOrder { slots, len: m })
+        Some(TensorOrder {
+            slots,
+            len: m,
+            ends,
+        })
     }
 }
 
@@ -672,11 +700,21 @@ pub(crate) fn edge_pseudo_inverse(
         let (t, h) = top.local_ends(e, vertices, c)?;
         key.extend([t, h]);
     }
+    pseudo_inverse_of_key(key, c, method)
+}
+
+/// A_c⁺ of the local incidence `key` (vertex count, then each edge's
+/// local tail and head), from the per-thread cache or computed.
+fn pseudo_inverse_of_key(
+    key: &[usize],
+    c: usize,
+    method: &'static str,
+) -> Result<Rc<DMatrix<f64>>, MetricError> {
     let cached = PSEUDO_INVERSES.with(|cache| cache.borrow_mut().get(key));
     if let Some(pinv) = cached {
         return Ok(pinv);
     }
-    let mut a = DMatrix::zeros(edges.len(), vertices.len());
+    let mut a = DMatrix::zeros((key.len() - 1) / 2, key[0]);
     for (r, ends) in key[1..].chunks_exact(2).enumerate() {
         a[(r, ends[0])] = -1.0;
         a[(r, ends[1])] = 1.0;
@@ -787,6 +825,87 @@ fn edge_block(
     Ok(())
 }
 
+/// Ω_c of a Q1 cell with N = 2ⁿ corners and E edges (n = 2: 4, 4; n = 3:
+/// 8, 12) into `scratch.omega`, over its sorted edges (`scratch.edges`):
+/// K_c from the 2ⁿ Gauss points, then (A_c⁺)ᵀ K_c A_c⁺ as in
+/// [`edge_block`], in fixed arrays, with A_c's pattern taken from the
+/// tensor order (no second walk of the edges).
+/// K_c and Ω_c are formed on and above the diagonal and mirrored, so both
+/// are exactly symmetric.
+fn q1_block<const N: usize, const E: usize>(
+    top: &Topology,
+    c: usize,
+    order: &TensorOrder,
+    k: &Tensor,
+    scratch: &mut CellScratch,
+) -> Result<(), MetricError> {
+    let n = top.n;
+    debug_assert_eq!((order.len(), n << (n - 1)), (N, E));
+    let map = q1_map::<N>(&tensor_points(top, c, order)[..N], n, c)?;
+    // K_c in tensor order.
+    let mut kc = [[0.0; N]; N];
+    for (&weight, gradients) in map.weights[..N].iter().zip(&map.gradients) {
+        let mut flux = [[0.0; 3]; N];
+        for (f, g) in flux.iter_mut().zip(gradients) {
+            for (i, fi) in f.iter_mut().enumerate().take(n) {
+                *fi = weight * (0..n).map(|j| k[i][j] * g[j]).sum::<f64>();
+            }
+        }
+        for l in 0..N {
+            for j in l..N {
+                kc[l][j] += (0..n).map(|i| gradients[l][i] * flux[j][i]).sum::<f64>();
+            }
+        }
+    }
+    let upper = kc;
+    for (l, row) in kc.iter_mut().enumerate() {
+        for (j, entry) in row.iter_mut().enumerate().take(l) {
+            *entry = upper[j][l];
+        }
+    }
+    // A_c⁺ with its rows (the cell's sorted vertices) in tensor order.
+    scratch.key.clear();
+    scratch.key.push(N);
+    for &[t, h] in &order.ends[..E] {
+        scratch.key.extend([usize::from(t), usize::from(h)]);
+    }
+    let pinv = pseudo_inverse_of_key(&scratch.key, c, "Q1")?;
+    let mut p = [[0.0; E]; N];
+    for (row, &o) in p.iter_mut().zip(order.iter()) {
+        for (e, entry) in row.iter_mut().enumerate() {
+            *entry = pinv[(o, e)];
+        }
+    }
+    // K_c A_c⁺ (N × E), then (A_c⁺)ᵀ K_c A_c⁺ on and above the diagonal.
+    let mut half = [[0.0; E]; N];
+    for (h, kl) in half.iter_mut().zip(&kc) {
+        for (a, pa) in kl.iter().zip(&p) {
+            for (he, pe) in h.iter_mut().zip(pa) {
+                *he += a * pe;
+            }
+        }
+    }
+    let out = &mut scratch.omega;
+    out.clear();
+    out.resize(E * E, 0.0);
+    for e in 0..E {
+        for f in e..E {
+            let value: f64 = (0..N).map(|l| p[l][e] * half[l][f]).sum();
+            out[e * E + f] = value;
+            out[f * E + e] = value;
+        }
+    }
+    if out.iter().any(|v| !v.is_finite()) {
+        return Err(MetricError::UnsupportedCell {
+            method: "Q1",
+            needs: "a non-degenerate cell (finite local stiffness)",
+            cell: c,
+        });
+    }
+    top.edges_into(c, &mut scratch.edges);
+    Ok(())
+}
+
 /// Sign (±1) of corner `l` along local axis `a`.
 fn corner_sign(l: usize, a: usize) -> f64 {
     if (l >> a) & 1 == 1 {
@@ -832,25 +951,28 @@ struct GaussPoint {
     point: Point,
 }
 
-/// The isoparametric map of a Q1 cell at its 2ⁿ Gauss points: |det J|
-/// (the reference weight is 1) and the physical shape gradients, both in
-/// tensor order. Fixed arrays: every cell of a Q1 mesh needs one.
-struct Q1Map {
-    weights: [f64; 8],
-    gradients: [[Point; 8]; 8],
+/// The isoparametric map of a Q1 cell with N = 2ⁿ corners at its N Gauss
+/// points: |det J| (the reference weight is 1) and the physical shape
+/// gradients, both in tensor order. Fixed arrays of the cell's own size:
+/// every cell of a Q1 mesh needs one.
+struct Q1Map<const N: usize> {
+    weights: [f64; N],
+    gradients: [[Point; N]; N],
 }
 
 /// [`Q1Map`] of the cell with corners `x` in tensor order (2 Gauss points
-/// per axis, weight 1 each on [−1, 1]^n).
-fn q1_map(x: &[Point], n: usize, cell: usize) -> Result<Q1Map, MetricError> {
+/// per axis, weight 1 each on [−1, 1]^n, N = 2ⁿ).
+#[inline(always)]
+fn q1_map<const N: usize>(x: &[Point], n: usize, cell: usize) -> Result<Q1Map<N>, MetricError> {
+    debug_assert_eq!((x.len(), 1 << n), (N, N));
     let bad = MetricError::UnsupportedCell {
         method: "Q1",
         needs: "a quadrilateral or hexahedron whose isoparametric map keeps one orientation (convex, not inverted)",
         cell,
     };
     let mut map = Q1Map {
-        weights: [0.0; 8],
-        gradients: [[[0.0; 3]; 8]; 8],
+        weights: [0.0; N],
+        gradients: [[[0.0; 3]; N]; N],
     };
     let mut orientation = 0.0;
     for (q, (_, shape_gradients)) in q1_reference(n).iter().enumerate() {
@@ -881,8 +1003,19 @@ fn q1_map(x: &[Point], n: usize, cell: usize) -> Result<Q1Map, MetricError> {
 /// Gauss points of a Q1 cell with corners `x` in tensor order, with the
 /// shape values and the mapped point (for loads).
 fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, MetricError> {
-    let map = q1_map(x, n, cell)?;
-    let m = 1 << n;
+    match n {
+        2 => q1_points_of::<4>(x, n, cell),
+        _ => q1_points_of::<8>(x, n, cell),
+    }
+}
+
+fn q1_points_of<const N: usize>(
+    x: &[Point],
+    n: usize,
+    cell: usize,
+) -> Result<Vec<GaussPoint>, MetricError> {
+    let map = q1_map::<N>(x, n, cell)?;
+    let m = N;
     Ok(q1_reference(n)
         .iter()
         .enumerate()
@@ -1010,30 +1143,6 @@ pub(crate) fn shape_gradients(
         }
         Element::Vem => Ok(None),
     }
-}
-
-/// The Q1 stiffness of cell `c`, written over `kc` (m × m row-major, m =
-/// 2ⁿ, indexed by the cell's sorted vertex list).
-fn q1_stiffness(
-    top: &Topology,
-    c: usize,
-    order: &[usize],
-    k: &Tensor,
-    kc: &mut Vec<f64>,
-) -> Result<(), MetricError> {
-    let n = top.n;
-    let m = order.len();
-    let map = q1_map(&tensor_points(top, c, order)[..m], n, c)?;
-    kc.clear();
-    kc.resize(m * m, 0.0);
-    for (&weight, gradients) in map.weights[..m].iter().zip(&map.gradients) {
-        for (l, gl) in gradients[..m].iter().enumerate() {
-            for (j, gj) in gradients[..m].iter().enumerate() {
-                kc[order[l] * m + order[j]] += weight * k_dot(gl, k, gj, n);
-            }
-        }
-    }
-    Ok(())
 }
 
 fn sub(a: &Point, b: &Point) -> Point {
