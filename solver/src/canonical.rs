@@ -935,10 +935,13 @@ impl Canonical {
         values
     }
 
-    /// M's values column after column in parallel: entry (i, j) adds the
+    /// M's values in parallel over ranges of columns: entry (i, j) adds the
     /// blocks' (A_Rᵀ W A_S)_ij in block order, each formed as
     /// Σ_r a_ri (Σ_s W_rs a_sj) with r and s in the block's order, whatever
-    /// the thread count.
+    /// the thread count. Each range's thread walks the blocks that touch
+    /// its columns in block order and reads each block's local incidence
+    /// (A_R and A_S in the block's own unknown lists) once, for all of
+    /// the block's columns in the range.
     fn block_values(&self, local: &LocalPattern) -> Vec<f64> {
         let mut values = vec![0.0; self.nonzeros()];
         let pattern = self.pattern();
@@ -946,80 +949,108 @@ impl Canonical {
         let parts = ranges(self.unknowns());
         let slices = split_at_ranges(&mut values, &parts, |j| col_ptr[j]);
         parts.into_par_iter().zip(slices).for_each_init(
-            || (Vec::new(), Vec::new()),
-            |(half, dense), (range, out)| {
+            BlockScratch::default,
+            |scratch, (range, out)| {
                 // Written before the sums read it (see `zeroed`).
                 out.fill(0.0);
                 let base = col_ptr[range.start];
-                for j in range {
-                    let (first, last) = (col_ptr[j], col_ptr[j + 1]);
-                    let column = &row_idx[first..last];
-                    let column_values = &mut out[first - base..last - base];
-                    for &b in local.blocks_of(j) {
-                        self.add_block_column(local, b, j, column, column_values, half, dense);
+                let touching = || {
+                    range
+                        .clone()
+                        .flat_map(|j| local.blocks_of(j).iter().copied())
+                };
+                let (first, last, count) = touching().fold((usize::MAX, 0, 0), |(lo, hi, k), b| {
+                    (lo.min(b), hi.max(b + 1), k + 1)
+                });
+                // Blocks numbered like their unknowns (cells and vertices of
+                // a generated grid) touch a range in a short run of block
+                // numbers: walk the run. Otherwise sort the touching blocks.
+                let scattered;
+                let blocks: &mut dyn Iterator<Item = usize> =
+                    if last.saturating_sub(first) <= 2 * count {
+                        &mut (first..last.max(first))
+                    } else {
+                        let mut list: Vec<usize> = touching().collect();
+                        list.sort_unstable();
+                        list.dedup();
+                        scattered = list;
+                        &mut scattered.iter().copied()
+                    };
+                for b in blocks {
+                    let (_, right) = local.sides(b);
+                    let in_range = right.partition_point(|&j| j < range.start)
+                        ..right.partition_point(|&j| j < range.end);
+                    if in_range.is_empty() {
+                        continue;
                     }
+                    self.add_block_columns(local, b, in_range, scratch, |j, i, v| {
+                        let column = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+                        out[col_ptr[j] - base + sorted_position(column, i)] += v;
+                    });
                 }
             },
         );
         values
     }
 
-    /// Add column j of block b's A_Rᵀ W A_S to M's column j (`column`
-    /// its sorted rows, `column_values` its values); `half` and `dense`
-    /// are scratch.
-    #[allow(clippy::too_many_arguments)]
-    fn add_block_column(
+    /// Columns `columns` (positions in the block's column-side unknowns)
+    /// of block b's A_Rᵀ W A_S, handed to `add(j, i, value)` column by
+    /// column, rows in the block's row-side order.
+    fn add_block_columns(
         &self,
         local: &LocalPattern,
         b: usize,
-        j: usize,
-        column: &[usize],
-        column_values: &mut [f64],
-        half: &mut Vec<f64>,
-        dense: &mut Vec<f64>,
+        columns: std::ops::Range<usize>,
+        scratch: &mut BlockScratch,
+        mut add: impl FnMut(usize, usize, f64),
     ) {
         let (rows, cols, w) = self.metric.block(b);
-        let (left, _) = local.sides(b);
-        // a_sj for each column-side row s of the block (0 when j ∉ row s).
-        let sign_at = |s: usize| {
-            let (unknowns, signs) = self.row(s);
-            unknowns
-                .iter()
-                .position(|&x| x == j)
-                .map(|k| f64::from(signs[k]))
-        };
-        if let ([r], [s]) = (rows, cols) {
-            // One row pair (a diagonal Ω, a face of a two-point flux): the
-            // column is a_r (w a_sj).
-            if let Some(y) = sign_at(*s) {
-                let (unknowns, signs) = self.row(*r);
-                for (&i, &x) in unknowns.iter().zip(signs) {
-                    let wx = w[0] * f64::from(x);
-                    column_values[sorted_position(column, i)] += wx * y;
+        let (left, right) = local.sides(b);
+        // A_S and A_R over the block's own unknowns: (local row, local
+        // unknown, sign), in row order and each row's order.
+        let BlockScratch {
+            column_side,
+            row_side,
+            half,
+        } = scratch;
+        let local_incidence = |a_rows: &[usize], unknowns: &[usize], out: &mut Vec<_>| {
+            out.clear();
+            for (k, &r) in a_rows.iter().enumerate() {
+                let (row_unknowns, signs) = self.row(r);
+                for (&u, &sign) in row_unknowns.iter().zip(signs) {
+                    out.push((k, position(unknowns, u), f64::from(sign)));
                 }
             }
-            return;
-        }
-        // (W A_S)_{·j}, then A_Rᵀ (W A_S)_{·j} over the block's row side.
-        half.clear();
-        half.resize(rows.len(), 0.0);
-        for (si, &s) in cols.iter().enumerate() {
-            if let Some(sign) = sign_at(s) {
+        };
+        local_incidence(cols, right, column_side);
+        local_incidence(rows, left, row_side);
+        for jl in columns {
+            // (W A_S)_{·j}, then A_Rᵀ (W A_S)_{·j}.
+            half.clear();
+            half.resize(rows.len(), 0.0);
+            for &(si, _, sign) in column_side.iter().filter(|e| e.1 == jl) {
                 for (ri, h) in half.iter_mut().enumerate() {
                     *h += w[ri * cols.len() + si] * sign;
                 }
             }
-        }
-        dense.clear();
-        dense.resize(left.len(), 0.0);
-        for (&r, &h) in rows.iter().zip(half.iter()) {
-            let (unknowns, signs) = self.row(r);
-            for (&i, &sign) in unknowns.iter().zip(signs) {
-                dense[position(left, i)] += f64::from(sign) * h;
+            let j = right[jl];
+            let mut dense = [0.0; 16];
+            if left.len() <= dense.len() {
+                for &(ri, il, sign) in row_side.iter() {
+                    dense[il] += sign * half[ri];
+                }
+                for (&i, &v) in left.iter().zip(&dense) {
+                    add(j, i, v);
+                }
+            } else {
+                let mut dense = vec![0.0; left.len()];
+                for &(ri, il, sign) in row_side.iter() {
+                    dense[il] += sign * half[ri];
+                }
+                for (&i, &v) in left.iter().zip(&dense) {
+                    add(j, i, v);
+                }
             }
-        }
-        for (&i, &v) in left.iter().zip(dense.iter()) {
-            column_values[sorted_position(column, i)] += v;
         }
     }
 
@@ -1051,6 +1082,14 @@ impl Canonical {
     pub fn apply(&self, u: &[f64]) -> Vec<f64> {
         self.sum_transpose(&self.flux(u))
     }
+}
+
+/// Scratch of [`Canonical::add_block_columns`], reused from block to block.
+#[derive(Default)]
+struct BlockScratch {
+    column_side: Vec<(usize, usize, f64)>,
+    row_side: Vec<(usize, usize, f64)>,
+    half: Vec<f64>,
 }
 
 /// Index of `x` in the short list `list` (it is there).
@@ -1184,6 +1223,64 @@ mod tests {
             assert!((mu[i] - row).abs() < 1e-14);
         }
         assert!(!omega.is_symmetric(0.0));
+    }
+
+    #[test]
+    fn blocks_numbered_apart_from_their_unknowns_assemble_like_the_dense_product() {
+        // A cycle of 240 unknowns numbered by a stride permutation, one row
+        // (edge) per consecutive pair; blocks of three rows picked by
+        // another stride, some symmetric, some with different row and
+        // column sets. The column ranges' touching blocks are then spread
+        // over the whole block range (the sorted path) for some blocks
+        // and in runs for the others (the 1×1 tail blocks).
+        let n = 240;
+        let label = |k: usize| (k * 7) % n;
+        let (mut indptr, mut indices, mut data) = (vec![0], Vec::new(), Vec::new());
+        for r in 0..n {
+            let (a, b) = (label(r), label((r + 1) % n));
+            let (lo, hi, sign) = if a < b { (a, b, -1i8) } else { (b, a, 1i8) };
+            indices.extend([lo, hi]);
+            data.extend([sign, -sign]);
+            indptr.push(indices.len());
+        }
+        let a = CsMat::new((n, n), indptr, indices, data);
+        let mut omega = BlockMetric::new(n);
+        let value = |b: usize, k: usize| 0.1 + ((b * 31 + k * 17) % 23) as f64 / 7.0;
+        for b in 0..60 {
+            let rows = [(b * 11) % n, (b * 11 + 97) % n, (b * 11 + 181) % n];
+            let mut w = [0.0; 9];
+            for i in 0..3 {
+                for j in 0..=i {
+                    let v = value(b, i * 3 + j) + if i == j { 5.0 } else { 0.0 };
+                    w[i * 3 + j] = v;
+                    w[j * 3 + i] = v;
+                }
+            }
+            if b % 4 == 0 {
+                let cols = [(b * 13 + 5) % n, (b * 13 + 50) % n, (b * 13 + 120) % n];
+                omega.push_block(&rows, &cols, &w);
+            } else {
+                omega.push_symmetric(&rows, &w);
+            }
+        }
+        for r in 0..n {
+            omega.push_block(&[r], &[r], &[1.0 + r as f64 / n as f64]);
+        }
+        let m = Canonical::new(a.clone(), omega.clone())
+            .unwrap()
+            .assemble()
+            .to_dense();
+        let ad = DMatrix::from_fn(n, n, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
+        let omega_dense = omega.to_dense();
+        let od = DMatrix::from_fn(n, n, |i, j| omega_dense[i][j]);
+        let expected = ad.transpose() * od * ad;
+        // Entries are sums of a few products of values below 10: the two
+        // orders of summation agree to a few ulps of 100.
+        for i in 0..n {
+            for j in 0..n {
+                assert!((m[(i, j)] - expected[(i, j)]).abs() < 1e-12, "({i},{j})");
+            }
+        }
     }
 
     #[test]
