@@ -141,13 +141,42 @@ pub fn load(
 ) -> Result<Vec<f64>, MetricError> {
     let top = Topology::new(complex, "FE load")?;
     let n = top.n;
-    let parts = (0..complex.cell_count(n))
-        .into_par_iter()
-        .map(|c| cell_load(&top, c, f))
-        .collect::<Result<Vec<_>, _>>()?;
+    let cells = complex.cell_count(n);
+    // Each cell's shares in one array laid out like the cells' vertex
+    // lists, written in parallel in place; then summed per vertex in cell
+    // order, so the load does not depend on the thread count.
+    let mut offsets = Vec::with_capacity(cells + 1);
+    offsets.push(0);
+    for c in 0..cells {
+        offsets.push(offsets[c] + complex.cell_vertices(n, c).len());
+    }
+    let mut shares = vec![0.0; offsets[cells]];
+    let parts = ranges(cells);
+    let pieces = split_at_ranges(&mut shares, &parts, |c| offsets[c]);
+    // Each part stops at its first bad cell; the parts' errors come back
+    // in cell order, so the first one reported is the first bad cell.
+    parts
+        .par_iter()
+        .zip(pieces)
+        .map(|(range, piece)| {
+            let base = offsets[range.start];
+            for c in range.clone() {
+                cell_load(
+                    &top,
+                    c,
+                    f,
+                    &mut piece[offsets[c] - base..offsets[c + 1] - base],
+                )?;
+            }
+            Ok(())
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect::<Result<(), MetricError>>()?;
     let mut out = crate::canonical::zeroed(complex.cell_count(0));
-    for part in parts {
-        for (v, x) in part {
+    for c in 0..cells {
+        let vertices = complex.cell_vertices(n, c);
+        for (&v, &x) in vertices.iter().zip(&shares[offsets[c]..offsets[c + 1]]) {
             out[v] += x;
         }
     }
@@ -940,17 +969,6 @@ fn q1_shape(xi: &[f64], n: usize) -> (Vec<f64>, Vec<[f64; 3]>) {
     (values, gradients)
 }
 
-/// One Gauss point of a Q1 cell mapped to the physical cell.
-struct GaussPoint {
-    /// Reference weight (1) times |det J|.
-    weight: f64,
-    /// Shape functions, tensor order.
-    values: Vec<f64>,
-    /// Physical shape gradients, tensor order.
-    gradients: Vec<Point>,
-    point: Point,
-}
-
 /// The isoparametric map of a Q1 cell with N = 2ⁿ corners at its N Gauss
 /// points: |det J| (the reference weight is 1) and the physical shape
 /// gradients, both in tensor order. Fixed arrays of the cell's own size:
@@ -998,42 +1016,6 @@ fn q1_map<const N: usize>(x: &[Point], n: usize, cell: usize) -> Result<Q1Map<N>
         }
     }
     Ok(map)
-}
-
-/// Gauss points of a Q1 cell with corners `x` in tensor order, with the
-/// shape values and the mapped point (for loads).
-fn q1_points(x: &[Point], n: usize, cell: usize) -> Result<Vec<GaussPoint>, MetricError> {
-    match n {
-        2 => q1_points_of::<4>(x, n, cell),
-        _ => q1_points_of::<8>(x, n, cell),
-    }
-}
-
-fn q1_points_of<const N: usize>(
-    x: &[Point],
-    n: usize,
-    cell: usize,
-) -> Result<Vec<GaussPoint>, MetricError> {
-    let map = q1_map::<N>(x, n, cell)?;
-    let m = N;
-    Ok(q1_reference(n)
-        .iter()
-        .enumerate()
-        .map(|(q, (values, _))| {
-            let mut point = [0.0; 3];
-            for (xl, &v) in x.iter().zip(values) {
-                for i in 0..n {
-                    point[i] += v * xl[i];
-                }
-            }
-            GaussPoint {
-                weight: map.weights[q],
-                values: values.clone(),
-                gradients: map.gradients[q][..m].to_vec(),
-                point,
-            }
-        })
-        .collect())
 }
 
 /// Shape values and reference gradients at the 2ⁿ Gauss points of
@@ -1126,23 +1108,33 @@ pub(crate) fn shape_gradients(
                 })?;
             Ok(Some(vec![(measure, gradients)]))
         }
-        Element::Q1(order) => {
-            let points = q1_points(&tensor_points(top, c, &order)[..order.len()], top.n, c)?;
-            Ok(Some(
-                points
-                    .into_iter()
-                    .map(|q| {
-                        let mut sorted = vec![[0.0; 3]; order.len()];
-                        for (l, g) in q.gradients.into_iter().enumerate() {
-                            sorted[order[l]] = g;
-                        }
-                        (q.weight, sorted)
-                    })
-                    .collect(),
-            ))
-        }
+        Element::Q1(order) if top.n == 2 => Ok(Some(q1_gradients::<4>(top, c, &order)?)),
+        Element::Q1(order) => Ok(Some(q1_gradients::<8>(top, c, &order)?)),
         Element::Vem => Ok(None),
     }
+}
+
+/// [`shape_gradients`] of a Q1 cell with N = 2ⁿ corners: each Gauss
+/// point's |det J| and physical gradients, moved from tensor order to the
+/// cell's sorted vertex order.
+fn q1_gradients<const N: usize>(
+    top: &Topology,
+    c: usize,
+    order: &TensorOrder,
+) -> Result<Vec<WeightedGradients>, MetricError> {
+    let map = q1_map::<N>(&tensor_points(top, c, order)[..N], top.n, c)?;
+    Ok(map
+        .weights
+        .iter()
+        .zip(&map.gradients)
+        .map(|(&weight, gradients)| {
+            let mut sorted = vec![[0.0; 3]; N];
+            for (&o, g) in order.iter().zip(gradients) {
+                sorted[o] = *g;
+            }
+            (weight, sorted)
+        })
+        .collect())
 }
 
 fn sub(a: &Point, b: &Point) -> Point {
@@ -1304,25 +1296,42 @@ fn vem_stiffness(top: &Topology, c: usize, k: &Tensor) -> Result<DMatrix<f64>, M
 }
 
 /// Barycentric quadrature on the n-simplex: (coordinates, weight / |c|).
-fn simplex_rule(n: usize) -> Vec<(Vec<f64>, f64)> {
-    match n {
+/// Barycentric points (first n + 1 entries) and weights of the P1 load
+/// rule on an n-simplex (module docs of [`load`]); the same for every
+/// cell, so built once per dimension.
+fn simplex_rule(n: usize) -> &'static [([f64; 4], f64)] {
+    type Rule = Vec<([f64; 4], f64)>;
+    static RULES: [std::sync::OnceLock<Rule>; 4] = [
+        std::sync::OnceLock::new(),
+        std::sync::OnceLock::new(),
+        std::sync::OnceLock::new(),
+        std::sync::OnceLock::new(),
+    ];
+    RULES[n.min(3)].get_or_init(|| match n {
         1 => {
             let s = 3f64.sqrt() / 6.0;
-            vec![(vec![0.5 + s, 0.5 - s], 0.5), (vec![0.5 - s, 0.5 + s], 0.5)]
+            vec![
+                ([0.5 + s, 0.5 - s, 0.0, 0.0], 0.5),
+                ([0.5 - s, 0.5 + s, 0.0, 0.0], 0.5),
+            ]
         }
         2 => vec![
-            (vec![0.5, 0.5, 0.0], 1.0 / 3.0),
-            (vec![0.0, 0.5, 0.5], 1.0 / 3.0),
-            (vec![0.5, 0.0, 0.5], 1.0 / 3.0),
+            ([0.5, 0.5, 0.0, 0.0], 1.0 / 3.0),
+            ([0.0, 0.5, 0.5, 0.0], 1.0 / 3.0),
+            ([0.5, 0.0, 0.5, 0.0], 1.0 / 3.0),
         ],
         _ => {
             let root5 = 5f64.sqrt();
             let (a, b) = ((5.0 + 3.0 * root5) / 20.0, (5.0 - root5) / 20.0);
             (0..4)
-                .map(|k| ((0..4).map(|i| if i == k { a } else { b }).collect(), 0.25))
+                .map(|k| {
+                    let mut beta = [b; 4];
+                    beta[k] = a;
+                    (beta, 0.25)
+                })
                 .collect()
         }
-    }
+    })
 }
 
 fn evaluate(
@@ -1339,14 +1348,16 @@ fn evaluate(
     }
 }
 
+/// Cell `c`'s load shares ∫_c f φ_v, written over `out` in the order of
+/// the cell's vertex list.
 fn cell_load(
     top: &Topology,
     c: usize,
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
-) -> Result<Vec<(usize, f64)>, MetricError> {
+    out: &mut [f64],
+) -> Result<(), MetricError> {
     let (n, d) = (top.n, top.d);
-    let vertices = top.complex.cell_vertices(n, c);
-    let mut out: Vec<(usize, f64)> = vertices.iter().map(|&v| (v, 0.0)).collect();
+    out.fill(0.0);
     match top.element(c, Route::ByShape)? {
         Element::P1 => {
             let x = top.points(c);
@@ -1357,36 +1368,54 @@ fn cell_load(
             })?;
             for (beta, w) in simplex_rule(n) {
                 let mut p = [0.0; 3];
-                for (xi, bi) in x.iter().zip(&beta) {
+                for (xi, bi) in x.iter().zip(beta) {
                     for a in 0..3 {
                         p[a] += bi * xi[a];
                     }
                 }
                 let value = w * measure * evaluate(f, &p, d, c)?;
-                for (o, bi) in out.iter_mut().zip(&beta) {
-                    o.1 += value * bi;
+                for (o, bi) in out.iter_mut().zip(beta) {
+                    *o += value * bi;
                 }
             }
         }
-        Element::Q1(order) => {
-            for q in q1_points(&tensor_points(top, c, &order)[..order.len()], n, c)? {
-                let value = q.weight * evaluate(f, &q.point, d, c)?;
-                for (l, v) in q.values.iter().enumerate() {
-                    out[order[l]].1 += value * v;
-                }
-            }
-        }
+        Element::Q1(order) if n == 2 => q1_load::<4>(top, c, &order, f, out)?,
+        Element::Q1(order) => q1_load::<8>(top, c, &order, f, out)?,
         Element::Vem => {
             let measure = top.complex.measure(n)[c];
             let mut p = [0.0; 3];
             p[..d].copy_from_slice(top.complex.centroid_of(n, c));
-            let share = measure * evaluate(f, &p, d, c)? / vertices.len() as f64;
-            for o in &mut out {
-                o.1 = share;
-            }
+            let share = measure * evaluate(f, &p, d, c)? / out.len() as f64;
+            out.fill(share);
         }
     }
-    Ok(out)
+    Ok(())
+}
+
+/// [`cell_load`] of a Q1 cell with N = 2ⁿ corners, tensor Gauss rule.
+fn q1_load<const N: usize>(
+    top: &Topology,
+    c: usize,
+    order: &TensorOrder,
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+    out: &mut [f64],
+) -> Result<(), MetricError> {
+    let (n, d) = (top.n, top.d);
+    let x = tensor_points(top, c, order);
+    let map = q1_map::<N>(&x[..N], n, c)?;
+    for ((values, _), &weight) in q1_reference(n).iter().zip(&map.weights) {
+        let mut point = [0.0; 3];
+        for (xl, &v) in x[..N].iter().zip(values) {
+            for i in 0..n {
+                point[i] += v * xl[i];
+            }
+        }
+        let value = weight * evaluate(f, &point, d, c)?;
+        for (&o, v) in order.iter().zip(values) {
+            out[o] += value * v;
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
