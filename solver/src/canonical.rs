@@ -256,6 +256,20 @@ impl BlockMetric {
         (rows, cols, values)
     }
 
+    /// True when block `b`'s columns are its rows (a square block over
+    /// one set of rows, as every symmetric metric block is).
+    fn rows_are_columns(&self, b: usize) -> bool {
+        match self.blocks.get(b) {
+            // Stored once when pushed or built that way: no compare.
+            Some(block) if block.rows == block.cols => true,
+            Some(_) => {
+                let (rows, cols, _) = self.block(b);
+                rows == cols
+            }
+            None => true,
+        }
+    }
+
     /// Mutable values of block `b` (row-major).
     pub fn block_values_mut(&mut self, b: usize) -> &mut [f64] {
         if self.blocks.is_empty() {
@@ -535,10 +549,7 @@ impl LocalPattern {
         };
         let shared: Vec<bool> = (0..metric.block_count())
             .into_par_iter()
-            .map(|b| {
-                let (r, s, _) = metric.block(b);
-                r == s
-            })
+            .map(|b| metric.rows_are_columns(b))
             .collect();
         let (ptr, unknowns) = compressed_lists(metric.block_count(), |b, out| {
             let (r, s, _) = metric.block(b);
