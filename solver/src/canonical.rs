@@ -1241,9 +1241,9 @@ mod tests {
         // A cycle of 240 unknowns numbered by a stride permutation, one row
         // (edge) per consecutive pair; blocks of three rows picked by
         // another stride, some symmetric, some with different row and
-        // column sets. The column ranges' touching blocks are then spread
-        // over the whole block range (the sorted path) for some blocks
-        // and in runs for the others (the 1×1 tail blocks).
+        // column sets, then a 1×1 block per row. A column range's blocks
+        // are spread over the whole block range, so each range sorts them
+        // (the nodal tests on generated grids take the run path).
         let n = 240;
         let label = |k: usize| (k * 7) % n;
         let (mut indptr, mut indices, mut data) = (vec![0], Vec::new(), Vec::new());
