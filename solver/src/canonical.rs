@@ -657,6 +657,37 @@ pub(crate) fn diagonal_pattern(
     )
 }
 
+/// The pattern of a nodal operator whose every top cell couples all its
+/// vertices (a dense block per cell, or P1 weights on a simplex's edges),
+/// restricted to the vertices with `keep[v]` and renumbered in increasing
+/// order: column k, the k-th kept vertex, holds the kept vertices that
+/// share a top cell with it. `cells_by_vertex` is the vertex star (vertex
+/// × top cell) and `cell_vertices(c)` a top cell's vertices.
+pub(crate) fn clique_pattern<'a>(
+    cells_by_vertex: &CsMat<u8>,
+    cell_vertices: impl Fn(usize) -> &'a [usize] + Sync,
+    keep: &[bool],
+) -> SymbolicSparseColMat<usize> {
+    let mut new_index = vec![usize::MAX; keep.len()];
+    let mut kept = Vec::new();
+    for (v, _) in keep.iter().enumerate().filter(|(_, &k)| k) {
+        new_index[v] = kept.len();
+        kept.push(v);
+    }
+    let (col_ptr, row_idx) = pattern_by_columns(kept.len(), |k, out| {
+        let star = cells_by_vertex.indptr().outer_inds_sz(kept[k]);
+        for &c in &cells_by_vertex.indices()[star] {
+            out.extend(
+                cell_vertices(c)
+                    .iter()
+                    .map(|&u| new_index[u])
+                    .filter(|&i| i != usize::MAX),
+            );
+        }
+    });
+    SymbolicSparseColMat::new_checked(kept.len(), kept.len(), col_ptr, None, row_idx)
+}
+
 /// The pattern of M = Aᵀ Ω A for the way its values are formed.
 fn matrix_pattern(incidence: &CsMat<i8>, assembly: &Assembly) -> SymbolicSparseColMat<usize> {
     let n = incidence.cols();
@@ -1234,6 +1265,28 @@ mod tests {
             assert!((mu[i] - row).abs() < 1e-14);
         }
         assert!(!omega.is_symmetric(0.0));
+    }
+
+    #[test]
+    fn the_clique_pattern_couples_the_kept_vertices_of_each_cell() {
+        // Two quadrilaterals side by side: bottom vertices 0 1 2, top 3 4
+        // 5; cell 0 = {0, 1, 3, 4}, cell 1 = {1, 2, 4, 5}. Vertex 0 is
+        // dropped, so vertices 1..5 become 0..4.
+        let cells = [vec![0, 1, 3, 4], vec![1, 2, 4, 5]];
+        let star = CsMat::new(
+            (6, 2),
+            vec![0, 1, 3, 4, 5, 7, 8],
+            vec![0, 0, 1, 1, 0, 0, 1, 1],
+            vec![1u8; 8],
+        );
+        let keep = [false, true, true, true, true, true];
+        let pattern = clique_pattern(&star, |c| &cells[c][..], &keep);
+        assert_eq!((pattern.nrows(), pattern.ncols()), (5, 5));
+        assert_eq!(pattern.col_ptr(), &[0, 5, 9, 12, 17, 21]);
+        assert_eq!(
+            pattern.row_idx(),
+            &[0, 1, 2, 3, 4, 0, 1, 3, 4, 0, 2, 3, 0, 1, 2, 3, 4, 0, 1, 3, 4]
+        );
     }
 
     #[test]
