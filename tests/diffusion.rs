@@ -738,9 +738,41 @@ fn analysis_beside_the_assembly_gives_the_plain_solution() {
         ),
         ("fv, pure Neumann", neumann, square.clone(), false),
         (
-            "fe (Q1) is not analysed early",
+            "fe (Q1), Dirichlet vertices dropped",
             square_problem(Method::Fe).0,
             square.clone(),
+            true,
+        ),
+        (
+            "fe (Q1), mixed (Robin ghosts)",
+            mixed(Method::Fe),
+            square.clone(),
+            true,
+        ),
+        (
+            "fe (P1), triangles",
+            square_problem(Method::Fe).0,
+            triangles(&[10]).remove(0),
+            true,
+        ),
+        (
+            "fe (Q1), 3D",
+            cube_problem(Method::Fe).0,
+            generate::box3(5, 4, 3, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap(),
+            true,
+        ),
+        (
+            "fe (virtual elements), Voronoi polygons",
+            square_problem(Method::Fe).0,
+            generate::voronoi_with_sites(60, [0.0, 1.0], [0.0, 1.0], 1, 2)
+                .unwrap()
+                .0,
+            true,
+        ),
+        (
+            "dec is not analysed early",
+            square_problem(Method::Dec(DualKind::Circumcentric)).0,
+            triangles(&[10]).remove(0),
             false,
         ),
     ];

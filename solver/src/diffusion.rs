@@ -265,8 +265,9 @@ pub struct Solution {
     pub report: SolveReport,
     pub assembly_seconds: f64,
     /// Whether the direct solve's symbolic analysis ran beside the assembly
-    /// (from M's pattern known from topology), so that its seconds overlap
-    /// `assembly_seconds` instead of adding to them.
+    /// (from the solved matrix's pattern known from topology: two-point
+    /// FV/FD, nodal FE), so that its seconds overlap `assembly_seconds`
+    /// instead of adding to them.
     pub analysed_during_assembly: bool,
     /// Whether the problem was pure Neumann (solution normalised to zero mean).
     pub pure_neumann: bool,
@@ -1051,11 +1052,7 @@ impl Diffusion {
             ..
         } = system;
         let unknowns = rhs.len();
-        let analysis = analysis
-            .filter(|a| fixed.iter().all(Option::is_none) && a.fits(&matrix))
-            .map(|a| a.solver);
-        let analysed_during_assembly = analysis.is_some();
-        let (mut values, report, iterations) = solve_fixed(
+        let (mut values, report, iterations, analysed_during_assembly) = solve_fixed(
             &matrix,
             &rhs,
             &fixed,
@@ -1137,12 +1134,16 @@ impl Diffusion {
         Ok(relative)
     }
 
-    /// Whether M's pattern is known before assembly: for the cell-centred
-    /// two-point methods it is that of ∂ₙᵀ∂ₙ (cells coupled through their
-    /// faces), whatever the conductivity and the boundary conditions, whose
-    /// ghost rows touch one cell each and so add only to the diagonal.
+    /// Whether the solved matrix's pattern is known before assembly. For
+    /// the cell-centred two-point methods it is that of ∂ₙᵀ∂ₙ (cells
+    /// coupled through their faces), whatever the conductivity and the
+    /// boundary conditions, whose ghost rows touch one cell each and so add
+    /// only to the diagonal. For nodal FE every top cell couples all its
+    /// vertices (Q1 and virtual-element blocks over the cell, P1 weights
+    /// on every edge of a simplex), and the Dirichlet vertices, which the
+    /// solve drops, are those of the Dirichlet faces.
     fn pattern_from_topology(&self) -> bool {
-        self.iterative.is_none() && matches!(self.method, Method::Fv | Method::Fd)
+        self.iterative.is_none() && matches!(self.method, Method::Fv | Method::Fd | Method::Fe)
     }
 
     /// The pattern of ∂ₙᵀ∂ₙ and its symbolic analysis for this problem's
@@ -1150,10 +1151,28 @@ impl Diffusion {
     /// then analyses the assembled matrix and reports the failure itself.
     fn analyse_topology(&self, complex: &Complex) -> Option<TopologyAnalysis> {
         let n = complex.dim();
-        let pattern = crate::canonical::diagonal_pattern(
-            &complex.shared_boundary(n),
-            &complex.shared_boundary_csc(n),
-        );
+        let pattern = if self.method == Method::Fe {
+            // A boundary tag that names nothing is reported by the assembly.
+            let faces = self.boundary_faces(complex).ok()?;
+            let mut free = vec![true; complex.cell_count(0)];
+            for &(f, k) in &faces.condition {
+                if matches!(self.boundary[k].kind, BoundaryKind::Dirichlet(_)) {
+                    for &v in complex.cell_vertices(n - 1, f) {
+                        free[v] = false;
+                    }
+                }
+            }
+            crate::canonical::clique_pattern(
+                complex.vertex_star(n),
+                |c| complex.cell_vertices(n, c),
+                &free,
+            )
+        } else {
+            crate::canonical::diagonal_pattern(
+                &complex.shared_boundary(n),
+                &complex.shared_boundary_csc(n),
+            )
+        };
         let solver =
             DirectSolver::analyse_pattern(pattern.as_ref(), self.factorization, self.ordering)
                 .ok()?;
@@ -1371,7 +1390,9 @@ pub fn solve_with_fixed(
     ordering: Ordering,
     iterative: Option<&Iterative>,
 ) -> Result<(Vec<f64>, SolveReport, Option<CgReport>), DiffusionError> {
-    solve_fixed(matrix, rhs, fixed, factorization, ordering, iterative, None)
+    let (values, report, iterations, _) =
+        solve_fixed(matrix, rhs, fixed, factorization, ordering, iterative, None)?;
+    Ok((values, report, iterations))
 }
 
 /// A symbolic analysis made from topology before M was assembled, and the
@@ -1392,9 +1413,10 @@ impl TopologyAnalysis {
     }
 }
 
-/// [`solve_with_fixed`], with an analysis made beforehand (of `matrix`'s
-/// pattern: see [`TopologyAnalysis::fits`]) used by a direct solve when no
-/// unknown is held.
+/// [`solve_with_fixed`], with an analysis made beforehand, used by a
+/// direct solve when it was made for the pattern of the system solved
+/// (the free unknowns' block: see [`TopologyAnalysis::fits`]); the last
+/// value says whether it was.
 fn solve_fixed(
     matrix: &SparseColMat<usize, f64>,
     rhs: &[f64],
@@ -1402,8 +1424,8 @@ fn solve_fixed(
     factorization: Factorization,
     ordering: Ordering,
     iterative: Option<&Iterative>,
-    analysis: Option<DirectSolver>,
-) -> Result<(Vec<f64>, SolveReport, Option<CgReport>), DiffusionError> {
+    analysis: Option<TopologyAnalysis>,
+) -> Result<(Vec<f64>, SolveReport, Option<CgReport>, bool), DiffusionError> {
     let n = rhs.len();
     let mut free_index = vec![usize::MAX; n];
     let mut free = Vec::new();
@@ -1458,7 +1480,7 @@ fn solve_fixed(
             solve_seconds: 0.0,
             relative_residual: 0.0,
         };
-        return Ok((values, report, None));
+        return Ok((values, report, None, false));
     }
     let reduced: std::borrow::Cow<'_, SparseColMat<usize, f64>> = if all_free {
         std::borrow::Cow::Borrowed(matrix)
@@ -1469,13 +1491,13 @@ fn solve_fixed(
         );
         std::borrow::Cow::Owned(SparseColMat::new(symbolic, val))
     };
+    let analysis = analysis.filter(|a| a.fits(&reduced)).map(|a| a.solver);
+    let analysed = analysis.is_some();
     let (x, report, iterations) = match iterative {
         None => {
             let (x, report) = match analysis {
-                Some(analysis) if all_free => {
-                    linear::solve_analysed(&analysis, matrix, &reduced_rhs)?
-                }
-                _ => linear::solve_with(&reduced, &reduced_rhs, factorization, ordering)?,
+                Some(analysis) => linear::solve_analysed(&analysis, &reduced, &reduced_rhs)?,
+                None => linear::solve_with(&reduced, &reduced_rhs, factorization, ordering)?,
             };
             (x, report, None)
         }
@@ -1524,7 +1546,7 @@ fn solve_fixed(
     for (k, &i) in free.iter().enumerate() {
         values[i] = x[k];
     }
-    Ok((values, report, iterations))
+    Ok((values, report, iterations, analysed))
 }
 
 /// Cell-wise gradient of a discrete field, by least squares over the
