@@ -1031,7 +1031,7 @@ impl Diffusion {
         // The analysis reads only M's pattern; when topology alone fixes it,
         // it runs on one thread while the geometry, Ω, the values and the
         // checks are computed on the other.
-        let (prepared, analysis) = if self.pattern_from_topology() {
+        let (prepared, analysis) = if self.pattern_from_topology(complex) {
             rayon::join(prepare, || self.analyse_topology(complex))
         } else {
             (prepare(), None)
@@ -1141,9 +1141,18 @@ impl Diffusion {
     /// only to the diagonal. For nodal FE every top cell couples all its
     /// vertices (Q1 and virtual-element blocks over the cell, P1 weights
     /// on every edge of a simplex), and the Dirichlet vertices, which the
-    /// solve drops, are those of the Dirichlet faces.
-    fn pattern_from_topology(&self) -> bool {
-        self.iterative.is_none() && matches!(self.method, Method::Fv | Method::Fd | Method::Fe)
+    /// solve drops, are those of the Dirichlet faces. So does DEC on a
+    /// simplicial complex, whose edges join every two vertices of a cell.
+    fn pattern_from_topology(&self, complex: &Complex) -> bool {
+        let n = complex.dim();
+        self.iterative.is_none()
+            && match self.method {
+                Method::Fv | Method::Fd | Method::Fe => true,
+                Method::Dec(_) => {
+                    (0..complex.cell_count(n)).all(|c| complex.cell_vertices(n, c).len() == n + 1)
+                }
+                Method::FvMimetic => false,
+            }
     }
 
     /// The pattern of ∂ₙᵀ∂ₙ and its symbolic analysis for this problem's
@@ -1151,15 +1160,28 @@ impl Diffusion {
     /// then analyses the assembled matrix and reports the failure itself.
     fn analyse_topology(&self, complex: &Complex) -> Option<TopologyAnalysis> {
         let n = complex.dim();
-        let pattern = if self.method == Method::Fe {
+        let pattern = if self.location() == Location::Nodal {
             // A boundary tag that names nothing is reported by the assembly.
             let faces = self.boundary_faces(complex).ok()?;
             let mut free = vec![true; complex.cell_count(0)];
+            let mut anchored = false;
             for &(f, k) in &faces.condition {
-                if matches!(self.boundary[k].kind, BoundaryKind::Dirichlet(_)) {
-                    for &v in complex.cell_vertices(n - 1, f) {
-                        free[v] = false;
+                match self.boundary[k].kind {
+                    BoundaryKind::Dirichlet(_) => {
+                        anchored = true;
+                        for &v in complex.cell_vertices(n - 1, f) {
+                            free[v] = false;
+                        }
                     }
+                    BoundaryKind::Robin { .. } => anchored = true,
+                    BoundaryKind::Neumann(_) => {}
+                }
+            }
+            // Without Dirichlet or Robin faces the problem is pure Neumann,
+            // and the solve pins vertex 0 (`make_compatible`).
+            if !anchored {
+                if let Some(first) = free.first_mut() {
+                    *first = false;
                 }
             }
             crate::canonical::clique_pattern(
