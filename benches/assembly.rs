@@ -19,7 +19,6 @@
 //! `--bench` (as under `cargo test --all-targets`) it runs small sizes and
 //! checks the hand-built matrix against hasse's.
 
-use faer::sparse::SparseColMat;
 use hasse_complex::{generate, Complex};
 use hasse_solver::canonical::Canonical;
 use hasse_solver::diffusion::{BoundaryKind, Conductivity, Diffusion, Method};
@@ -30,7 +29,9 @@ use std::time::Instant;
 
 #[path = "common/measure.rs"]
 mod measure;
-use measure::{cpu_and_faults, peak_memory_gib, plain_matrix, seconds};
+use measure::{
+    cpu_and_faults, max_difference, peak_memory_gib, plain_matrix, plain_q1_matrix, seconds,
+};
 
 fn poisson(method: Method) -> Diffusion {
     Diffusion::new(
@@ -42,16 +43,6 @@ fn poisson(method: Method) -> Diffusion {
 }
 
 /// Largest |a − b| over the entries of two matrices with the same pattern.
-fn max_difference(a: &SparseColMat<usize, f64>, b: &SparseColMat<usize, f64>) -> f64 {
-    assert_eq!(a.symbolic().col_ptr(), b.symbolic().col_ptr(), "patterns");
-    assert_eq!(a.symbolic().row_idx(), b.symbolic().row_idx(), "patterns");
-    a.val()
-        .iter()
-        .zip(b.val())
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
-}
-
 fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<usize>) {
     let d = complex.dim();
     // The primal geometry the methods read, computed once per complex and
@@ -109,7 +100,7 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
         // one triplet list of 16 entries per cell.
         let n = (cells as f64).sqrt().round() as usize;
         let t = Instant::now();
-        let hand = plain_q1_matrix(n);
+        let hand = plain_q1_matrix(n, 2);
         let plain_seconds = seconds(t);
         let difference = max_difference(&matrix, &hand);
         // Rounding only: the Gauss points, the mapped gradients and A_c⁺
@@ -140,34 +131,6 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
         );
     }
     println!(" | peak {:.2} GiB", peak_memory_gib());
-}
-
-/// The Q1 stiffness (λ = 1) of an n × n unit grid with vertex i + (n + 1) j
-/// at (i, j)/n, built without hasse from the element matrix of a square,
-/// (1/6)·[4 −1 −1 −2; −1 4 −2 −1; −1 −2 4 −1; −2 −1 −1 4] over its corners
-/// (0, 0), (1, 0), (0, 1), (1, 1): independent of the side in 2D.
-fn plain_q1_matrix(n: usize) -> SparseColMat<usize, f64> {
-    use faer::sparse::Triplet;
-    const ELEMENT: [[f64; 4]; 4] = [
-        [4.0, -1.0, -1.0, -2.0],
-        [-1.0, 4.0, -2.0, -1.0],
-        [-1.0, -2.0, 4.0, -1.0],
-        [-2.0, -1.0, -1.0, 4.0],
-    ];
-    let vertices = (n + 1) * (n + 1);
-    let mut triplets = Vec::with_capacity(16 * n * n);
-    for j in 0..n {
-        for i in 0..n {
-            let v = i + (n + 1) * j;
-            let corners = [v, v + 1, v + n + 1, v + n + 2];
-            for (a, &va) in corners.iter().enumerate() {
-                for (b, &vb) in corners.iter().enumerate() {
-                    triplets.push(Triplet::new(va, vb, ELEMENT[a][b] / 6.0));
-                }
-            }
-        }
-    }
-    SparseColMat::try_new_from_triplets(vertices, vertices, &triplets).expect("valid triplets")
 }
 
 fn elasticity_case(label: &str, complex: &Complex) {

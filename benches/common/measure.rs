@@ -1,6 +1,6 @@
 //! What the benchmarks share: wall time, the process's peak memory and the
-//! cell-centred Poisson matrix built by hand (the baseline hasse's assembly
-//! is measured against). Include it with
+//! Poisson matrices built by hand (cell-centred and nodal Q1, the baselines
+//! hasse's assembly is measured against). Include it with
 //! `#[path = "common/measure.rs"] mod measure;`.
 
 // Each benchmark uses its own subset.
@@ -74,4 +74,58 @@ pub fn plain_matrix(n: usize, d: usize) -> SparseColMat<usize, f64> {
         triplets.push(Triplet::new(c, c, diagonal));
     }
     SparseColMat::try_new_from_triplets(cells, cells, &triplets).expect("valid triplets")
+}
+
+/// The Q1 stiffness (λ = 1) of an n^d unit grid (d = 2, 3) with vertex
+/// i + (n + 1) j (+ (n + 1)² k) at (i, j, k)/n, built without hasse from
+/// the element matrix of a square or cube of side h, whose entry between
+/// corners that differ in m coordinates is, in 2D, 2/3, −1/6, −1/3 for
+/// m = 0, 1, 2 (independent of h), and in 3D h/3, 0, −h/12, −h/12 for
+/// m = 0, 1, 2, 3 (∫∇φ_a·∇φ_b of the products of hat functions).
+pub fn plain_q1_matrix(n: usize, d: usize) -> SparseColMat<usize, f64> {
+    let h = 1.0 / n as f64;
+    let entry: Vec<f64> = if d == 2 {
+        vec![2.0 / 3.0, -1.0 / 6.0, -1.0 / 3.0]
+    } else {
+        vec![h / 3.0, 0.0, -h / 12.0, -h / 12.0]
+    };
+    let side = n + 1;
+    let vertices = side.pow(d as u32);
+    let corners = 1usize << d;
+    let stride: Vec<usize> = (0..d).map(|a| side.pow(a as u32)).collect();
+    let cells = n.pow(d as u32);
+    let mut triplets = Vec::with_capacity(cells * corners * corners);
+    for c in 0..cells {
+        // The cell's lowest corner, then the others by bit pattern.
+        let base: usize = (0..d)
+            .map(|a| ((c / n.pow(a as u32)) % n) * stride[a])
+            .sum();
+        let corner = |l: usize| -> usize {
+            base + (0..d)
+                .filter(|a| l >> a & 1 == 1)
+                .map(|a| stride[a])
+                .sum::<usize>()
+        };
+        for a in 0..corners {
+            for b in 0..corners {
+                // Zeros too (3D edge neighbours): the pattern is the
+                // cells' vertex cliques, as hasse's.
+                let value = entry[(a ^ b).count_ones() as usize];
+                triplets.push(Triplet::new(corner(a), corner(b), value));
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(vertices, vertices, &triplets).expect("valid triplets")
+}
+
+/// Largest entry-wise difference of two matrices with the same pattern
+/// (asserted).
+pub fn max_difference(a: &SparseColMat<usize, f64>, b: &SparseColMat<usize, f64>) -> f64 {
+    assert_eq!(a.symbolic().col_ptr(), b.symbolic().col_ptr(), "patterns");
+    assert_eq!(a.symbolic().row_idx(), b.symbolic().row_idx(), "patterns");
+    a.val()
+        .iter()
+        .zip(b.val())
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
