@@ -143,13 +143,12 @@ pub fn load(
     let n = top.n;
     let cells = complex.cell_count(n);
     // Each cell's shares in one array laid out like the cells' vertex
-    // lists, written in parallel in place; then summed per vertex in cell
-    // order, so the load does not depend on the thread count.
-    let mut offsets = Vec::with_capacity(cells + 1);
-    offsets.push(0);
-    for c in 0..cells {
-        offsets.push(offsets[c] + complex.cell_vertices(n, c).len());
-    }
+    // lists (the characteristic matrix M_n), written in parallel in place;
+    // then summed per vertex in cell order, so the load does not depend
+    // on the thread count.
+    let characteristic = complex.lar().characteristic(n)?;
+    let indptr = characteristic.indptr();
+    let offsets = indptr.to_proper();
     let mut shares = vec![0.0; offsets[cells]];
     let parts = ranges(cells);
     let pieces = split_at_ranges(&mut shares, &parts, |c| offsets[c]);
@@ -174,11 +173,8 @@ pub fn load(
         .into_iter()
         .collect::<Result<(), MetricError>>()?;
     let mut out = crate::canonical::zeroed(complex.cell_count(0));
-    for c in 0..cells {
-        let vertices = complex.cell_vertices(n, c);
-        for (&v, &x) in vertices.iter().zip(&shares[offsets[c]..offsets[c + 1]]) {
-            out[v] += x;
-        }
+    for (&v, &x) in characteristic.indices().iter().zip(&shares) {
+        out[v] += x;
     }
     Ok(out)
 }
@@ -855,7 +851,8 @@ fn edge_block(
 }
 
 /// Ω_c of a Q1 cell with N = 2ⁿ corners and E edges (n = 2: 4, 4; n = 3:
-/// 8, 12) into `scratch.omega`, over its sorted edges (`scratch.edges`):
+/// 8, 12) into `scratch.omega`, over its sorted edges (`scratch.edges`,
+/// left there by the element lookup that found the tensor order):
 /// K_c from the 2ⁿ Gauss points, then (A_c⁺)ᵀ K_c A_c⁺ as in
 /// [`edge_block`], in fixed arrays, with A_c's pattern taken from the
 /// tensor order (no second walk of the edges).
@@ -931,7 +928,9 @@ fn q1_block<const N: usize, const E: usize>(
             cell: c,
         });
     }
-    top.edges_into(c, &mut scratch.edges);
+    // The sorted edges are already in `scratch.edges`: the tensor order
+    // was found from them (`Topology::element_with`).
+    debug_assert_eq!(scratch.edges, top.edges_of(c));
     Ok(())
 }
 
@@ -1295,10 +1294,9 @@ fn vem_stiffness(top: &Topology, c: usize, k: &Tensor) -> Result<DMatrix<f64>, M
     Ok(consistency + residual.transpose() * residual * alpha)
 }
 
-/// Barycentric quadrature on the n-simplex: (coordinates, weight / |c|).
-/// Barycentric points (first n + 1 entries) and weights of the P1 load
-/// rule on an n-simplex (module docs of [`load`]); the same for every
-/// cell, so built once per dimension.
+/// Barycentric quadrature on the n-simplex, (coordinates, weight / |c|)
+/// with the coordinates in the first n + 1 entries: the P1 rules of
+/// [`load`], the same for every cell, so built once per dimension.
 fn simplex_rule(n: usize) -> &'static [([f64; 4], f64)] {
     type Rule = Vec<([f64; 4], f64)>;
     static RULES: [std::sync::OnceLock<Rule>; 4] = [
