@@ -1049,11 +1049,13 @@ impl Canonical {
         let (rows, cols, w) = self.metric.block(b);
         let (left, right) = local.sides(b);
         // A_S and A_R over the block's own unknowns: (local row, local
-        // unknown, sign), in row order and each row's order.
+        // unknown, sign), in row order and each row's order; one list when
+        // the block's rows are its columns.
         let BlockScratch {
             column_side,
             row_side,
             half,
+            dense,
         } = scratch;
         let local_incidence = |a_rows: &[usize], unknowns: &[usize], out: &mut Vec<_>| {
             out.clear();
@@ -1065,7 +1067,21 @@ impl Canonical {
             }
         };
         local_incidence(cols, right, column_side);
-        local_incidence(rows, left, row_side);
+        let row_side: &[(usize, usize, f64)] = if local.shared[b] {
+            column_side
+        } else {
+            local_incidence(rows, left, row_side);
+            row_side
+        };
+        // A_Rᵀ (W A_S)_{·j} on the stack when the block is small (every
+        // FE cell), else in the scratch.
+        let mut stack = [0.0; 16];
+        let dense: &mut [f64] = if left.len() <= stack.len() {
+            &mut stack[..left.len()]
+        } else {
+            dense.resize(left.len(), 0.0);
+            dense
+        };
         for jl in columns {
             // (W A_S)_{·j}, then A_Rᵀ (W A_S)_{·j}.
             half.clear();
@@ -1075,23 +1091,12 @@ impl Canonical {
                     *h += w[ri * cols.len() + si] * sign;
                 }
             }
-            let j = right[jl];
-            let mut dense = [0.0; 16];
-            if left.len() <= dense.len() {
-                for &(ri, il, sign) in row_side.iter() {
-                    dense[il] += sign * half[ri];
-                }
-                for (&i, &v) in left.iter().zip(&dense) {
-                    add(j, i, v);
-                }
-            } else {
-                let mut dense = vec![0.0; left.len()];
-                for &(ri, il, sign) in row_side.iter() {
-                    dense[il] += sign * half[ri];
-                }
-                for (&i, &v) in left.iter().zip(&dense) {
-                    add(j, i, v);
-                }
+            dense.fill(0.0);
+            for &(ri, il, sign) in row_side {
+                dense[il] += sign * half[ri];
+            }
+            for (&i, &v) in left.iter().zip(dense.iter()) {
+                add(right[jl], i, v);
             }
         }
     }
@@ -1132,6 +1137,7 @@ struct BlockScratch {
     column_side: Vec<(usize, usize, f64)>,
     row_side: Vec<(usize, usize, f64)>,
     half: Vec<f64>,
+    dense: Vec<f64>,
 }
 
 /// Index of `x` in the short list `list` (it is there).
