@@ -1155,9 +1155,14 @@ impl Diffusion {
             }
     }
 
-    /// The pattern of ∂ₙᵀ∂ₙ and its symbolic analysis for this problem's
-    /// factorisation and ordering. `None` when the analysis fails: the solve
-    /// then analyses the assembled matrix and reports the failure itself.
+    /// The pattern the solve will factorise, predicted from topology (see
+    /// [`Diffusion::pattern_from_topology`]: ∂ₙᵀ∂ₙ cell-centred, the free
+    /// vertices' cell cliques nodal), and its symbolic analysis for this
+    /// problem's factorisation and ordering. The nodal prediction restates
+    /// which vertices the boundary data and `make_compatible` hold; the
+    /// solve uses it only where it matches entry for entry. `None` when the
+    /// analysis fails: the solve then analyses the assembled matrix and
+    /// reports the failure itself.
     fn analyse_topology(&self, complex: &Complex) -> Option<TopologyAnalysis> {
         let n = complex.dim();
         let pattern = if self.location() == Location::Nodal {
