@@ -1463,34 +1463,14 @@ fn solve_fixed(
         }
     }
     let mut reduced_rhs: Vec<f64> = free.iter().map(|&i| rhs[i]).collect();
-    // The free block, column by column: renumbering keeps the order of the
-    // rows, so the CSC invariants of `matrix` carry over and no sort is
-    // needed. Without fixed unknowns the matrix is used as it is.
-    let mut col_ptr = Vec::with_capacity(free.len() + 1);
-    let mut row_idx = Vec::new();
-    let mut val = Vec::new();
-    col_ptr.push(0);
-    let all_free = free.len() == n;
-    for (j, held) in fixed.iter().enumerate().take(n) {
-        let range = matrix.col_range(j);
-        let rows = &matrix.row_idx()[range.clone()];
-        let vals = &matrix.val()[range];
-        match *held {
-            None if all_free => {}
-            None => {
-                for (&i, &v) in rows.iter().zip(vals) {
-                    if free_index[i] != usize::MAX {
-                        row_idx.push(free_index[i]);
-                        val.push(v);
-                    }
-                }
-                col_ptr.push(row_idx.len());
-            }
-            Some(g) => {
-                for (&i, &v) in rows.iter().zip(vals) {
-                    if free_index[i] != usize::MAX {
-                        reduced_rhs[free_index[i]] -= v * g;
-                    }
+    // b_f −= M_fd g, column after column of the fixed unknowns.
+    for (j, g) in fixed.iter().enumerate().take(n) {
+        if let Some(g) = *g {
+            let range = matrix.col_range(j);
+            let rows = &matrix.row_idx()[range.clone()];
+            for (&i, &v) in rows.iter().zip(&matrix.val()[range]) {
+                if free_index[i] != usize::MAX {
+                    reduced_rhs[free_index[i]] -= v * g;
                 }
             }
         }
@@ -1509,14 +1489,11 @@ fn solve_fixed(
         };
         return Ok((values, report, None, false));
     }
-    let reduced: std::borrow::Cow<'_, SparseColMat<usize, f64>> = if all_free {
+    // Without fixed unknowns the matrix is used as it is.
+    let reduced: std::borrow::Cow<'_, SparseColMat<usize, f64>> = if free.len() == n {
         std::borrow::Cow::Borrowed(matrix)
     } else {
-        let size = free.len();
-        let symbolic = faer::sparse::SymbolicSparseColMat::new_unsorted_checked(
-            size, size, col_ptr, None, row_idx,
-        );
-        std::borrow::Cow::Owned(SparseColMat::new(symbolic, val))
+        std::borrow::Cow::Owned(free_block(matrix, &free, &free_index))
     };
     let analysis = analysis.filter(|a| a.fits(&reduced)).map(|a| a.solver);
     let analysed = analysis.is_some();
@@ -1574,6 +1551,55 @@ fn solve_fixed(
         values[i] = x[k];
     }
     Ok((values, report, iterations, analysed))
+}
+
+/// The block of `matrix` on the unknowns `free` (increasing), whose new
+/// indices are `free_index` (`usize::MAX` for the others). Renumbering keeps
+/// the order of the rows, so the CSC invariants of `matrix` carry over and
+/// nothing is sorted; the columns are copied in parallel ranges, each
+/// counted and then written in place (see `canonical::compressed_lists`).
+fn free_block(
+    matrix: &SparseColMat<usize, f64>,
+    free: &[usize],
+    free_index: &[usize],
+) -> SparseColMat<usize, f64> {
+    let kept_rows = |j: usize| {
+        let range = matrix.col_range(j);
+        matrix.row_idx()[range.clone()]
+            .iter()
+            .zip(&matrix.val()[range])
+            .filter(|(&i, _)| free_index[i] != usize::MAX)
+            .map(|(&i, &v)| (free_index[i], v))
+    };
+    let size = free.len();
+    let parts = crate::canonical::ranges(size);
+    let mut col_ptr = vec![0usize; size + 1];
+    let counts = crate::canonical::split_at_ranges(&mut col_ptr[1..], &parts, |k| k);
+    parts.par_iter().zip(counts).for_each(|(range, counts)| {
+        for (k, count) in range.clone().zip(counts) {
+            *count = kept_rows(free[k]).count();
+        }
+    });
+    for k in 0..size {
+        col_ptr[k + 1] += col_ptr[k];
+    }
+    let mut row_idx = vec![0usize; col_ptr[size]];
+    let mut val = vec![0.0; col_ptr[size]];
+    let row_pieces = crate::canonical::split_at_ranges(&mut row_idx, &parts, |k| col_ptr[k]);
+    let val_pieces = crate::canonical::split_at_ranges(&mut val, &parts, |k| col_ptr[k]);
+    parts
+        .par_iter()
+        .zip(row_pieces.into_par_iter().zip(val_pieces))
+        .for_each(|(range, (rows_out, vals_out))| {
+            let slots = rows_out.iter_mut().zip(vals_out.iter_mut());
+            let entries = range.clone().flat_map(|k| kept_rows(free[k]));
+            for ((row, value), (i, v)) in slots.zip(entries) {
+                *row = i;
+                *value = v;
+            }
+        });
+    let symbolic = SymbolicSparseColMat::new_checked(size, size, col_ptr, None, row_idx);
+    SparseColMat::new(symbolic, val)
 }
 
 /// Cell-wise gradient of a discrete field, by least squares over the
@@ -1844,4 +1870,42 @@ pub fn conservation_residual(
             out - source(&centre[c * d..(c + 1) * d]) * volume[c]
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::Triplet;
+
+    #[test]
+    fn the_free_block_drops_fixed_rows_and_columns_in_order() {
+        // A 4×4 matrix with entry (i, j) = 10 i + j + 1 on its pattern
+        // (every entry but (0, 3) and (3, 0)); unknowns 1 and 2 fixed.
+        // The free block on {0, 3}, renumbered 0 and 1, keeps (0, 0) = 1
+        // and (3, 3) = 34, and nothing between them.
+        let mut entries = Vec::new();
+        for j in 0..4 {
+            for i in 0..4 {
+                if (i, j) != (0, 3) && (i, j) != (3, 0) {
+                    entries.push(Triplet::new(i, j, (10 * i + j + 1) as f64));
+                }
+            }
+        }
+        let m = SparseColMat::try_new_from_triplets(4, 4, &entries).unwrap();
+        let free = [0, 3];
+        let free_index = [0, usize::MAX, usize::MAX, 1];
+        let block = free_block(&m, &free, &free_index);
+        assert_eq!(block.col_ptr(), [0, 1, 2]);
+        assert_eq!(block.row_idx(), [0, 1]);
+        assert_eq!(block.val(), [1.0, 34.0]);
+        // Only unknown 1 fixed: column 0 keeps rows 0 and 2 (renumbered 0
+        // and 1; (3, 0) is not stored), column 2 rows 0, 2, 3, column 3
+        // rows 2 and 3.
+        let free = [0, 2, 3];
+        let free_index = [0, usize::MAX, 1, 2];
+        let block = free_block(&m, &free, &free_index);
+        assert_eq!(block.col_ptr(), [0, 2, 5, 7]);
+        assert_eq!(block.row_idx(), [0, 1, 0, 1, 2, 1, 2]);
+        assert_eq!(block.val(), [1.0, 21.0, 3.0, 23.0, 33.0, 24.0, 34.0]);
+    }
 }
