@@ -18,6 +18,11 @@
 //!   solve, fluxes and checks), timed whole.
 //! - `plain`: the same 5/7-point matrix built by hand as triplets and
 //!   factorised with faer's own LLᵀ (AMD ordering), without hasse.
+//! - `q1-solve`: complex, then nodal Q1 `Diffusion::solve` (u = 0 on the
+//!   boundary vertices), timed whole, as `solve` for the cell-centred one.
+//! - `q1-plain`: the Q1 stiffness on the interior vertices built by hand
+//!   from the element matrix of the square or cube, factorised with faer's
+//!   own LLᵀ (AMD ordering), without hasse.
 //! - `amd`, `nd`: the hand-built matrix factorised through hasse's
 //!   `DirectSolver` with the AMD or the nested-dissection (METIS) ordering:
 //!   analysis, factorisation, solve, factor entries and peak memory.
@@ -74,7 +79,7 @@ use std::time::Instant;
 
 #[path = "common/measure.rs"]
 mod measure;
-use measure::{peak_memory_gib, plain_matrix, seconds};
+use measure::{peak_memory_gib, plain_matrix, plain_q1_matrix, seconds};
 
 /// (dimension, cells per axis) of a case name such as `3d-100`.
 fn parse_case(case: &str) -> Option<(usize, usize)> {
@@ -205,6 +210,38 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 relative_residual(matrix.as_ref(), &x, &rhs)
             )
         }
+        "q1-solve" => {
+            let t = Instant::now();
+            let complex = mesh(d, n);
+            let complex_s = seconds(t);
+            let t = Instant::now();
+            let solution = nodal_problem(Method::Fe).solve(&complex).expect("solve");
+            let whole_s = seconds(t);
+            let report = &solution.report;
+            format!(
+                "unknowns={} ordering={} complex={complex_s:.3} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} residual={:.2e}",
+                report.unknowns,
+                short_name(report.ordering),
+                solution.assembly_seconds,
+                report.symbolic_seconds,
+                report.numeric_seconds,
+                report.solve_seconds,
+                solution.analysed_during_assembly,
+                report.relative_residual
+            )
+        }
+        "q1-plain" => {
+            let t = Instant::now();
+            let matrix = interior_block(&plain_q1_matrix(n, d), n, d);
+            let build_s = seconds(t);
+            let rhs = vec![1.0 / n.pow(d as u32) as f64; matrix.nrows()];
+            let (x, factor_s, solve_s) = plain_faer_llt(&matrix, &rhs);
+            format!(
+                "unknowns={} assembly={build_s:.3} factor={factor_s:.3} solve={solve_s:.3} residual={:.2e}",
+                rhs.len(),
+                relative_residual(matrix.as_ref(), &x, &rhs)
+            )
+        }
         "amd" | "nd" => {
             let matrix = plain_matrix(n, d);
             let rhs = plain_rhs(&matrix, n, d);
@@ -218,7 +255,7 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             format!("file={path}.mtx")
         }
         other => {
-            panic!("unknown phase {other}: mg, mg-pc, direct, solve, plain, amd, nd or export")
+            panic!("unknown phase {other}: mg, mg-pc, direct, solve, plain, q1-solve, q1-plain, amd, nd or export")
         }
     };
     format!(
@@ -226,6 +263,31 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
         seconds(started),
         peak_memory_gib()
     )
+}
+
+/// The block of a matrix on the (n + 1)^d grid vertices (numbered as in
+/// `plain_q1_matrix`) off the boundary, renumbered in increasing order, as
+/// the solve keeps it after dropping the Dirichlet vertices.
+fn interior_block(m: &SparseColMat<usize, f64>, n: usize, d: usize) -> SparseColMat<usize, f64> {
+    let side = n + 1;
+    let mut index = vec![usize::MAX; m.nrows()];
+    let mut free = 0;
+    for (v, slot) in index.iter_mut().enumerate() {
+        if (0..d).all(|a| (1..n).contains(&(v / side.pow(a as u32) % side))) {
+            *slot = free;
+            free += 1;
+        }
+    }
+    let mut triplets = Vec::with_capacity(m.compute_nnz());
+    for j in (0..m.ncols()).filter(|&j| index[j] != usize::MAX) {
+        let range = m.col_range(j);
+        for (&i, &v) in m.row_idx()[range.clone()].iter().zip(&m.val()[range]) {
+            if index[i] != usize::MAX {
+                triplets.push(Triplet::new(index[i], index[j], v));
+            }
+        }
+    }
+    SparseColMat::try_new_from_triplets(free, free, &triplets).expect("valid triplets")
 }
 
 /// b = h^d: the load of f = 1 on a cell.
@@ -308,6 +370,13 @@ fn write_vector_market(path: &str, v: &[f64]) -> std::io::Result<()> {
     f.flush()
 }
 
+/// Every phase of a structured grid case, in the order they run.
+const GRID_PHASES: [&str; 9] = [
+    "mg", "mg-pc", "direct", "solve", "plain", "q1-solve", "q1-plain", "amd", "nd",
+];
+/// Every phase of a Delaunay case.
+const DELAUNAY_PHASES: [&str; 7] = ["check", "amg", "dec", "direct", "plain", "amd", "nd"];
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let positional: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
@@ -320,14 +389,8 @@ fn main() {
     let env = |k: &str| std::env::var(k).is_ok_and(|v| v == "1");
     let mut cases: Vec<(&str, Vec<&str>)> = if benching {
         vec![
-            (
-                "2d-1000",
-                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
-            ),
-            (
-                "3d-60",
-                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
-            ),
+            ("2d-1000", GRID_PHASES.to_vec()),
+            ("3d-60", GRID_PHASES.to_vec()),
             (
                 "3d-100",
                 if env("HASSE_BENCH_DIRECT_100") {
@@ -336,32 +399,17 @@ fn main() {
                     vec!["mg", "mg-pc"]
                 },
             ),
-            (
-                "delaunay-1m",
-                vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"],
-            ),
+            ("delaunay-1m", DELAUNAY_PHASES.to_vec()),
         ]
     } else {
         vec![
-            (
-                "2d-64",
-                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
-            ),
-            (
-                "3d-16",
-                vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
-            ),
-            (
-                "delaunay-20k",
-                vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"],
-            ),
+            ("2d-64", GRID_PHASES.to_vec()),
+            ("3d-16", GRID_PHASES.to_vec()),
+            ("delaunay-20k", DELAUNAY_PHASES.to_vec()),
         ]
     };
     if benching && env("HASSE_BENCH_LARGE") {
-        cases.push((
-            "2d-2000",
-            vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"],
-        ));
+        cases.push(("2d-2000", GRID_PHASES.to_vec()));
     }
     // HASSE_BENCH_CASES="delaunay-1m 3d-60" runs only these cases, with
     // the listed phases, or all phases of their kind for other sizes.
@@ -376,9 +424,9 @@ fn main() {
                     .cloned()
                     .unwrap_or_else(|| {
                         let phases = if parse_delaunay(name).is_some() {
-                            vec!["check", "amg", "dec", "direct", "plain", "amd", "nd"]
+                            DELAUNAY_PHASES.to_vec()
                         } else {
-                            vec!["mg", "mg-pc", "direct", "solve", "plain", "amd", "nd"]
+                            GRID_PHASES.to_vec()
                         };
                         (name, phases)
                     })

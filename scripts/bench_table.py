@@ -1,7 +1,8 @@
 """Turn the `RESULT case phase key=value ...` lines of benches/multigrid.rs
 and scripts/pyamg_baseline.py (stdin) into one table: hasse next to its
 baseline, with the ratio hasse / baseline (below 1: hasse is faster or
-smaller). Structured cases (phases mg, mg-pc, direct, solve, plain, amd, nd) and
+smaller). Structured cases (phases mg, mg-pc, direct, solve, plain, q1-solve,
+q1-plain, amd, nd) and
 Delaunay cases (phases amg, dec, direct, plain, amd, nd, check) get their own
 rows; a failed phase shows as — in its rows."""
 import sys
@@ -125,6 +126,15 @@ for case in runs:
     if whole:
         beside = " (analysis beside assembly)" if whole.get("beside") == "true" else ""
         rows.append((label, f"whole Diffusion::solve{beside}", fmt(num(whole, "whole")), "plain faer LLᵀ analysis+factorisation", fmt(num(plain, "factor")), ratio(num(whole, "whole"), num(plain, "factor"))))
+    q1, q1_plain = r.get("q1-solve", {}), r.get("q1-plain", {})
+    if q1 or q1_plain:
+        beside = " (analysis beside assembly)" if q1.get("beside") == "true" else ""
+        q1_label = f"{case} Q1 ({q1.get('unknowns') or q1_plain.get('unknowns') or '?'})"
+        rows.append((q1_label, f"nodal Q1 whole Diffusion::solve{beside}", fmt(num(q1, "whole")), "plain faer LLᵀ analysis+factorisation", fmt(num(q1_plain, "factor")), ratio(num(q1, "whole"), num(q1_plain, "factor"))))
+        rows.append((q1_label, "  assembly (geometry, Ω, AᵀΩA, b)", fmt(num(q1, "assembly")), "plain Q1 triplets", fmt(num(q1_plain, "assembly")), ratio(num(q1, "assembly"), num(q1_plain, "assembly"))))
+        rows.append((q1_label, f"  LLᵀ analysis + numeric ({ORDERING.get(q1.get('ordering'), '?')})", fmt(add(num(q1, "analysis"), num(q1, "numeric"))), "plain faer LLᵀ (AMD)", fmt(num(q1_plain, "factor")), ratio(add(num(q1, "analysis"), num(q1, "numeric")), num(q1_plain, "factor"))))
+        rows.append((q1_label, "  assembly against its own LLᵀ", fmt(num(q1, "assembly")), "hasse LLᵀ analysis + numeric", fmt(add(num(q1, "analysis"), num(q1, "numeric"))), ratio(num(q1, "assembly"), add(num(q1, "analysis"), num(q1, "numeric")))))
+        rows.append((q1_label, "  peak memory", fmt(num(q1, "peak_gib"), "GiB"), "plain faer process", fmt(num(q1_plain, "peak_gib"), "GiB"), ratio(num(q1, "peak_gib"), num(q1_plain, "peak_gib"))))
     mg_setup, mg_solve = num(mg, "setup"), num(mg, "solve")
     mg_total = None if mg_setup is None else mg_setup + mg_solve
     amg_total = None if num(amg, "setup") is None else num(amg, "setup") + num(amg, "solve")
