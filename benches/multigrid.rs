@@ -176,46 +176,18 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 relative_residual(system.matrix.as_ref(), &x, &system.rhs)
             )
         }
-        "solve" => {
+        "solve" | "q1-solve" => {
             // Diffusion::solve as a case file runs it: assembly with the
             // analysis beside it, factorisation, solve, fluxes and checks.
             let t = Instant::now();
             let complex = mesh(d, n);
             let complex_s = seconds(t);
+            let problem = match phase {
+                "solve" => problem(),
+                _ => nodal_problem(Method::Fe),
+            };
             let t = Instant::now();
-            let solution = problem().solve(&complex).expect("solve");
-            let whole_s = seconds(t);
-            let report = &solution.report;
-            format!(
-                "unknowns={} ordering={} complex={complex_s:.3} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} residual={:.2e}",
-                solution.values.len(),
-                short_name(report.ordering),
-                solution.assembly_seconds,
-                report.symbolic_seconds,
-                report.numeric_seconds,
-                report.solve_seconds,
-                solution.analysed_during_assembly,
-                report.relative_residual
-            )
-        }
-        "plain" => {
-            let t = Instant::now();
-            let matrix = plain_matrix(n, d);
-            let build_s = seconds(t);
-            let rhs = plain_rhs(&matrix, n, d);
-            let (x, factor_s, solve_s) = plain_faer_llt(&matrix, &rhs);
-            format!(
-                "unknowns={} assembly={build_s:.3} factor={factor_s:.3} solve={solve_s:.3} residual={:.2e}",
-                rhs.len(),
-                relative_residual(matrix.as_ref(), &x, &rhs)
-            )
-        }
-        "q1-solve" => {
-            let t = Instant::now();
-            let complex = mesh(d, n);
-            let complex_s = seconds(t);
-            let t = Instant::now();
-            let solution = nodal_problem(Method::Fe).solve(&complex).expect("solve");
+            let solution = problem.solve(&complex).expect("solve");
             let whole_s = seconds(t);
             let report = &solution.report;
             format!(
@@ -230,11 +202,14 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 report.relative_residual
             )
         }
-        "q1-plain" => {
+        "plain" | "q1-plain" => {
             let t = Instant::now();
-            let matrix = interior_block(&plain_q1_matrix(n, d), n, d);
+            let matrix = match phase {
+                "plain" => plain_matrix(n, d),
+                _ => interior_block(&plain_q1_matrix(n, d), n, d),
+            };
             let build_s = seconds(t);
-            let rhs = vec![1.0 / n.pow(d as u32) as f64; matrix.nrows()];
+            let rhs = plain_rhs(&matrix, n, d);
             let (x, factor_s, solve_s) = plain_faer_llt(&matrix, &rhs);
             format!(
                 "unknowns={} assembly={build_s:.3} factor={factor_s:.3} solve={solve_s:.3} residual={:.2e}",
@@ -290,7 +265,8 @@ fn interior_block(m: &SparseColMat<usize, f64>, n: usize, d: usize) -> SparseCol
     SparseColMat::try_new_from_triplets(free, free, &triplets).expect("valid triplets")
 }
 
-/// b = h^d: the load of f = 1 on a cell.
+/// b = h^d: the load of f = 1 on a cell, and on an interior vertex of
+/// the Q1 grid (a 2^−d share of each of its 2^d cells).
 fn plain_rhs(matrix: &SparseColMat<usize, f64>, n: usize, d: usize) -> Vec<f64> {
     vec![1.0 / n.pow(d as u32) as f64; matrix.nrows()]
 }
