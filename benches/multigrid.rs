@@ -253,6 +253,16 @@ fn interior_block(m: &SparseColMat<usize, f64>, n: usize, d: usize) -> SparseCol
             free += 1;
         }
     }
+    block_on(m, &index, free)
+}
+
+/// The block of `m` on the unknowns with `index[i] != usize::MAX`, which
+/// are numbered `index[i]` in it (`size` of them).
+fn block_on(
+    m: &SparseColMat<usize, f64>,
+    index: &[usize],
+    size: usize,
+) -> SparseColMat<usize, f64> {
     let mut triplets = Vec::with_capacity(m.compute_nnz());
     for j in (0..m.ncols()).filter(|&j| index[j] != usize::MAX) {
         let range = m.col_range(j);
@@ -262,7 +272,7 @@ fn interior_block(m: &SparseColMat<usize, f64>, n: usize, d: usize) -> SparseCol
             }
         }
     }
-    SparseColMat::try_new_from_triplets(free, free, &triplets).expect("valid triplets")
+    SparseColMat::try_new_from_triplets(size, size, &triplets).expect("valid triplets")
 }
 
 /// b = h^d: the load of f = 1 on a cell, and on an interior vertex of
@@ -551,18 +561,7 @@ fn free_block(system: &Assembled) -> (SparseColMat<usize, f64>, Vec<f64>) {
             rhs.push(system.rhs[i]);
         }
     }
-    let m = &system.matrix;
-    let mut triplets = Vec::with_capacity(m.compute_nnz());
-    for j in (0..m.ncols()).filter(|&j| index[j] != usize::MAX) {
-        let range = m.col_range(j);
-        for (&i, &v) in m.row_idx()[range.clone()].iter().zip(&m.val()[range]) {
-            if index[i] != usize::MAX {
-                triplets.push(Triplet::new(index[i], index[j], v));
-            }
-        }
-    }
-    let matrix = SparseColMat::try_new_from_triplets(rhs.len(), rhs.len(), &triplets)
-        .expect("valid triplets");
+    let matrix = block_on(&system.matrix, &index, rhs.len());
     (matrix, rhs)
 }
 
