@@ -10,6 +10,13 @@
 //! it as a faer [`Perm`], ready for
 //! `SymmetricOrdering::Custom` (see [`crate::linear::Ordering`]).
 //!
+//! [`coordinate_dissection`] is nested dissection from the unknowns'
+//! positions instead: each part is cut at the median of its longest axis,
+//! and the vertices on one side of the cut that touch the other side are
+//! the separator. It needs no graph partitioner, costs a few passes over the
+//! graph, and on mesh graphs its separators are as small as the mesh is
+//! thin across the cut (one grid line or plane on structured grids).
+//!
 //! The permutation follows faer's (and METIS's) convention: `forward[k]` is
 //! the original index of the k-th pivot and `inverse[i]` the position of
 //! original index i, so the factorised matrix is A(forward, forward).
@@ -17,13 +24,15 @@
 use faer::perm::Perm;
 use faer::sparse::SymbolicSparseColMatRef;
 use metis_sys as metis;
+use std::sync::atomic::AtomicU32;
+use std::sync::atomic::Ordering::Relaxed;
 
 /// Largest adjacency (sum of vertex degrees) METIS can index: the vendored
 /// METIS uses 32-bit `idx_t`.
 pub const METIS_MAX_ENTRIES: usize = i32::MAX as usize;
 
 /// Why an ordering could not be computed.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum OrderingError {
     #[error("the pattern is {rows}×{cols}; a symmetric ordering needs a square pattern")]
     NotSquare { rows: usize, cols: usize },
@@ -35,6 +44,16 @@ pub enum OrderingError {
     },
     #[error("METIS nested dissection failed: {0}")]
     Metis(&'static str),
+    #[error("{found} coordinates given for {unknowns} unknowns in R^{dimension}; coordinate dissection needs one point per unknown")]
+    PointCount {
+        found: usize,
+        unknowns: usize,
+        dimension: usize,
+    },
+    #[error("coordinate {index} of the unknowns' points is {value}; coordinate dissection needs finite positions")]
+    NonFinitePoint { index: usize, value: f64 },
+    #[error("the geometric ordering needs the unknowns' positions, and this solve has none; use the \"auto\", \"amd\" or \"nested-dissection\" ordering")]
+    NoPoints,
 }
 
 /// The adjacency graph of a symmetric pattern in METIS's CSR form: the
@@ -212,6 +231,200 @@ pub fn nested_dissection(
     Ok(Perm::new_checked(forward, inverse, n))
 }
 
+/// Parts of at most this many vertices are not cut further: their own
+/// order adds little fill, and smaller leaves only lengthen the recursion
+/// (measured on 2D 1000² grids: leaves of 8 to 64 give the same factor
+/// within 4 %, leaves of 256 give 25 % more).
+const DISSECTION_LEAF: usize = 32;
+
+/// Parts larger than this cut their two halves in parallel.
+const PARALLEL_PART: usize = 20_000;
+
+/// Nested dissection from positions: `points` holds `dimension`
+/// coordinates per vertex of the pattern's graph (vertex v at
+/// `points[v * dimension..(v + 1) * dimension]`).
+///
+/// A part is cut at the median of its widest coordinate: the vertices below
+/// the median go left, the others right, and the right vertices with a left
+/// neighbour are the separator, numbered after both sides, whose own parts
+/// are ordered the same way first. Ties at the median go right, so on a
+/// grid the separator is one grid line (2D) or plane (3D). Parts of at most
+/// 32 vertices keep their order.
+///
+/// On 2D 1000² grids this leaves 2.9× fewer factorisation flops than AMD
+/// for the nine-point Q1 stiffness and 6 % more for the five-point
+/// operator; on 3D 60³ grids it matches METIS for Q1 and leaves 30 % more
+/// for the seven-point one, at 1/10 to 1/25 of METIS's time (see
+/// [`crate::linear::Ordering::Automatic`]). The result depends only on the
+/// pattern and the points.
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::ordering::coordinate_dissection;
+/// // The five-point pattern of a 9×9 grid, vertex i + 9 j at (i, j).
+/// let m = 9;
+/// let mut t = Vec::new();
+/// let mut points = Vec::new();
+/// for j in 0..m * m {
+///     t.push(Triplet::new(j, j, 4.0));
+///     if j % m + 1 < m { t.push(Triplet::new(j + 1, j, -1.0)); }
+///     if j + m < m * m { t.push(Triplet::new(j + m, j, -1.0)); }
+///     points.extend([(j % m) as f64, (j / m) as f64]);
+/// }
+/// let a = SparseColMat::<usize, f64>::try_new_from_triplets(m * m, m * m, &t).unwrap();
+/// let perm = coordinate_dissection(a.symbolic(), &points, 2).unwrap();
+/// // The first cut is the grid line x = 4, numbered last.
+/// let (forward, _) = perm.arrays();
+/// assert!(forward[m * m - m..].iter().all(|&v| v % m == 4));
+/// ```
+pub fn coordinate_dissection(
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+    points: &[f64],
+    dimension: usize,
+) -> Result<Perm<usize>, OrderingError> {
+    dissect_with_leaf(pattern, points, dimension, DISSECTION_LEAF)
+}
+
+fn dissect_with_leaf(
+    pattern: SymbolicSparseColMatRef<'_, usize>,
+    points: &[f64],
+    dimension: usize,
+    leaf: usize,
+) -> Result<Perm<usize>, OrderingError> {
+    let n = pattern.ncols();
+    if dimension == 0 || points.len() != n * dimension {
+        return Err(OrderingError::PointCount {
+            found: points.len(),
+            unknowns: n,
+            dimension,
+        });
+    }
+    if let Some((index, &value)) = points.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        return Err(OrderingError::NonFinitePoint { index, value });
+    }
+    let graph = Adjacency::of_pattern(pattern)?;
+    let parts = Dissection {
+        points,
+        dimension,
+        graph: &graph,
+        side: (0..n).map(|_| AtomicU32::new(0)).collect(),
+        cuts: AtomicU32::new(0),
+        leaf: leaf.max(1),
+    };
+    // n ≤ i32::MAX (Adjacency::of_pattern checked it).
+    let mut order: Vec<u32> = (0..n as u32).collect();
+    parts.order(&mut order);
+    let forward: Box<[usize]> = order.iter().map(|&v| v as usize).collect();
+    let mut inverse = vec![0usize; n].into_boxed_slice();
+    for (k, &v) in forward.iter().enumerate() {
+        inverse[v] = k;
+    }
+    Ok(Perm::new_checked(forward, inverse, n))
+}
+
+/// The shared state of one coordinate dissection.
+struct Dissection<'a> {
+    points: &'a [f64],
+    dimension: usize,
+    graph: &'a Adjacency,
+    /// `side[v]` = the number of the cut that put v on its left side.
+    /// Parts being cut at the same time hold disjoint vertices, so a
+    /// relaxed atomic is enough; a cut reads only marks it wrote itself.
+    side: Vec<AtomicU32>,
+    cuts: AtomicU32,
+    leaf: usize,
+}
+
+impl Dissection<'_> {
+    fn coordinate(&self, v: u32, axis: usize) -> f64 {
+        self.points[v as usize * self.dimension + axis]
+    }
+
+    /// Rearranges `part` into [left, right, separator], each side ordered
+    /// recursively.
+    fn order(&self, part: &mut [u32]) {
+        let n = part.len();
+        if n <= self.leaf {
+            return;
+        }
+        // The widest axis; the first of equally wide ones.
+        let mut axis = 0;
+        let mut widest = f64::NEG_INFINITY;
+        for a in 0..self.dimension {
+            let (lo, hi) = part
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    let x = self.coordinate(v, a);
+                    (lo.min(x), hi.max(x))
+                });
+            if hi - lo > widest {
+                (axis, widest) = (a, hi - lo);
+            }
+        }
+        if widest <= 0.0 {
+            // Every point of the part at one position: nothing to cut.
+            return;
+        }
+        let x = |v: &u32| self.coordinate(*v, axis);
+        part.select_nth_unstable_by(n / 2, |a, b| x(a).total_cmp(&x(b)));
+        let median = x(&part[n / 2]);
+        // Below the median goes left; when the median is the smallest
+        // value, at or below it.
+        let mut left = partition(part, |v| x(v) < median);
+        if left == 0 {
+            left = partition(part, |v| x(v) <= median);
+        }
+        if left == 0 || left == n {
+            // Unreachable with a positive width: some value lies below the
+            // largest, and the median is at most that.
+            return;
+        }
+        let cut = self.cuts.fetch_add(1, Relaxed) + 1;
+        for &v in &part[..left] {
+            self.side[v as usize].store(cut, Relaxed);
+        }
+        let xadj = &self.graph.xadj;
+        let touches_left = |v: u32| {
+            let v = v as usize;
+            self.graph.adjncy[xadj[v] as usize..xadj[v + 1] as usize]
+                .iter()
+                .any(|&w| self.side[w as usize].load(Relaxed) == cut)
+        };
+        // The separator to the end of the part.
+        let mut end = n;
+        let mut k = left;
+        while k < end {
+            if touches_left(part[k]) {
+                end -= 1;
+                part.swap(k, end);
+            } else {
+                k += 1;
+            }
+        }
+        let (left_part, rest) = part.split_at_mut(left);
+        let right_part = &mut rest[..end - left];
+        if n > PARALLEL_PART {
+            rayon::join(|| self.order(left_part), || self.order(right_part));
+        } else {
+            self.order(left_part);
+            self.order(right_part);
+        }
+    }
+}
+
+/// Moves the entries where `keep` holds to the front (their order is not
+/// kept) and returns how many there are.
+fn partition(part: &mut [u32], keep: impl Fn(&u32) -> bool) -> usize {
+    let mut front = 0;
+    for k in 0..part.len() {
+        if keep(&part[k]) {
+            part.swap(k, front);
+            front += 1;
+        }
+    }
+    front
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -304,6 +517,140 @@ mod tests {
         assert_bijection(&perm, n);
         let last = perm.arrays().0[n - 1];
         assert!(last > 0 && last < n - 1, "last pivot {last}");
+    }
+
+    /// The pattern and points of the (2r+1)-point grid operator on an
+    /// m^d grid (r = 1: nearest neighbours), vertex index
+    /// i + m j (+ m² k) at (i, j, k).
+    fn grid(m: usize, d: usize) -> (SymbolicSparseColMat<usize>, Vec<f64>) {
+        let n = m.pow(d as u32);
+        let mut entries: Vec<(usize, usize)> = (0..n).map(|v| (v, v)).collect();
+        let mut points = Vec::new();
+        for v in 0..n {
+            for a in 0..d {
+                let stride = m.pow(a as u32);
+                let x = (v / stride) % m;
+                points.push(x as f64);
+                if x + 1 < m {
+                    entries.push((v + stride, v));
+                    entries.push((v, v + stride));
+                }
+            }
+        }
+        (pattern(n, &entries), points)
+    }
+
+    #[test]
+    fn a_path_is_cut_at_its_medians() {
+        // Seven vertices at x = 0..6, cut down to single vertices: the
+        // median x = 3 splits {0, 1, 2} | {3, …, 6} and 3 is the right
+        // vertex touching the left, so it is numbered last; {0, 1, 2} cuts
+        // at x = 1 (separator 1), {4, 5, 6} at x = 5 (separator 5).
+        let n = 7;
+        let mut entries: Vec<(usize, usize)> = (0..n).map(|i| (i, i)).collect();
+        entries.extend((0..n - 1).map(|i| (i + 1, i)));
+        let points: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let perm = dissect_with_leaf(pattern(n, &entries).as_ref(), &points, 1, 1).unwrap();
+        assert_bijection(&perm, n);
+        assert_eq!(perm.arrays().0, [0, 2, 1, 4, 6, 5, 3]);
+    }
+
+    #[test]
+    fn a_grid_is_cut_along_its_middle_plane_then_across_the_halves() {
+        // 7³ grid, seven-point pattern: all axes are as wide, so the first
+        // cut is x = 3 (the first axis) and the plane x = 3 is numbered
+        // last. The right part x ∈ {4, 5, 6} is then widest in y (y and z
+        // tie, y comes first): its separator, the 3 × 7 vertices with
+        // y = 3, comes just before the plane.
+        let m = 7;
+        let (p, points) = grid(m, 3);
+        let n = m * m * m;
+        let perm = coordinate_dissection(p.as_ref(), &points, 3).unwrap();
+        assert_bijection(&perm, n);
+        let forward = perm.arrays().0;
+        let (x, y) = (|v: usize| v % m, |v: usize| (v / m) % m);
+        let plane = &forward[n - m * m..];
+        assert!(plane.iter().all(|&v| x(v) == 3), "{plane:?}");
+        let right_cut = &forward[n - m * m - 3 * m..n - m * m];
+        assert!(
+            right_cut.iter().all(|&v| x(v) >= 4 && y(v) == 3),
+            "{right_cut:?}"
+        );
+    }
+
+    #[test]
+    fn a_grid_in_dissection_order_fills_less_than_its_band() {
+        // In the natural order the factor of the five-point pattern of an
+        // m × m grid fills its envelope: row i of L runs from its first
+        // neighbour to the diagonal, i − 1 for the m − 1 rows of the first
+        // grid row after vertex 0 and i − m for the n − m others, so L
+        // holds n + (m − 1) + (n − m) m values. Nested dissection by grid
+        // lines fills (31/8) n log₂ m to leading order (George 1973), 0.37
+        // of the envelope at m = 63; the lower-order terms add a few per
+        // cent at this size.
+        use faer::sparse::linalg::cholesky::{
+            factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
+        };
+        let m = 63;
+        let n = m * m;
+        let (p, points) = grid(m, 2);
+        let lower_count = |order: SymmetricOrdering<'_, usize>| {
+            let params = CholeskySymbolicParams {
+                supernodal_flop_ratio_threshold:
+                    faer::sparse::linalg::SupernodalThreshold::FORCE_SIMPLICIAL,
+                ..Default::default()
+            };
+            factorize_symbolic_cholesky(p.as_ref(), faer::Side::Lower, order, params)
+                .unwrap()
+                .len_val()
+        };
+        let identity: Box<[usize]> = (0..n).collect();
+        let natural = Perm::new_checked(identity.clone(), identity, n);
+        let band = lower_count(SymmetricOrdering::Custom(natural.as_ref()));
+        assert_eq!(band, n + (m - 1) + (n - m) * m);
+        let perm = coordinate_dissection(p.as_ref(), &points, 2).unwrap();
+        let dissected = lower_count(SymmetricOrdering::Custom(perm.as_ref()));
+        let george = 31.0 / 8.0 * n as f64 * (m as f64).log2();
+        assert!(
+            2 * dissected < band && (dissected as f64) < 1.1 * george,
+            "{dissected} against the band's {band} and George's {george}"
+        );
+    }
+
+    #[test]
+    fn coincident_points_and_leaf_sized_graphs_keep_their_order() {
+        let (p, _) = grid(8, 2);
+        let n = 64;
+        let same = vec![0.5; 2 * n];
+        let perm = coordinate_dissection(p.as_ref(), &same, 2).unwrap();
+        assert_eq!(perm.arrays().0, (0..n).collect::<Vec<_>>().as_slice());
+        // At most a leaf's worth of vertices: not cut at all.
+        let (q, points) = grid(5, 2);
+        let perm = coordinate_dissection(q.as_ref(), &points, 2).unwrap();
+        assert_eq!(perm.arrays().0, (0..25).collect::<Vec<_>>().as_slice());
+    }
+
+    #[test]
+    fn points_that_do_not_fit_are_refused() {
+        let (p, points) = grid(4, 2);
+        assert_eq!(
+            coordinate_dissection(p.as_ref(), &points[1..], 2).unwrap_err(),
+            OrderingError::PointCount {
+                found: 31,
+                unknowns: 16,
+                dimension: 2
+            }
+        );
+        let mut bad = points.clone();
+        bad[7] = f64::NAN;
+        assert!(matches!(
+            coordinate_dissection(p.as_ref(), &bad, 2).unwrap_err(),
+            OrderingError::NonFinitePoint { index: 7, .. }
+        ));
+        assert!(matches!(
+            coordinate_dissection(p.as_ref(), &points, 0).unwrap_err(),
+            OrderingError::PointCount { dimension: 0, .. }
+        ));
     }
 
     #[test]
