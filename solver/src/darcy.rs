@@ -536,6 +536,8 @@ impl DarcySystem {
             numeric_seconds,
             solve_seconds: started.elapsed().as_secs_f64(),
             relative_residual: linear::relative_residual(a, &x, &self.rhs),
+            factor_entries: None,
+            factor_flops: None,
         };
         let (flux, pressure) = self.unpack(&x);
         Ok(DarcySolution {
