@@ -24,7 +24,9 @@
 
 use crate::canonical::{BlockMetric, Canonical, CanonicalError};
 use crate::iterative::{conjugate_gradient, CgError, CgOptions, CgReport, RowMatrix};
-use crate::linear::{self, DirectSolver, Factorization, Ordering, SolveError, SolveReport};
+use crate::linear::{
+    self, DirectSolver, Factorization, Ordering, SolveError, SolveReport, UnknownPoints,
+};
 use crate::metric::{self, dec, fd, fe, fv, CellTensors, MetricError, Tensor};
 use crate::multigrid::{
     self, CellProlongation, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
@@ -1031,8 +1033,13 @@ impl Diffusion {
         // The analysis reads only M's pattern; when topology alone fixes it,
         // it runs on one thread while the geometry, Ω, the values and the
         // checks are computed on the other.
+        let points = unknown_points(complex, self.location());
+        let points = UnknownPoints {
+            coordinates: &points,
+            dimension: complex.embedding_dim(),
+        };
         let (prepared, analysis) = if self.pattern_from_topology(complex) {
-            rayon::join(prepare, || self.analyse_topology(complex))
+            rayon::join(prepare, || self.analyse_topology(complex, points))
         } else {
             (prepare(), None)
         };
@@ -1060,6 +1067,7 @@ impl Diffusion {
             self.ordering,
             self.iterative.as_ref(),
             analysis,
+            Some(points),
         )?;
         if pure_neumann {
             let weights = self.mean_weights(complex, location, unknowns);
@@ -1163,8 +1171,13 @@ impl Diffusion {
     /// solve uses it only where it matches entry for entry. `None` when the
     /// analysis fails: the solve then analyses the assembled matrix and
     /// reports the failure itself.
-    fn analyse_topology(&self, complex: &Complex) -> Option<TopologyAnalysis> {
+    fn analyse_topology(
+        &self,
+        complex: &Complex,
+        points: UnknownPoints<'_>,
+    ) -> Option<TopologyAnalysis> {
         let n = complex.dim();
+        let mut free_points = Vec::new();
         let pattern = if self.location() == Location::Nodal {
             // A boundary tag that names nothing is reported by the assembly.
             let faces = self.boundary_faces(complex).ok()?;
@@ -1189,6 +1202,12 @@ impl Diffusion {
                     *first = false;
                 }
             }
+            let d = points.dimension;
+            free_points = (0..free.len())
+                .filter(|&v| free[v])
+                .flat_map(|v| &points.coordinates[v * d..(v + 1) * d])
+                .copied()
+                .collect();
             crate::canonical::clique_pattern(
                 complex.vertex_star(n),
                 |c| complex.cell_vertices(n, c),
@@ -1200,9 +1219,21 @@ impl Diffusion {
                 &complex.shared_boundary_csc(n),
             )
         };
-        let solver =
-            DirectSolver::analyse_pattern(pattern.as_ref(), self.factorization, self.ordering)
-                .ok()?;
+        let points = if self.location() == Location::Nodal {
+            UnknownPoints {
+                coordinates: &free_points,
+                ..points
+            }
+        } else {
+            points
+        };
+        let solver = DirectSolver::analyse_pattern_at(
+            pattern.as_ref(),
+            self.factorization,
+            self.ordering,
+            Some(points),
+        )
+        .ok()?;
         Some(TopologyAnalysis { pattern, solver })
     }
 
@@ -1417,8 +1448,16 @@ pub fn solve_with_fixed(
     ordering: Ordering,
     iterative: Option<&Iterative>,
 ) -> Result<(Vec<f64>, SolveReport, Option<CgReport>), DiffusionError> {
-    let (values, report, iterations, _) =
-        solve_fixed(matrix, rhs, fixed, factorization, ordering, iterative, None)?;
+    let (values, report, iterations, _) = solve_fixed(
+        matrix,
+        rhs,
+        fixed,
+        factorization,
+        ordering,
+        iterative,
+        None,
+        None,
+    )?;
     Ok((values, report, iterations))
 }
 
@@ -1443,7 +1482,9 @@ impl TopologyAnalysis {
 /// [`solve_with_fixed`], with an analysis made beforehand, used by a
 /// direct solve when it was made for the pattern of the system solved
 /// (the free unknowns' block: see [`TopologyAnalysis::fits`]); the last
-/// value says whether it was.
+/// value says whether it was. Without such an analysis, the free
+/// unknowns' `points` (given for all unknowns) go to the ordering.
+#[allow(clippy::too_many_arguments)]
 fn solve_fixed(
     matrix: &SparseColMat<usize, f64>,
     rhs: &[f64],
@@ -1452,6 +1493,7 @@ fn solve_fixed(
     ordering: Ordering,
     iterative: Option<&Iterative>,
     analysis: Option<TopologyAnalysis>,
+    points: Option<UnknownPoints<'_>>,
 ) -> Result<(Vec<f64>, SolveReport, Option<CgReport>, bool), DiffusionError> {
     let n = rhs.len();
     let mut free_index = vec![usize::MAX; n];
@@ -1486,6 +1528,8 @@ fn solve_fixed(
             numeric_seconds: 0.0,
             solve_seconds: 0.0,
             relative_residual: 0.0,
+            factor_entries: None,
+            factor_flops: None,
         };
         return Ok((values, report, None, false));
     }
@@ -1501,7 +1545,29 @@ fn solve_fixed(
         None => {
             let (x, report) = match analysis {
                 Some(analysis) => linear::solve_analysed(&analysis, &reduced, &reduced_rhs)?,
-                None => linear::solve_with(&reduced, &reduced_rhs, factorization, ordering)?,
+                None => {
+                    let free_points: Option<Vec<f64>> = points.map(|p| {
+                        let d = p.dimension;
+                        free.iter()
+                            .flat_map(|&i| &p.coordinates[i * d..(i + 1) * d])
+                            .copied()
+                            .collect()
+                    });
+                    let points = free_points
+                        .as_deref()
+                        .zip(points)
+                        .map(|(c, p)| UnknownPoints {
+                            coordinates: c,
+                            ..p
+                        });
+                    let solver = DirectSolver::analyse_pattern_at(
+                        reduced.symbolic(),
+                        factorization,
+                        ordering,
+                        points,
+                    )?;
+                    linear::solve_analysed(&solver, &reduced, &reduced_rhs)?
+                }
             };
             (x, report, None)
         }
@@ -1543,6 +1609,8 @@ fn solve_fixed(
                 numeric_seconds: setup,
                 solve_seconds: cg.seconds,
                 relative_residual: cg.relative_residual,
+                factor_entries: None,
+                factor_flops: None,
             };
             (x, report, Some(cg))
         }
@@ -1551,6 +1619,43 @@ fn solve_fixed(
         values[i] = x[k];
     }
     Ok((values, report, iterations, analysed))
+}
+
+/// A point of each unknown of `location`, for the geometric ordering: the
+/// vertices themselves for nodal unknowns, the mean of each cell's
+/// vertices for cell-centred ones (then each face's for the hybrid
+/// method's face unknowns). Any point inside a cell would do, and the mean
+/// costs no geometry.
+fn unknown_points(complex: &Complex, location: Location) -> std::borrow::Cow<'_, [f64]> {
+    let n = complex.dim();
+    let vertex_means = |p: usize| -> Vec<f64> {
+        let d = complex.embedding_dim();
+        let mut means = vec![0.0; complex.cell_count(p) * d];
+        means
+            .par_chunks_mut(d.max(1))
+            .enumerate()
+            .for_each(|(c, mean)| {
+                let vertices = complex.cell_vertices(p, c);
+                for &v in vertices {
+                    for (m, x) in mean.iter_mut().zip(complex.vertices().point(v)) {
+                        *m += x;
+                    }
+                }
+                for m in mean {
+                    *m /= vertices.len() as f64;
+                }
+            });
+        means
+    };
+    match location {
+        Location::Nodal => std::borrow::Cow::Borrowed(complex.vertices().as_slice()),
+        Location::CellCentred => std::borrow::Cow::Owned(vertex_means(n)),
+        Location::Hybrid => {
+            let mut points = vertex_means(n);
+            points.extend(vertex_means(n - 1));
+            std::borrow::Cow::Owned(points)
+        }
+    }
 }
 
 /// The block of `matrix` on the unknowns `free` (increasing), whose new
