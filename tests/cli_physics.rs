@@ -531,9 +531,9 @@ fn multigrid_solver_types_match_the_direct_solution() {
 }
 
 /// `solver.ordering` reaches the direct solve: the summary line names the
-/// ordering, and the nested-dissection and AMD solutions of the same
-/// system agree (both are backward-stable Cholesky factorisations of one
-/// SPD matrix, so the printed 7-digit errors coincide).
+/// ordering, and the solutions of the same system under each ordering
+/// agree (all are backward-stable Cholesky factorisations of one SPD
+/// matrix, so the printed 7-digit errors coincide).
 #[test]
 fn the_solve_line_names_the_ordering() {
     let line = |out: &str| {
@@ -542,21 +542,31 @@ fn the_solve_line_names_the_ordering() {
             .unwrap_or_else(|| panic!("no unknowns line in\n{out}"))
             .to_string()
     };
-    // 1089 unknowns: the automatic rule keeps AMD.
+    // A diffusion case hands the unknowns' positions to the automatic
+    // rule, which orders by them.
     let auto = run("cases/poisson-square.toml", &[]);
     assert!(
-        line(&auto).contains("solver sparse LLᵀ (faer), AMD ordering"),
+        line(&auto).contains("solver sparse LLᵀ (faer), geometric nested dissection ordering"),
         "{auto}"
     );
-    let nd = run(
-        "cases/poisson-square.toml",
-        &["solver.ordering=\"nested-dissection\"".into()],
-    );
-    assert!(
-        line(&nd).contains("solver sparse LLᵀ (faer), nested dissection (METIS) ordering"),
-        "{nd}"
-    );
-    assert_eq!(reported(&nd, "error", "L2"), reported(&auto, "error", "L2"));
+    for (name, printed) in [
+        ("nested-dissection", "nested dissection (METIS) ordering"),
+        ("amd", "AMD ordering"),
+        ("geometric", "geometric nested dissection ordering"),
+    ] {
+        let out = run(
+            "cases/poisson-square.toml",
+            &[format!("solver.ordering=\"{name}\"")],
+        );
+        assert!(
+            line(&out).contains(&format!("solver sparse LLᵀ (faer), {printed}")),
+            "{out}"
+        );
+        assert_eq!(
+            reported(&out, "error", "L2"),
+            reported(&auto, "error", "L2")
+        );
+    }
     // The transient solver analyses once per run and says which ordering.
     let heat = run(
         "cases/heat-square.toml",
@@ -760,6 +770,16 @@ fn bad_problem_kind_input_names_the_key() {
         "[mesh]\ngenerator = \"rectangle\"\nn = [8, 8]\n[problem]\nmethod = \"fv\"\n[solver]\nfactorization = \"lu\"\nordering = \"nested-dissection\"\n",
         2,
         &["`solver.ordering`", "COLAMD"],
+    );
+    refused(
+        "ordering-geometric-heat",
+        &format!("{HEAT}\n[solver]\nordering = \"geometric\"\n"),
+        2,
+        &[
+            "`solver.ordering`",
+            "unknowns' positions",
+            "kind = \"heat\"",
+        ],
     );
     refused(
         "ordering-darcy",

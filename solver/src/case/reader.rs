@@ -1263,15 +1263,23 @@ impl Reader {
                 "auto" => spec.ordering = Ordering::Automatic,
                 "amd" => spec.ordering = Ordering::Amd,
                 "nested-dissection" => spec.ordering = Ordering::NestedDissection,
+                "geometric" => spec.ordering = Ordering::Geometric,
                 other => self.error(
                     span.clone(),
                     "solver.ordering",
                     format!("unknown ordering \"{other}\""),
-                    Some("use \"auto\" (the default), \"amd\" (approximate minimum degree) or \"nested-dissection\" (METIS)".into()),
+                    Some("use \"auto\" (the default), \"amd\" (approximate minimum degree), \"nested-dissection\" (METIS) or \"geometric\" (nested dissection from the unknowns' positions)".into()),
                 ),
             }
             let kind = problem_kind(root);
-            if !matches!(kind, "diffusion" | "heat" | "elasticity") {
+            if spec.ordering == Ordering::Geometric && kind != "diffusion" {
+                self.error(
+                    span.clone(),
+                    "solver.ordering",
+                    format!("\"geometric\" orders by the unknowns' positions, which only diffusion cases hand to the solver; kind = \"{kind}\" does not"),
+                    Some("use \"auto\", \"amd\" or \"nested-dissection\"".into()),
+                );
+            } else if !matches!(kind, "diffusion" | "heat" | "elasticity") {
                 self.error(
                     span,
                     "solver.ordering",
