@@ -15,7 +15,8 @@
 //!   factorisation, solve) with the automatic fill-reducing ordering.
 //! - `solve`: complex, then `Diffusion::solve` as a case file runs it
 //!   (the analysis of M's pattern beside the assembly, factorisation,
-//!   solve, fluxes and checks), timed whole.
+//!   solve, fluxes and checks), timed whole, with the automatic ordering
+//!   or the one `HASSE_BENCH_ORDERING` names (`amd`, `nd`, `geometric`).
 //! - `plain`: the same 5/7-point matrix built by hand as triplets and
 //!   factorised with faer's own LLᵀ (AMD ordering), without hasse.
 //! - `q1-solve`: complex, then nodal Q1 `Diffusion::solve` (u = 0 on the
@@ -38,6 +39,8 @@
 //! - `dec`: the same with DEC's circumcentric Hodge star (on a Delaunay
 //!   mesh the same matrix, by a different assembly).
 //! - `direct`: complex, FE assembly, LLᵀ through `solve_with_fixed`.
+//! - `solve`: complex, then nodal P1 `Diffusion::solve`, timed whole (as
+//!   the structured cases' `solve`).
 //! - `plain`: the P1 cotangent matrix on the interior vertices built from
 //!   coordinates and vertex triples alone, factorised by faer's own LLᵀ.
 //! - `amd`, `nd`: that matrix through `DirectSolver` with AMD or nested
@@ -182,16 +185,17 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             let t = Instant::now();
             let complex = mesh(d, n);
             let complex_s = seconds(t);
-            let problem = match phase {
+            let mut problem = match phase {
                 "solve" => problem(),
                 _ => nodal_problem(Method::Fe),
             };
+            problem.ordering = bench_ordering();
             let t = Instant::now();
             let solution = problem.solve(&complex).expect("solve");
             let whole_s = seconds(t);
             let report = &solution.report;
             format!(
-                "unknowns={} ordering={} complex={complex_s:.3} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} residual={:.2e}",
+                "unknowns={} ordering={} complex={complex_s:.3} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} entries={} flops={:.3e} residual={:.2e}",
                 report.unknowns,
                 short_name(report.ordering),
                 solution.assembly_seconds,
@@ -199,6 +203,8 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 report.numeric_seconds,
                 report.solve_seconds,
                 solution.analysed_during_assembly,
+                report.factor_entries.unwrap_or(0),
+                report.factor_flops.unwrap_or(f64::NAN),
                 report.relative_residual
             )
         }
@@ -281,10 +287,24 @@ fn plain_rhs(matrix: &SparseColMat<usize, f64>, n: usize, d: usize) -> Vec<f64> 
     vec![1.0 / n.pow(d as u32) as f64; matrix.nrows()]
 }
 
+/// The ordering of the whole solves (`solve`, `q1-solve`, a Delaunay
+/// case's `solve`): `HASSE_BENCH_ORDERING` = `auto` (the default), `amd`,
+/// `nd` or `geometric`, to measure one ordering against another.
+fn bench_ordering() -> Ordering {
+    match std::env::var("HASSE_BENCH_ORDERING").as_deref() {
+        Ok("amd") => Ordering::Amd,
+        Ok("nd") => Ordering::NestedDissection,
+        Ok("geometric") => Ordering::Geometric,
+        Ok("auto") | Err(_) => Ordering::Automatic,
+        Ok(other) => panic!("HASSE_BENCH_ORDERING={other}: use auto, amd, nd or geometric"),
+    }
+}
+
 fn short_name(ordering: Option<Ordering>) -> &'static str {
     match ordering {
         Some(Ordering::NestedDissection) => "nd",
         Some(Ordering::Amd) => "amd",
+        Some(Ordering::Geometric) => "geometric",
         _ => "other",
     }
 }
@@ -361,7 +381,9 @@ const GRID_PHASES: [&str; 9] = [
     "mg", "mg-pc", "direct", "solve", "plain", "q1-solve", "q1-plain", "amd", "nd",
 ];
 /// Every phase of a Delaunay case.
-const DELAUNAY_PHASES: [&str; 7] = ["check", "amg", "dec", "direct", "plain", "amd", "nd"];
+const DELAUNAY_PHASES: [&str; 8] = [
+    "check", "amg", "dec", "direct", "solve", "plain", "amd", "nd",
+];
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -729,6 +751,28 @@ fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {
         _ => Method::Fe,
     };
     let fields = match phase {
+        "solve" => {
+            // Diffusion::solve as a case file runs it, timed whole.
+            let mut problem = nodal_problem(method);
+            problem.ordering = bench_ordering();
+            let t = Instant::now();
+            let solution = problem.solve(&complex).expect("solve");
+            let whole_s = seconds(t);
+            let report = &solution.report;
+            format!(
+                "{counts} unknowns={} ordering={} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} entries={} flops={:.3e} residual={:.2e}",
+                report.unknowns,
+                short_name(report.ordering),
+                solution.assembly_seconds,
+                report.symbolic_seconds,
+                report.numeric_seconds,
+                report.solve_seconds,
+                solution.analysed_during_assembly,
+                report.factor_entries.unwrap_or(0),
+                report.factor_flops.unwrap_or(f64::NAN),
+                report.relative_residual
+            )
+        }
         "amg" | "dec" | "direct" => {
             let Assembled {
                 matrix,

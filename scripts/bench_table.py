@@ -45,7 +45,7 @@ def add(*parts):
     return None if any(p is None for p in parts) else sum(parts)
 
 
-ORDERING = {"nd": "nested dissection", "amd": "AMD"}
+ORDERING = {"nd": "nested dissection", "amd": "AMD", "geometric": "geometric ND"}
 
 
 def ordering_rows(label, r):
@@ -68,8 +68,8 @@ def ordering_rows(label, r):
 
 
 def delaunay_rows(label, r):
-    """Nodal P1 on a Delaunay mesh (phases amg, dec, direct, plain, check and
-    pyamg): the FE assembly, DEC assembly and LLᵀ next to the hand-built
+    """Nodal P1 on a Delaunay mesh (phases amg, dec, direct, solve, plain,
+    check and pyamg): the FE assembly, DEC assembly and LLᵀ next to the hand-built
     matrix and faer's own LLᵀ, AMG-CG next to pyamg."""
     fe, dec, direct, plain, amg, check = (
         r.get(p, {}) for p in ("amg", "dec", "direct", "plain", "pyamg", "check")
@@ -103,6 +103,11 @@ def delaunay_rows(label, r):
     hasse_direct = add(num(direct, "assembly"), num(direct, "factor"), num(direct, "solve"))
     plain_total = add(num(plain, "assembly"), num(plain, "factor"), num(plain, "solve"))
     out.append((label, "FE assembly + LLᵀ + solve", fmt(hasse_direct), "plain build+LLᵀ+solve", fmt(plain_total), ratio(hasse_direct, plain_total)))
+    whole = r.get("solve", {})
+    if whole:
+        used = ORDERING.get(whole.get("ordering"), "?")
+        beside = " (analysis beside assembly)" if whole.get("beside") == "true" else ""
+        out.append((label, f"whole P1 Diffusion::solve{beside}, {used}", fmt(num(whole, "whole")), "plain faer LLᵀ analysis+factorisation", fmt(num(plain, "factor")), ratio(num(whole, "whole"), num(plain, "factor"))))
     return out + ordering_rows(label, r)
 
 
@@ -125,7 +130,7 @@ for case in runs:
     whole = r.get("solve", {})
     if whole:
         beside = " (analysis beside assembly)" if whole.get("beside") == "true" else ""
-        rows.append((label, f"whole Diffusion::solve{beside}", fmt(num(whole, "whole")), "plain faer LLᵀ analysis+factorisation", fmt(num(plain, "factor")), ratio(num(whole, "whole"), num(plain, "factor"))))
+        rows.append((label, f"whole Diffusion::solve{beside}, {ORDERING.get(whole.get('ordering'), '?')}", fmt(num(whole, "whole")), "plain faer LLᵀ analysis+factorisation", fmt(num(plain, "factor")), ratio(num(whole, "whole"), num(plain, "factor"))))
     q1, q1_plain = r.get("q1-solve", {}), r.get("q1-plain", {})
     if q1 or q1_plain:
         beside = " (analysis beside assembly)" if q1.get("beside") == "true" else ""
