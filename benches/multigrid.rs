@@ -185,28 +185,11 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             let t = Instant::now();
             let complex = mesh(d, n);
             let complex_s = seconds(t);
-            let mut problem = match phase {
+            let problem = match phase {
                 "solve" => problem(),
                 _ => nodal_problem(Method::Fe),
             };
-            problem.ordering = bench_ordering();
-            let t = Instant::now();
-            let solution = problem.solve(&complex).expect("solve");
-            let whole_s = seconds(t);
-            let report = &solution.report;
-            format!(
-                "unknowns={} ordering={} complex={complex_s:.3} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} entries={} flops={:.3e} residual={:.2e}",
-                report.unknowns,
-                short_name(report.ordering),
-                solution.assembly_seconds,
-                report.symbolic_seconds,
-                report.numeric_seconds,
-                report.solve_seconds,
-                solution.analysed_during_assembly,
-                report.factor_entries.unwrap_or(0),
-                report.factor_flops.unwrap_or(f64::NAN),
-                report.relative_residual
-            )
+            format!("complex={complex_s:.3} {}", whole_solve(problem, &complex))
         }
         "plain" | "q1-plain" => {
             let t = Instant::now();
@@ -285,6 +268,29 @@ fn block_on(
 /// the Q1 grid (a 2^−d share of each of its 2^d cells).
 fn plain_rhs(matrix: &SparseColMat<usize, f64>, n: usize, d: usize) -> Vec<f64> {
     vec![1.0 / n.pow(d as u32) as f64; matrix.nrows()]
+}
+
+/// `Diffusion::solve` on `complex` with the bench's ordering, timed whole,
+/// as `unknowns=… whole=… …` fields.
+fn whole_solve(mut problem: Diffusion, complex: &Complex) -> String {
+    problem.ordering = bench_ordering();
+    let t = Instant::now();
+    let solution = problem.solve(complex).expect("solve");
+    let whole_s = seconds(t);
+    let report = &solution.report;
+    format!(
+        "unknowns={} ordering={} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} entries={} flops={:.3e} residual={:.2e}",
+        report.unknowns,
+        short_name(report.ordering),
+        solution.assembly_seconds,
+        report.symbolic_seconds,
+        report.numeric_seconds,
+        report.solve_seconds,
+        solution.analysed_during_assembly,
+        report.factor_entries.unwrap_or(0),
+        report.factor_flops.unwrap_or(f64::NAN),
+        report.relative_residual
+    )
 }
 
 /// The ordering of the whole solves (`solve`, `q1-solve`, a Delaunay
@@ -753,25 +759,7 @@ fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {
     let fields = match phase {
         "solve" => {
             // Diffusion::solve as a case file runs it, timed whole.
-            let mut problem = nodal_problem(method);
-            problem.ordering = bench_ordering();
-            let t = Instant::now();
-            let solution = problem.solve(&complex).expect("solve");
-            let whole_s = seconds(t);
-            let report = &solution.report;
-            format!(
-                "{counts} unknowns={} ordering={} whole={whole_s:.3} assembly={:.3} analysis={:.3} numeric={:.3} solve={:.3} beside={} entries={} flops={:.3e} residual={:.2e}",
-                report.unknowns,
-                short_name(report.ordering),
-                solution.assembly_seconds,
-                report.symbolic_seconds,
-                report.numeric_seconds,
-                report.solve_seconds,
-                solution.analysed_during_assembly,
-                report.factor_entries.unwrap_or(0),
-                report.factor_flops.unwrap_or(f64::NAN),
-                report.relative_residual
-            )
+            format!("{counts} {}", whole_solve(nodal_problem(method), &complex))
         }
         "amg" | "dec" | "direct" => {
             let Assembled {
