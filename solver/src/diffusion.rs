@@ -1033,13 +1033,17 @@ impl Diffusion {
         // The analysis reads only M's pattern; when topology alone fixes it,
         // it runs on one thread while the geometry, Ω, the values and the
         // checks are computed on the other.
-        let points = unknown_points(complex, self.location());
-        let points = UnknownPoints {
-            coordinates: &points,
+        // Only a direct solve orders its unknowns.
+        let coordinates = self
+            .iterative
+            .is_none()
+            .then(|| unknown_points(complex, self.location()));
+        let points = coordinates.as_deref().map(|coordinates| UnknownPoints {
+            coordinates,
             dimension: complex.embedding_dim(),
-        };
+        });
         let (prepared, analysis) = if self.pattern_from_topology(complex) {
-            rayon::join(prepare, || self.analyse_topology(complex, points))
+            rayon::join(prepare, || self.analyse_topology(complex, points?))
         } else {
             (prepare(), None)
         };
@@ -1067,7 +1071,7 @@ impl Diffusion {
             self.ordering,
             self.iterative.as_ref(),
             analysis,
-            Some(points),
+            points,
         )?;
         if pure_neumann {
             let weights = self.mean_weights(complex, location, unknowns);
@@ -1202,12 +1206,7 @@ impl Diffusion {
                     *first = false;
                 }
             }
-            let d = points.dimension;
-            free_points = (0..free.len())
-                .filter(|&v| free[v])
-                .flat_map(|v| &points.coordinates[v * d..(v + 1) * d])
-                .copied()
-                .collect();
+            free_points = points_of(points, (0..free.len()).filter(|&v| free[v]));
             crate::canonical::clique_pattern(
                 complex.vertex_star(n),
                 |c| complex.cell_vertices(n, c),
@@ -1546,13 +1545,8 @@ fn solve_fixed(
             let (x, report) = match analysis {
                 Some(analysis) => linear::solve_analysed(&analysis, &reduced, &reduced_rhs)?,
                 None => {
-                    let free_points: Option<Vec<f64>> = points.map(|p| {
-                        let d = p.dimension;
-                        free.iter()
-                            .flat_map(|&i| &p.coordinates[i * d..(i + 1) * d])
-                            .copied()
-                            .collect()
-                    });
+                    let free_points: Option<Vec<f64>> =
+                        points.map(|p| points_of(p, free.iter().copied()));
                     let points = free_points
                         .as_deref()
                         .zip(points)
@@ -1656,6 +1650,14 @@ fn unknown_points(complex: &Complex, location: Location) -> std::borrow::Cow<'_,
             std::borrow::Cow::Owned(points)
         }
     }
+}
+
+/// The coordinates of the unknowns `kept`, in that order.
+fn points_of(points: UnknownPoints<'_>, kept: impl Iterator<Item = usize>) -> Vec<f64> {
+    let d = points.dimension;
+    kept.flat_map(|i| &points.coordinates[i * d..(i + 1) * d])
+        .copied()
+        .collect()
 }
 
 /// The block of `matrix` on the unknowns `free` (increasing), whose new
