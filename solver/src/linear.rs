@@ -475,15 +475,37 @@ impl DirectSolver {
                 .map(Arc::new)
                 .map_err(|e| SolveError::Symbolic(format!("{e:?}")))
         };
-        let (analysis, ordering) = match (kind, ordering) {
-            (Factorization::Lu, _) => (
+        // The geometric ordering: asked for (positions required), or the
+        // automatic rule's for LLᵀ when the positions are usable (within
+        // 32-bit graph indices, all finite); otherwise the rule without.
+        let geometric = match (kind, ordering, points) {
+            (Factorization::Lu, _, _) => None,
+            (_, Ordering::Geometric, points) => {
+                let p = points.ok_or(OrderingError::NoPoints)?;
+                Some(ordering::coordinate_dissection(
+                    matrix,
+                    p.coordinates,
+                    p.dimension,
+                )?)
+            }
+            (Factorization::Llt, Ordering::Automatic, Some(p)) => {
+                ordering::coordinate_dissection(matrix, p.coordinates, p.dimension).ok()
+            }
+            _ => None,
+        };
+        let (analysis, ordering) = match (kind, ordering, geometric) {
+            (Factorization::Lu, _, _) => (
                 Analysis::Lu(
                     SymbolicLu::try_new(matrix)
                         .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?,
                 ),
                 None,
             ),
-            (_, Ordering::NestedDissection) => {
+            (_, _, Some(perm)) => (
+                Analysis::symmetric(kind, symbolic(SymmetricOrdering::Custom(perm.as_ref()))?),
+                Some(Ordering::Geometric),
+            ),
+            (_, Ordering::NestedDissection, None) => {
                 let perm = ordering::nested_dissection(matrix)?;
                 let analysed = symbolic(SymmetricOrdering::Custom(perm.as_ref()))?;
                 (
@@ -491,30 +513,7 @@ impl DirectSolver {
                     Some(Ordering::NestedDissection),
                 )
             }
-            (_, Ordering::Geometric) => {
-                let points = points.ok_or(OrderingError::NoPoints)?;
-                let perm =
-                    ordering::coordinate_dissection(matrix, points.coordinates, points.dimension)?;
-                let analysed = symbolic(SymmetricOrdering::Custom(perm.as_ref()))?;
-                (
-                    Analysis::symmetric(kind, analysed),
-                    Some(Ordering::Geometric),
-                )
-            }
-            (Factorization::Llt, Ordering::Automatic) if points.is_some() => {
-                // Points that cannot be used (beyond 32-bit graph indices,
-                // a non-finite coordinate) leave the rule without points.
-                match points
-                    .map(|p| ordering::coordinate_dissection(matrix, p.coordinates, p.dimension))
-                {
-                    Some(Ok(perm)) => (
-                        Analysis::Llt(symbolic(SymmetricOrdering::Custom(perm.as_ref()))?),
-                        Some(Ordering::Geometric),
-                    ),
-                    _ => return Self::analyse_pattern_at(matrix, kind, ordering, None),
-                }
-            }
-            (Factorization::Llt, Ordering::Automatic) => {
+            (Factorization::Llt, Ordering::Automatic, None) => {
                 let amd = symbolic(SymmetricOrdering::Amd)?;
                 if amd.len_val() < ND_MIN_FILL_PER_UNKNOWN.saturating_mul(size) {
                     (Analysis::Llt(amd), Some(Ordering::Amd))
@@ -539,7 +538,8 @@ impl DirectSolver {
                     }
                 }
             }
-            (_, Ordering::Amd | Ordering::Automatic) => (
+            // (A geometric request always has its permutation by now.)
+            (_, Ordering::Amd | Ordering::Automatic | Ordering::Geometric, None) => (
                 Analysis::symmetric(kind, symbolic(SymmetricOrdering::Amd)?),
                 Some(Ordering::Amd),
             ),
