@@ -37,7 +37,7 @@ pub struct Complex {
     boundaries: Vec<Arc<CsMat<i8>>>,
     top_orientation: Vec<i8>,
     tags: Tags,
-    stars: Vec<OnceLock<CsMat<u8>>>,
+    stars: Vec<OnceLock<Arc<CsMat<u8>>>>,
     pub(crate) geometry: crate::geometry::GeometryCache,
     pub(crate) dual: crate::dual::DualCache,
 }
@@ -344,12 +344,21 @@ impl Complex {
 
     /// Vertex → p-cells incidence (M_pᵀ as CSR; for p = n the vertex star).
     pub fn vertex_star(&self, p: usize) -> &CsMat<u8> {
+        self.star(p)
+    }
+
+    /// [`Complex::vertex_star`], shared.
+    pub fn shared_vertex_star(&self, p: usize) -> Arc<CsMat<u8>> {
+        Arc::clone(self.star(p))
+    }
+
+    fn star(&self, p: usize) -> &Arc<CsMat<u8>> {
         self.stars[p].get_or_init(|| {
-            if p == 0 {
+            Arc::new(if p == 0 {
                 CsMat::eye(self.cell_count(0))
             } else {
                 self.lar.cells_by_vertex(p)
-            }
+            })
         })
     }
 

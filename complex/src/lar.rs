@@ -10,6 +10,7 @@ use crate::cells::{FlatSets, Vertices};
 use crate::error::{ComplexError, Result};
 use rayon::prelude::*;
 use sprs::{CsMat, TriMat};
+use std::sync::Arc;
 
 /// Vertex coordinates plus the characteristic matrices M_1 … M_n.
 /// M_0 is the identity and is not stored.
@@ -28,7 +29,8 @@ use sprs::{CsMat, TriMat};
 #[derive(Clone, Debug, PartialEq)]
 pub struct Lar {
     vertices: Vertices,
-    characteristic: Vec<CsMat<u8>>,
+    /// Shared, so that operators built on a cell's vertex list use it in place.
+    characteristic: Vec<Arc<CsMat<u8>>>,
     /// 0..k0, so that rows of the identity M_0 can be borrowed like other rows.
     vertex_ids: Vec<usize>,
 }
@@ -90,7 +92,7 @@ impl Lar {
         }
         let characteristic = characteristic
             .into_iter()
-            .map(|m| if m.is_csr() { m } else { m.to_csr() })
+            .map(|m| Arc::new(if m.is_csr() { m } else { m.to_csr() }))
             .collect();
         Ok(Self {
             vertex_ids: (0..vertices.len()).collect(),
@@ -160,6 +162,12 @@ impl Lar {
             return Err(ComplexError::DimensionOutOfRange { p, dim: self.dim() });
         }
         Ok(&self.characteristic[p - 1])
+    }
+
+    /// M_p, shared (see [`Lar::characteristic`]).
+    pub fn shared_characteristic(&self, p: usize) -> Result<Arc<CsMat<u8>>> {
+        self.characteristic(p)?;
+        Ok(Arc::clone(&self.characteristic[p - 1]))
     }
 
     /// Sorted vertices of p-cell `i`.
