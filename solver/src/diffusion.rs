@@ -806,9 +806,20 @@ impl Diffusion {
             Arc::new(tri.to_csr())
         };
         // The cell-centred methods' A is ∂ₙ itself, which the complex also
-        // keeps by columns.
+        // keeps by columns; a nodal element metric's blocks are the top
+        // cells, whose vertex lists the complex keeps.
         let mut canonical = if ghosts.is_empty() && matches!(self.method, Method::Fv | Method::Fd) {
             Canonical::with_columns(incidence, complex.shared_boundary_csc(n), metric_final)?
+        } else if location == Location::Nodal {
+            Canonical::with_cell_blocks(
+                incidence,
+                metric_final,
+                complex
+                    .lar()
+                    .shared_characteristic(n)
+                    .map_err(MetricError::from)?,
+                complex.shared_vertex_star(n),
+            )?
         } else {
             Canonical::new(incidence, metric_final)?
         };

@@ -354,6 +354,7 @@ fn dense_stiffness(
         &edge_ptr,
         indices,
         values,
+        true,
     ))
 }
 
