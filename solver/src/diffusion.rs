@@ -516,6 +516,18 @@ fn replace_row_weights(metric: &mut BlockMetric, rows: &[(usize, f64)]) {
     }
 }
 
+/// A load whose every entry is finite (finite values can still overflow
+/// when summed).
+fn finite_load(rhs: Vec<f64>) -> Result<Vec<f64>, DiffusionError> {
+    if rhs.iter().any(|v| !v.is_finite()) {
+        return Err(DiffusionError::NonFinite {
+            what: "source",
+            location: vec![],
+        });
+    }
+    Ok(rhs)
+}
+
 fn evaluate(f: &ScalarFn, x: &[f64], what: &'static str) -> Result<f64, DiffusionError> {
     let v = f(x);
     if v.is_finite() {
@@ -706,12 +718,15 @@ impl Diffusion {
         let face_count = complex.cell_count(n - 1);
         let cell_points = self.cell_points(complex)?;
 
+        // Nodal FE finds each cell's element once for Ω and the load.
+        let mut fe_load = None;
         let (incidence, metric, unknowns) = match self.method {
-            Method::Fe => (
-                complex.shared_coboundary(0),
-                fe::stiffness_metric(complex, tensors)?,
-                complex.cell_count(0),
-            ),
+            Method::Fe => {
+                let (metric, load) =
+                    fe::stiffness_and_load(complex, tensors, &|x| (self.source)(x))?;
+                fe_load = Some(load);
+                (complex.shared_coboundary(0), metric, complex.cell_count(0))
+            }
             Method::Dec(kind) => (
                 complex.shared_coboundary(0),
                 dec::hodge_metric(complex, kind, tensors)?,
@@ -755,7 +770,10 @@ impl Diffusion {
             faces,
             cell_diagonal,
         };
-        let mut rhs = self.source_load(complex, unknowns)?;
+        let mut rhs = match fe_load {
+            Some(load) => finite_load(load)?,
+            None => self.source_load(complex, unknowns)?,
+        };
         let BoundaryData {
             fixed,
             ghosts,
@@ -884,14 +902,7 @@ impl Diffusion {
                 }
             }
         }
-        if rhs.iter().any(|v| !v.is_finite()) {
-            return Err(DiffusionError::NonFinite {
-                what: "source",
-                location: vec![],
-            });
-        }
-
-        Ok(rhs)
+        finite_load(rhs)
     }
 
     /// Boundary values and data on the faces of `layout`: Dirichlet values

@@ -172,11 +172,67 @@ pub fn load(
         .collect::<Vec<_>>()
         .into_iter()
         .collect::<Result<(), MetricError>>()?;
+    Ok(sum_shares(complex, characteristic, &shares))
+}
+
+/// [`stiffness_metric`] and [`load`] together, equal to them bit for bit:
+/// when every cell is a Q1 or virtual element, one pass over the cells
+/// finds each cell's element (its tensor order and, for Q1, the
+/// isoparametric map at the Gauss points) once for both. On a bad
+/// cell or a non-finite f the two are computed apart, so the error is the
+/// one they report.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::{fe, isotropic};
+/// let k = rectangle(3, 2, [0.0, 3.0], [0.0, 1.0]).unwrap();
+/// let tensors = vec![isotropic(1.0); 6];
+/// let f = |x: &[f64]| 1.0 + x[0];
+/// let (omega, b) = fe::stiffness_and_load(&k, &tensors, &f).unwrap();
+/// assert_eq!(omega, fe::stiffness_metric(&k, &tensors).unwrap());
+/// assert_eq!(b, fe::load(&k, &f).unwrap());
+/// ```
+pub fn stiffness_and_load<'a>(
+    complex: &Complex,
+    tensors: impl Into<CellTensors<'a>>,
+    f: &(dyn Fn(&[f64]) -> f64 + Sync),
+) -> Result<(BlockMetric, Vec<f64>), MetricError> {
+    let tensors = tensors.into();
+    let apart = || Ok((stiffness_metric(complex, tensors)?, load(complex, f)?));
+    let Ok(top) = Topology::new(complex, "FE stiffness") else {
+        return apart();
+    };
+    let cells = complex.cell_count(top.n);
+    if check_tensors(tensors, cells, top.d).is_err()
+        || (0..cells).into_par_iter().any(|c| top.is_simplex(c))
+    {
+        return apart();
+    }
+    let Ok(characteristic) = complex.lar().characteristic(top.n) else {
+        return apart();
+    };
+    let indptr = characteristic.indptr();
+    let offsets = indptr.to_proper();
+    let mut shares = vec![0.0; offsets[cells]];
+    match dense_stiffness(
+        &top,
+        tensors,
+        Route::ByShape,
+        Some((f, &offsets, &mut shares)),
+    ) {
+        Ok(metric) => Ok((metric, sum_shares(complex, characteristic, &shares))),
+        Err(_) => apart(),
+    }
+}
+
+/// Per-vertex sums of the cells' load shares (laid out like the cells'
+/// vertex lists in `characteristic`), in cell order.
+fn sum_shares(complex: &Complex, characteristic: &CsMat<u8>, shares: &[f64]) -> Vec<f64> {
     let mut out = crate::canonical::zeroed(complex.cell_count(0));
-    for (&v, &x) in characteristic.indices().iter().zip(&shares) {
+    for (&v, &x) in characteristic.indices().iter().zip(shares) {
         out[v] += x;
     }
-    Ok(out)
+    out
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -229,7 +285,7 @@ fn stiffness(
         Route::ByShape => !(0..cells).into_par_iter().any(|c| top.is_simplex(c)),
     };
     if all_dense {
-        return dense_stiffness(&top, tensors, route);
+        return dense_stiffness(&top, tensors, route, None);
     }
     let locals = (0..cells)
         .into_par_iter()
@@ -277,11 +333,18 @@ fn dense_block(
 ) -> Result<(), MetricError> {
     let method = match element {
         // Q1 cells exist in 2D and 3D only (`Topology::tensor_order`).
-        Element::Q1(order) if top.n == 2 => {
-            return q1_block::<4, 4>(top, c, &order, k, scratch);
-        }
         Element::Q1(order) => {
-            return q1_block::<8, 12>(top, c, &order, k, scratch);
+            // The sorted edges are already in `scratch.edges`: the tensor
+            // order was found from them (`Topology::element_with`).
+            debug_assert_eq!(scratch.edges, top.edges_of(c));
+            let edges = scratch.edges.len();
+            scratch.omega.clear();
+            scratch.omega.resize(edges * edges, 0.0);
+            let (key, out) = (&mut scratch.key, &mut scratch.omega[..]);
+            return match top.n {
+                2 => q1_block::<4, 4>(top, c, &order, k, key, out, None),
+                _ => q1_block::<8, 12>(top, c, &order, k, key, out, None),
+            };
         }
         _ => {
             let kc = vem_stiffness(top, c, k)?;
@@ -300,10 +363,15 @@ fn dense_block(
 /// Ω with one dense block per top cell, in cell order, every cell a Q1 or
 /// virtual element: the block sizes (edges per cell) are counted first, and
 /// each thread then writes its cells' edge lists and blocks in place.
+///
+/// With `load` = (f, offsets, shares), each cell's load shares ∫_c f φ_v
+/// are also written to `shares[offsets[c]..offsets[c + 1]]` (the layout of
+/// the cells' vertex lists), from the element found for the stiffness.
 fn dense_stiffness(
     top: &Topology,
     tensors: CellTensors,
     route: Route,
+    load: Option<(LoadFn, &[usize], &mut [f64])>,
 ) -> Result<BlockMetric, MetricError> {
     let cells = top.complex.cell_count(top.n);
     let sizes: Vec<usize> = (0..cells)
@@ -327,20 +395,55 @@ fn dense_stiffness(
     let parts = ranges(cells);
     let index_parts = split_at_ranges(&mut indices, &parts, |c| edge_ptr[c]);
     let value_parts = split_at_ranges(&mut values, &parts, |c| value_ptr[c]);
+    let (f, share_parts) = match load {
+        Some((f, offsets, shares)) => (
+            Some((f, offsets)),
+            split_at_ranges(shares, &parts, |c| offsets[c])
+                .into_iter()
+                .map(Some)
+                .collect(),
+        ),
+        None => (None, parts.iter().map(|_| None).collect::<Vec<_>>()),
+    };
     // Each part stops at its first bad cell; the parts' errors come back
     // in cell order, so the first one reported is the first bad cell.
     parts
         .par_iter()
         .zip(index_parts)
         .zip(value_parts)
-        .map(|((range, index_out), value_out)| {
+        .zip(share_parts)
+        .map(|(((range, index_out), value_out), mut share_out)| {
             let mut scratch = CellScratch::default();
             let (edge_base, value_base) = (edge_ptr[range.start], value_ptr[range.start]);
             for c in range.clone() {
                 let element = top.element_with(c, route, &mut scratch.edges)?;
-                dense_block(top, c, element, &tensors.get(c), &mut scratch)?;
-                value_out[value_ptr[c] - value_base..value_ptr[c + 1] - value_base]
-                    .copy_from_slice(&scratch.omega);
+                let share = match (f, share_out.as_deref_mut()) {
+                    (Some((f, offsets)), Some(out)) => {
+                        let base = offsets[range.start];
+                        Some((f, &mut out[offsets[c] - base..offsets[c + 1] - base]))
+                    }
+                    _ => None,
+                };
+                let omega =
+                    &mut value_out[value_ptr[c] - value_base..value_ptr[c + 1] - value_base];
+                let k = tensors.get(c);
+                // Q1 blocks are written in place, with the load from the
+                // same map.
+                match element {
+                    Element::Q1(order) if top.n == 2 => {
+                        q1_block::<4, 4>(top, c, &order, &k, &mut scratch.key, omega, share)?
+                    }
+                    Element::Q1(order) => {
+                        q1_block::<8, 12>(top, c, &order, &k, &mut scratch.key, omega, share)?
+                    }
+                    element => {
+                        if let Some((f, out)) = share {
+                            element_load(top, c, &element, f, out)?;
+                        }
+                        dense_block(top, c, element, &k, &mut scratch)?;
+                        omega.copy_from_slice(&scratch.omega);
+                    }
+                }
                 index_out[edge_ptr[c] - edge_base..edge_ptr[c + 1] - edge_base]
                     .copy_from_slice(&scratch.edges);
             }
@@ -852,23 +955,30 @@ fn edge_block(
 }
 
 /// Ω_c of a Q1 cell with N = 2ⁿ corners and E edges (n = 2: 4, 4; n = 3:
-/// 8, 12) into `scratch.omega`, over its sorted edges (`scratch.edges`,
-/// left there by the element lookup that found the tensor order):
+/// 8, 12) into `out` (E × E), over its sorted edges (left in the scratch
+/// by the element lookup that found the tensor order):
 /// K_c from the 2ⁿ Gauss points, then (A_c⁺)ᵀ K_c A_c⁺ as in
 /// [`edge_block`], in fixed arrays, with A_c's pattern taken from the
 /// tensor order (no second walk of the edges).
 /// K_c and Ω_c are formed on and above the diagonal and mirrored, so both
-/// are exactly symmetric.
+/// are exactly symmetric. With `load` = (f, shares), the cell's load
+/// shares are written too, from the same map (as [`q1_load`]).
 fn q1_block<const N: usize, const E: usize>(
     top: &Topology,
     c: usize,
     order: &TensorOrder,
     k: &Tensor,
-    scratch: &mut CellScratch,
+    key: &mut Vec<usize>,
+    out: &mut [f64],
+    load: Option<(LoadFn, &mut [f64])>,
 ) -> Result<(), MetricError> {
     let n = top.n;
-    debug_assert_eq!((order.len(), n << (n - 1)), (N, E));
-    let map = q1_map::<N>(&tensor_points(top, c, order)[..N], n, c)?;
+    debug_assert_eq!((order.len(), n << (n - 1), out.len()), (N, E, E * E));
+    let x = tensor_points(top, c, order);
+    let map = q1_map::<N>(&x[..N], n, c)?;
+    if let Some((f, shares)) = load {
+        q1_shares(top, c, order, &x[..N], &map.weights, f, shares)?;
+    }
     // K_c in tensor order.
     let mut kc = [[0.0; N]; N];
     for (&weight, gradients) in map.weights[..N].iter().zip(&map.gradients) {
@@ -891,12 +1001,12 @@ fn q1_block<const N: usize, const E: usize>(
         }
     }
     // A_c⁺ with its rows (the cell's sorted vertices) in tensor order.
-    scratch.key.clear();
-    scratch.key.push(N);
+    key.clear();
+    key.push(N);
     for &[t, h] in &order.ends[..E] {
-        scratch.key.extend([usize::from(t), usize::from(h)]);
+        key.extend([usize::from(t), usize::from(h)]);
     }
-    let pinv = pseudo_inverse_of_key(&scratch.key, c, "Q1")?;
+    let pinv = pseudo_inverse_of_key(key, c, "Q1")?;
     let mut p = [[0.0; E]; N];
     for (row, &o) in p.iter_mut().zip(order.iter()) {
         for (e, entry) in row.iter_mut().enumerate() {
@@ -912,9 +1022,6 @@ fn q1_block<const N: usize, const E: usize>(
             }
         }
     }
-    let out = &mut scratch.omega;
-    out.clear();
-    out.resize(E * E, 0.0);
     for e in 0..E {
         for f in e..E {
             let value: f64 = (0..N).map(|l| p[l][e] * half[l][f]).sum();
@@ -929,9 +1036,6 @@ fn q1_block<const N: usize, const E: usize>(
             cell: c,
         });
     }
-    // The sorted edges are already in `scratch.edges`: the tensor order
-    // was found from them (`Topology::element_with`).
-    debug_assert_eq!(scratch.edges, top.edges_of(c));
     Ok(())
 }
 
@@ -1355,9 +1459,23 @@ fn cell_load(
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
     out: &mut [f64],
 ) -> Result<(), MetricError> {
+    element_load(top, c, &top.element(c, Route::ByShape)?, f, out)
+}
+
+/// A source f as the loads take it.
+type LoadFn<'f> = &'f (dyn Fn(&[f64]) -> f64 + Sync);
+
+/// [`cell_load`] of cell `c` with its element already found.
+fn element_load(
+    top: &Topology,
+    c: usize,
+    element: &Element,
+    f: LoadFn,
+    out: &mut [f64],
+) -> Result<(), MetricError> {
     let (n, d) = (top.n, top.d);
     out.fill(0.0);
-    match top.element(c, Route::ByShape)? {
+    match element {
         Element::P1 => {
             let x = top.points(c);
             let (measure, _) = simplex_gradients(&x, d).ok_or(MetricError::UnsupportedCell {
@@ -1378,8 +1496,8 @@ fn cell_load(
                 }
             }
         }
-        Element::Q1(order) if n == 2 => q1_load::<4>(top, c, &order, f, out)?,
-        Element::Q1(order) => q1_load::<8>(top, c, &order, f, out)?,
+        Element::Q1(order) if n == 2 => q1_load::<4>(top, c, order, f, out)?,
+        Element::Q1(order) => q1_load::<8>(top, c, order, f, out)?,
         Element::Vem => {
             let measure = top.complex.measure(n)[c];
             let mut p = [0.0; 3];
@@ -1399,12 +1517,27 @@ fn q1_load<const N: usize>(
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
     out: &mut [f64],
 ) -> Result<(), MetricError> {
-    let (n, d) = (top.n, top.d);
     let x = tensor_points(top, c, order);
-    let map = q1_map::<N>(&x[..N], n, c)?;
-    for ((values, _), &weight) in q1_reference(n).iter().zip(&map.weights) {
+    let map = q1_map::<N>(&x[..N], top.n, c)?;
+    q1_shares(top, c, order, &x[..N], &map.weights, f, out)
+}
+
+/// The tensor Gauss rule of [`q1_load`] on corners `x` (tensor order) with
+/// the map's weights |det J|, written over `out` (sorted vertex order).
+fn q1_shares(
+    top: &Topology,
+    c: usize,
+    order: &TensorOrder,
+    x: &[Point],
+    weights: &[f64],
+    f: LoadFn,
+    out: &mut [f64],
+) -> Result<(), MetricError> {
+    let (n, d) = (top.n, top.d);
+    out.fill(0.0);
+    for ((values, _), &weight) in q1_reference(n).iter().zip(weights) {
         let mut point = [0.0; 3];
-        for (xl, &v) in x[..N].iter().zip(values) {
+        for (xl, &v) in x.iter().zip(values) {
             for i in 0..n {
                 point[i] += v * xl[i];
             }
@@ -1534,6 +1667,93 @@ mod tests {
                 assert!((m[(i, j)] - expected).abs() < 1e-14, "({i},{j})");
             }
         }
+    }
+
+    /// A 6 × 5 grid of [0, 3] × [0, 2] with its interior vertices moved
+    /// (by a fixed pattern, up to 0.15 of a cell): convex quadrilaterals
+    /// that are not parallelograms, so the Gauss points see four maps.
+    fn distorted_quads() -> Complex {
+        let k = hasse_complex::generate::rectangle(6, 5, [0.0, 3.0], [0.0, 2.0]).unwrap();
+        let moved: Vec<[f64; 2]> = (0..k.cell_count(0))
+            .map(|v| {
+                let p = k.vertices().point(v);
+                let inside = p[0] > 0.0 && p[0] < 3.0 && p[1] > 0.0 && p[1] < 2.0;
+                let s = if inside { 0.15 * 0.5 } else { 0.0 };
+                let t = v as f64;
+                [p[0] + s * (1.7 * t).sin(), p[1] + s * (2.3 * t).cos()]
+            })
+            .collect();
+        k.with_vertices(Vertices::from_points(&moved).unwrap())
+            .unwrap()
+    }
+
+    #[test]
+    fn stiffness_and_load_together_are_the_two_apart() {
+        let f = |x: &[f64]| 1.0 + 2.0 * x[0] - x[1];
+        let quads = distorted_quads();
+        let axis = hasse_complex::generate::uniform_axis(3, 0.0, 1.0).unwrap();
+        let hexes =
+            hasse_complex::generate::box3(3, 2, 2, [0.0, 1.0], [0.0, 2.0], [0.0, 1.0]).unwrap();
+        let tets = hasse_complex::generate::kuhn(&[axis.clone(), axis.clone(), axis]).unwrap();
+        for k in [&quads, &hexes, &tets] {
+            let n = k.dim();
+            let cells = k.cell_count(n);
+            let tensors: Vec<Tensor> = (0..cells)
+                .map(|c| isotropic(1.0 + (c % 3) as f64))
+                .collect();
+            let (omega, b) = stiffness_and_load(k, &tensors, &f).unwrap();
+            assert_eq!(omega, stiffness_metric(k, &tensors).unwrap());
+            assert_eq!(b, load(k, &f).unwrap());
+            // Independently: the shares of a linear f sum to its integral,
+            // which the tensor Gauss rule and the P1 rules give exactly;
+            // ∫ f = |Ω| f(centre of mass).
+            let (volume, centre) = match n {
+                2 => (6.0, [1.5, 1.0]),
+                _ if k.cell_count(n) == 12 => (2.0, [0.5, 1.0]),
+                _ => (1.0, [0.5, 0.5]),
+            };
+            let expected = volume * f(&centre);
+            let total: f64 = b.iter().sum();
+            assert!(
+                (total - expected).abs() < 1e-12 * expected,
+                "{total} against {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn stiffness_and_load_report_what_they_report_apart() {
+        let k = hasse_complex::generate::rectangle(40, 25, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let mut tensors = vec![isotropic(1.0); 1000];
+        tensors[700] = isotropic(f64::MAX);
+        // A source that fails at a cell before the bad stiffness: the
+        // stiffness error still comes first, as when computed apart.
+        let f = |x: &[f64]| {
+            if x[0] < 0.1 && x[1] < 0.1 {
+                f64::NAN
+            } else {
+                1.0
+            }
+        };
+        let error = stiffness_and_load(&k, &tensors, &f).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                MetricError::UnsupportedCell {
+                    method: "Q1",
+                    cell: 700,
+                    ..
+                }
+            ),
+            "{error:?}"
+        );
+        // With a sound stiffness the source's first bad cell is named.
+        let error = stiffness_and_load(&k, &vec![isotropic(1.0); 1000], &f).unwrap_err();
+        assert_eq!(error, load(&k, &f).unwrap_err());
+        assert!(
+            matches!(error, MetricError::NonFinite { cell: 0 }),
+            "{error:?}"
+        );
     }
 
     #[test]
