@@ -5,7 +5,8 @@
 //! methods read (cached in the complex, so computed first and apart), the
 //! whole `Diffusion::assemble` (Ω, boundary data, source load, pattern and
 //! values) on the warm complex, then its parts through the
-//! public API: the metric Ω, `Canonical::new` (the sparsity pattern) and
+//! public API: the metric Ω, `Canonical::new` (the sparsity pattern; for
+//! the nodal cases `Canonical::with_cell_blocks`, as `Diffusion` builds it) and
 //! `Canonical::assemble_owned` (the values), each with its page faults. For the
 //! structured cell-centred cases the same 5/7-point matrix is also built by
 //! hand as triplets and compressed by faer, the floor any assembly is
@@ -78,7 +79,11 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
     };
     let metric_seconds = seconds(t);
     let (t, faults_metric) = (Instant::now(), faults());
-    let mut canonical = Canonical::new(incidence, metric).expect("canonical");
+    let mut canonical = match method {
+        Method::Fv => Canonical::new(incidence, metric),
+        _ => Canonical::with_cell_blocks(incidence, metric, complex),
+    }
+    .expect("canonical");
     let pattern_seconds = seconds(t);
     let (t, faults_pattern) = (Instant::now(), faults());
     let matrix = canonical.assemble_owned();

@@ -696,7 +696,11 @@ impl LocalPattern {
     fn matrix_pattern(&self, n: usize) -> (Vec<usize>, Vec<usize>) {
         pattern_by_columns(n, |j, rows| {
             for &b in self.blocks_of(j) {
-                rows.extend_from_slice(self.sides(b).0);
+                // A block's unknowns are few (a cell's vertices): a copy
+                // loop beats a call to memcpy per block.
+                for &i in self.sides(b).0 {
+                    rows.push(i);
+                }
             }
         })
     }
@@ -875,20 +879,37 @@ impl Canonical {
         Self::build(incidence, Some(by_columns), metric)
     }
 
-    /// [`Canonical::new`] for a metric with one block per top cell of a
-    /// complex, block b over the edges of cell b (a nodal element metric:
-    /// A = δ⁰, Ω from [`crate::metric::fe`]): the blocks' unknowns are
-    /// read from the complex's characteristic matrix M_n (`vertices`,
-    /// cells × vertices) and vertex star (`star`, its transpose) instead
-    /// of being gathered from A's rows, which at 10⁶ cells is a third of
-    /// the pattern's time and 80 MB. Falls back to [`Canonical::new`]
-    /// unless Ω was built with one block per cell and the shapes fit.
-    pub(crate) fn with_cell_blocks(
-        incidence: Arc<CsMat<i8>>,
+    /// [`Canonical::new`] for a metric with one block per top cell of
+    /// `complex`, block b over the edges of cell b (a nodal element
+    /// metric: A = δ⁰, Ω from [`crate::metric::fe::stiffness_metric`]):
+    /// the blocks' unknowns are read from the complex's characteristic
+    /// matrix M_n and vertex star (its transpose) instead of being
+    /// gathered from A's rows, which at 10⁶ Q1 cells is half the pattern's
+    /// time and 80 MB. The same M to the bit; falls back to
+    /// [`Canonical::new`] unless Ω was built with one block per cell and
+    /// the shapes fit.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::canonical::Canonical;
+    /// use hasse_solver::metric::fe;
+    /// let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let omega = fe::stiffness_metric(&k, &[1.0; 4]).unwrap();
+    /// let m = Canonical::with_cell_blocks(k.coboundary(0), omega.clone(), &k).unwrap().assemble();
+    /// let plain = Canonical::new(k.coboundary(0), omega).unwrap().assemble();
+    /// assert_eq!(m.val(), plain.val());
+    /// ```
+    pub fn with_cell_blocks(
+        incidence: impl Into<Arc<CsMat<i8>>>,
         metric: BlockMetric,
-        vertices: Arc<CsMat<u8>>,
-        star: Arc<CsMat<u8>>,
+        complex: &hasse_complex::Complex,
     ) -> Result<Self, CanonicalError> {
+        let incidence = incidence.into();
+        let n = complex.dim();
+        let Ok(vertices) = complex.lar().shared_characteristic(n) else {
+            return Self::new(incidence, metric);
+        };
+        let star = complex.shared_vertex_star(n);
         let fits = incidence.is_csr()
             && metric.per_cell
             && metric.diagonal_weights().is_none()
@@ -1296,15 +1317,8 @@ mod tests {
         k: &hasse_complex::Complex,
         omega: BlockMetric,
     ) -> (SparseColMat<usize, f64>, SparseColMat<usize, f64>) {
-        let n = k.dim();
         let gathered = Canonical::new(k.shared_coboundary(0), omega.clone()).unwrap();
-        let from_cells = Canonical::with_cell_blocks(
-            k.shared_coboundary(0),
-            omega,
-            k.lar().shared_characteristic(n).unwrap(),
-            k.shared_vertex_star(n),
-        )
-        .unwrap();
+        let from_cells = Canonical::with_cell_blocks(k.shared_coboundary(0), omega, k).unwrap();
         (gathered.assemble(), from_cells.assemble())
     }
 

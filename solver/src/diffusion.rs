@@ -829,15 +829,7 @@ impl Diffusion {
         let mut canonical = if ghosts.is_empty() && matches!(self.method, Method::Fv | Method::Fd) {
             Canonical::with_columns(incidence, complex.shared_boundary_csc(n), metric_final)?
         } else if location == Location::Nodal {
-            Canonical::with_cell_blocks(
-                incidence,
-                metric_final,
-                complex
-                    .lar()
-                    .shared_characteristic(n)
-                    .map_err(MetricError::from)?,
-                complex.shared_vertex_star(n),
-            )?
+            Canonical::with_cell_blocks(incidence, metric_final, complex)?
         } else {
             Canonical::new(incidence, metric_final)?
         };
