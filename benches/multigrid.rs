@@ -21,6 +21,10 @@
 //!   factorised with faer's own LLᵀ (AMD ordering), without hasse.
 //! - `q1-solve`: complex, then nodal Q1 `Diffusion::solve` (u = 0 on the
 //!   boundary vertices), timed whole, as `solve` for the cell-centred one.
+//! - `q1-assembly`: complex, then the nodal Q1 `Diffusion::assemble`
+//!   alone (geometry, Ω with the load, pattern, values, boundary data) on
+//!   both cores: the assembly's own cost, which `q1-solve` overlaps with
+//!   the analysis on the other core.
 //! - `q1-plain`: the Q1 stiffness on the interior vertices built by hand
 //!   from the element matrix of the square or cube, factorised with faer's
 //!   own LLᵀ (AMD ordering), without hasse.
@@ -191,6 +195,20 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             };
             format!("complex={complex_s:.3} {}", whole_solve(problem, &complex))
         }
+        "q1-assembly" => {
+            let t = Instant::now();
+            let complex = mesh(d, n);
+            let complex_s = seconds(t);
+            let system = nodal_problem(Method::Fe)
+                .assemble(&complex)
+                .expect("assembly");
+            format!(
+                "unknowns={} complex={complex_s:.3} assembly={:.3} nnz={}",
+                system.fixed.iter().filter(|g| g.is_none()).count(),
+                system.assembly_seconds,
+                system.matrix.compute_nnz(),
+            )
+        }
         "plain" | "q1-plain" => {
             let t = Instant::now();
             let matrix = match phase {
@@ -219,7 +237,7 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
             format!("file={path}.mtx")
         }
         other => {
-            panic!("unknown phase {other}: mg, mg-pc, direct, solve, plain, q1-solve, q1-plain, amd, nd or export")
+            panic!("unknown phase {other}: mg, mg-pc, direct, solve, plain, q1-solve, q1-assembly, q1-plain, amd, nd or export")
         }
     };
     format!(
@@ -383,8 +401,17 @@ fn write_vector_market(path: &str, v: &[f64]) -> std::io::Result<()> {
 }
 
 /// Every phase of a structured grid case, in the order they run.
-const GRID_PHASES: [&str; 9] = [
-    "mg", "mg-pc", "direct", "solve", "plain", "q1-solve", "q1-plain", "amd", "nd",
+const GRID_PHASES: [&str; 10] = [
+    "mg",
+    "mg-pc",
+    "direct",
+    "solve",
+    "plain",
+    "q1-solve",
+    "q1-assembly",
+    "q1-plain",
+    "amd",
+    "nd",
 ];
 /// Every phase of a Delaunay case.
 const DELAUNAY_PHASES: [&str; 8] = [

@@ -2,7 +2,7 @@
 and scripts/pyamg_baseline.py (stdin) into one table: hasse next to its
 baseline, with the ratio hasse / baseline (below 1: hasse is faster or
 smaller). Structured cases (phases mg, mg-pc, direct, solve, plain, q1-solve,
-q1-plain, amd, nd) and
+q1-assembly, q1-plain, amd, nd) and
 Delaunay cases (phases amg, dec, direct, plain, amd, nd, check) get their own
 rows; a failed phase shows as — in its rows."""
 import sys
@@ -139,6 +139,9 @@ for case in runs:
         rows.append((q1_label, "  assembly (geometry, Ω, AᵀΩA, b)", fmt(num(q1, "assembly")), "plain Q1 triplets", fmt(num(q1_plain, "assembly")), ratio(num(q1, "assembly"), num(q1_plain, "assembly"))))
         rows.append((q1_label, f"  LLᵀ analysis + numeric ({ORDERING.get(q1.get('ordering'), '?')})", fmt(add(num(q1, "analysis"), num(q1, "numeric"))), "plain faer LLᵀ (AMD)", fmt(num(q1_plain, "factor")), ratio(add(num(q1, "analysis"), num(q1, "numeric")), num(q1_plain, "factor"))))
         rows.append((q1_label, "  assembly against its own LLᵀ", fmt(num(q1, "assembly")), "hasse LLᵀ analysis + numeric", fmt(add(num(q1, "analysis"), num(q1, "numeric"))), ratio(num(q1, "assembly"), add(num(q1, "analysis"), num(q1, "numeric")))))
+        alone = r.get("q1-assembly", {})
+        if alone:
+            rows.append((q1_label, "  assembly alone (q1-assembly) against its own LLᵀ", fmt(num(alone, "assembly")), "hasse LLᵀ analysis + numeric", fmt(add(num(q1, "analysis"), num(q1, "numeric"))), ratio(num(alone, "assembly"), add(num(q1, "analysis"), num(q1, "numeric")))))
         rows.append((q1_label, "  peak memory", fmt(num(q1, "peak_gib"), "GiB"), "plain faer process", fmt(num(q1_plain, "peak_gib"), "GiB"), ratio(num(q1, "peak_gib"), num(q1_plain, "peak_gib"))))
     mg_setup, mg_solve = num(mg, "setup"), num(mg, "solve")
     mg_total = None if mg_setup is None else mg_setup + mg_solve
