@@ -500,7 +500,19 @@ impl Columns {
 /// dense element block (a Q1 hexahedron: 12 edge rows, 8 vertices) costs a
 /// few products per entry and no map from local entries to M is stored.
 #[derive(Clone, Debug)]
-struct LocalPattern {
+enum LocalPattern {
+    /// Gathered from A's rows, for any blocks.
+    Gathered(GatheredPattern),
+    /// Block b is top cell b of a complex over the cell's edges (a nodal
+    /// element metric): both sides of block b are the cell's vertices, row
+    /// b of the characteristic matrix M_n, and the blocks of unknown j are
+    /// row j of the vertex star M_nᵀ, both shared with the complex instead
+    /// of rebuilt.
+    Cells(CellSides),
+}
+
+#[derive(Clone, Debug)]
+struct GatheredPattern {
     /// Block b's row-side unknowns are `unknowns[ptr[b]..ptr[b] + rows[b]]`
     /// and its column-side unknowns the rest up to `ptr[b + 1]`, each
     /// sorted and distinct; when `shared[b]` (the block's row and column
@@ -514,12 +526,6 @@ struct LocalPattern {
     /// `blocks_of[block_ptr[j]..block_ptr[j + 1]]`, in block order.
     block_ptr: Vec<usize>,
     blocks_of: Vec<usize>,
-    /// Set instead of the lists above when block b is top cell b of a
-    /// complex over the cell's edges (a nodal element metric): both sides
-    /// of block b are the cell's vertices, row b of the characteristic
-    /// matrix M_n, and the blocks of unknown j are row j of the vertex
-    /// star M_nᵀ, both shared with the complex instead of rebuilt.
-    cells: Option<CellSides>,
 }
 
 #[derive(Clone, Debug)]
@@ -556,10 +562,11 @@ pub(crate) fn ranges(count: usize) -> Vec<std::ops::Range<usize>> {
         .collect()
 }
 
-impl LocalPattern {
+impl GatheredPattern {
     /// The local unknown sets of every block, in block order, written
-    /// straight into one list by [`compressed_lists`].
-    fn new(incidence: &CsMat<i8>, metric: &BlockMetric) -> Self {
+    /// straight into one list by [`compressed_lists`], and the blocks
+    /// indexed by column-side unknown (`n` unknowns).
+    fn new(incidence: &CsMat<i8>, metric: &BlockMetric, n: usize) -> Self {
         // Append the distinct unknowns of the rows `list` of A, sorted.
         let side = |list: &[usize], out: &mut Vec<usize>| {
             let begin = out.len();
@@ -601,50 +608,20 @@ impl LocalPattern {
                 }
             })
             .collect();
-        Self {
+        let mut gathered = Self {
             ptr,
             rows,
             shared,
             unknowns,
             block_ptr: Vec::new(),
             blocks_of: Vec::new(),
-            cells: None,
-        }
-    }
-
-    /// The local pattern of one block per top cell, read from the
-    /// complex's characteristic matrix and vertex star.
-    fn of_cells(cells: CellSides) -> Self {
-        Self {
-            ptr: Vec::new(),
-            rows: Vec::new(),
-            shared: Vec::new(),
-            unknowns: Vec::new(),
-            block_ptr: Vec::new(),
-            blocks_of: Vec::new(),
-            cells: Some(cells),
-        }
-    }
-
-    fn block_count(&self) -> usize {
-        match &self.cells {
-            Some(cells) => cells.vertices.rows(),
-            None => self.rows.len(),
-        }
-    }
-
-    /// Whether block b's row side is its column side.
-    fn is_shared(&self, b: usize) -> bool {
-        self.cells.is_some() || self.shared[b]
+        };
+        gathered.index_blocks(n);
+        gathered
     }
 
     /// Row-side and column-side unknowns of block b.
     fn sides(&self, b: usize) -> (&[usize], &[usize]) {
-        if let Some(cells) = &self.cells {
-            let m = &cells.vertices;
-            let both = &m.indices()[m.indptr().outer_inds_sz(b)];
-            return (both, both);
-        }
         let start = self.ptr[b];
         if self.shared[b] {
             let both = &self.unknowns[start..self.ptr[b + 1]];
@@ -657,19 +634,10 @@ impl LocalPattern {
         )
     }
 
-    /// The blocks with unknown j on their column side, in block order.
-    fn blocks_of(&self, j: usize) -> &[usize] {
-        if let Some(cells) = &self.cells {
-            let m = &cells.star;
-            return &m.indices()[m.indptr().outer_inds_sz(j)];
-        }
-        &self.blocks_of[self.block_ptr[j]..self.block_ptr[j + 1]]
-    }
-
     /// Index the blocks by column-side unknown (n unknowns).
     fn index_blocks(&mut self, n: usize) {
         let mut block_ptr = zeroed(n + 1);
-        for b in 0..self.block_count() {
+        for b in 0..self.rows.len() {
             for &j in self.sides(b).1 {
                 block_ptr[j + 1] += 1;
             }
@@ -679,7 +647,7 @@ impl LocalPattern {
         }
         let mut blocks_of = vec![0usize; block_ptr[n]];
         let mut next = block_ptr.clone();
-        for b in 0..self.block_count() {
+        for b in 0..self.rows.len() {
             for &j in self.sides(b).1 {
                 blocks_of[next[j]] = b;
                 next[j] += 1;
@@ -688,6 +656,39 @@ impl LocalPattern {
         drop(next);
         self.block_ptr = block_ptr;
         self.blocks_of = blocks_of;
+    }
+}
+
+impl LocalPattern {
+    /// Whether block b's row side is its column side.
+    fn is_shared(&self, b: usize) -> bool {
+        match self {
+            Self::Gathered(gathered) => gathered.shared[b],
+            Self::Cells(_) => true,
+        }
+    }
+
+    /// Row-side and column-side unknowns of block b.
+    fn sides(&self, b: usize) -> (&[usize], &[usize]) {
+        match self {
+            Self::Gathered(gathered) => gathered.sides(b),
+            Self::Cells(cells) => {
+                let m = &cells.vertices;
+                let both = &m.indices()[m.indptr().outer_inds_sz(b)];
+                (both, both)
+            }
+        }
+    }
+
+    /// The blocks with unknown j on their column side, in block order.
+    fn blocks_of(&self, j: usize) -> &[usize] {
+        match self {
+            Self::Gathered(g) => &g.blocks_of[g.block_ptr[j]..g.block_ptr[j + 1]],
+            Self::Cells(cells) => {
+                let m = &cells.star;
+                &m.indices()[m.indptr().outer_inds_sz(j)]
+            }
+        }
     }
 
     /// The sparsity pattern of M: column j holds every row-side unknown of
@@ -926,10 +927,10 @@ impl Canonical {
             return Self::new(incidence, metric);
         }
         check_sizes(&incidence, &metric)?;
-        let local = LocalPattern::of_cells(CellSides { vertices, star });
+        let local = LocalPattern::Cells(CellSides { vertices, star });
         debug_assert!(
             {
-                let gathered = LocalPattern::new(&incidence, &metric);
+                let gathered = GatheredPattern::new(&incidence, &metric, incidence.cols());
                 (0..metric.block_count()).all(|b| gathered.sides(b) == local.sides(b))
             },
             "a block's edges do not touch exactly its cell's vertices"
@@ -963,11 +964,9 @@ impl Canonical {
                 };
                 Assembly::Diagonal(columns)
             }
-            None => {
-                let mut local = LocalPattern::new(&incidence, &metric);
-                local.index_blocks(n);
-                Assembly::Blocks(local)
-            }
+            None => Assembly::Blocks(LocalPattern::Gathered(GatheredPattern::new(
+                &incidence, &metric, n,
+            ))),
         };
         Self::finish(incidence, metric, assembly)
     }

@@ -68,7 +68,7 @@ pub fn stiffness_metric<'a>(
     complex: &Complex,
     tensors: impl Into<CellTensors<'a>>,
 ) -> Result<BlockMetric, MetricError> {
-    stiffness(complex, tensors.into(), Route::ByShape)
+    stiffness(complex, tensors.into(), Route::ByShape, None).map(|(metric, _)| metric)
 }
 
 /// Stiffness metric from the lowest-order virtual element method on every
@@ -108,7 +108,7 @@ pub fn vem_stiffness_metric<'a>(
     complex: &Complex,
     tensors: impl Into<CellTensors<'a>>,
 ) -> Result<BlockMetric, MetricError> {
-    stiffness(complex, tensors.into(), Route::Vem)
+    stiffness(complex, tensors.into(), Route::Vem, None).map(|(metric, _)| metric)
 }
 
 /// Galerkin load vector ∫ f φ_v for every vertex v, with the quadrature of
@@ -198,30 +198,11 @@ pub fn stiffness_and_load<'a>(
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
 ) -> Result<(BlockMetric, Vec<f64>), MetricError> {
     let tensors = tensors.into();
-    let apart = || Ok((stiffness_metric(complex, tensors)?, load(complex, f)?));
-    let Ok(top) = Topology::new(complex, "FE stiffness") else {
-        return apart();
-    };
-    let cells = complex.cell_count(top.n);
-    if check_tensors(tensors, cells, top.d).is_err()
-        || (0..cells).into_par_iter().any(|c| top.is_simplex(c))
-    {
-        return apart();
-    }
-    let Ok(characteristic) = complex.lar().characteristic(top.n) else {
-        return apart();
-    };
-    let indptr = characteristic.indptr();
-    let offsets = indptr.to_proper();
-    let mut shares = vec![0.0; offsets[cells]];
-    match dense_stiffness(
-        &top,
-        tensors,
-        Route::ByShape,
-        Some((f, &offsets, &mut shares)),
-    ) {
-        Ok(metric) => Ok((metric, sum_shares(complex, characteristic, &shares))),
-        Err(_) => apart(),
+    match stiffness(complex, tensors, Route::ByShape, Some(f)) {
+        Ok((metric, Some(shares))) => Ok((metric, shares)),
+        Ok((metric, None)) => Ok((metric, load(complex, f)?)),
+        // A bad cell or source value: the error the two report apart.
+        Err(_) => Ok((stiffness_metric(complex, tensors)?, load(complex, f)?)),
     }
 }
 
@@ -268,11 +249,14 @@ impl std::ops::Deref for TensorOrder {
     }
 }
 
+/// Ω by `route`, and with `load` = Some(f) also the load of f when every
+/// cell has a dense block (written in the same pass; `None` otherwise).
 fn stiffness(
     complex: &Complex,
     tensors: CellTensors,
     route: Route,
-) -> Result<BlockMetric, MetricError> {
+    load: Option<LoadFn>,
+) -> Result<(BlockMetric, Option<Vec<f64>>), MetricError> {
     let top = Topology::new(complex, "FE stiffness")?;
     let n = top.n;
     let cells = complex.cell_count(n);
@@ -285,7 +269,15 @@ fn stiffness(
         Route::ByShape => !(0..cells).into_par_iter().any(|c| top.is_simplex(c)),
     };
     if all_dense {
-        return dense_stiffness(&top, tensors, route, None);
+        let Some(f) = load else {
+            return Ok((dense_stiffness(&top, tensors, route, None)?, None));
+        };
+        let characteristic = complex.lar().characteristic(n)?;
+        let indptr = characteristic.indptr();
+        let offsets = indptr.to_proper();
+        let mut shares = vec![0.0; offsets[cells]];
+        let metric = dense_stiffness(&top, tensors, route, Some((f, &offsets, &mut shares)))?;
+        return Ok((metric, Some(sum_shares(complex, characteristic, &shares))));
     }
     let locals = (0..cells)
         .into_par_iter()
@@ -305,7 +297,7 @@ fn stiffness(
         .collect::<Vec<Result<_, _>>>()
         .into_iter()
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(gather(complex.cell_count(1), &locals))
+    Ok((gather(complex.cell_count(1), &locals), None))
 }
 
 /// Scratch vectors reused from cell to cell by one thread.
@@ -340,11 +332,15 @@ fn dense_block(
             let edges = scratch.edges.len();
             scratch.omega.clear();
             scratch.omega.resize(edges * edges, 0.0);
-            let (key, out) = (&mut scratch.key, &mut scratch.omega[..]);
-            return match top.n {
-                2 => q1_block::<4, 4>(top, c, &order, k, key, out, None),
-                _ => q1_block::<8, 12>(top, c, &order, k, key, out, None),
-            };
+            return q1_cell(
+                top,
+                c,
+                &order,
+                k,
+                &mut scratch.key,
+                &mut scratch.omega,
+                None,
+            );
         }
         _ => {
             let kc = vem_stiffness(top, c, k)?;
@@ -430,11 +426,8 @@ fn dense_stiffness(
                 // Q1 blocks are written in place, with the load from the
                 // same map.
                 match element {
-                    Element::Q1(order) if top.n == 2 => {
-                        q1_block::<4, 4>(top, c, &order, &k, &mut scratch.key, omega, share)?
-                    }
                     Element::Q1(order) => {
-                        q1_block::<8, 12>(top, c, &order, &k, &mut scratch.key, omega, share)?
+                        q1_cell(top, c, &order, &k, &mut scratch.key, omega, share)?
                     }
                     element => {
                         if let Some((f, out)) = share {
@@ -952,6 +945,22 @@ fn edge_block(
         });
     }
     Ok(())
+}
+
+/// [`q1_block`] of a quadrilateral (n = 2) or hexahedron (n = 3).
+fn q1_cell(
+    top: &Topology,
+    c: usize,
+    order: &TensorOrder,
+    k: &Tensor,
+    key: &mut Vec<usize>,
+    out: &mut [f64],
+    load: Option<(LoadFn, &mut [f64])>,
+) -> Result<(), MetricError> {
+    match top.n {
+        2 => q1_block::<4, 4>(top, c, order, k, key, out, load),
+        _ => q1_block::<8, 12>(top, c, order, k, key, out, load),
+    }
 }
 
 /// Ω_c of a Q1 cell with N = 2ⁿ corners and E edges (n = 2: 4, 4; n = 3:
