@@ -237,6 +237,14 @@ pub fn nested_dissection(
 /// within 4 %, leaves of 256 give 25 % more).
 const DISSECTION_LEAF: usize = 32;
 
+/// Values closer to a part's median than this fraction of the part's width
+/// count as on the median (far below any grid spacing, far above rounding).
+const MEDIAN_TOLERANCE: f64 = 1e-9;
+
+/// Parts larger than this try both kinds of direction (axes and, in the
+/// plane, diagonals); smaller ones keep their parent's kind.
+const TRIAL_PART: usize = 50_000;
+
 /// Parts larger than this cut their two halves in parallel.
 const PARALLEL_PART: usize = 20_000;
 
@@ -247,16 +255,26 @@ const PARALLEL_PART: usize = 20_000;
 /// A part is cut at the median of its widest coordinate: the vertices below
 /// the median go left, the others right, and the right vertices with a left
 /// neighbour are the separator, numbered after both sides, whose own parts
-/// are ordered the same way first. Ties at the median go right, so on a
-/// grid the separator is one grid line (2D) or plane (3D). Parts of at most
-/// 32 vertices keep their order.
+/// are ordered the same way first. Ties at the median go right (values
+/// within 10⁻⁹ of the part's width count as ties, so that rounding in
+/// centroids does not split a grid line), so on a grid the separator is
+/// one grid line (2D) or plane (3D). In the plane the part's widest
+/// diagonal, x + y or x − y, is tried too, and the cut with the smaller
+/// separator is kept, the diagonal on a tie; parts of at most 50 000
+/// vertices try only the kind (axis or diagonal) their parent was cut
+/// along. The five-point stencil steps x + y by ±1, so a diagonal line
+/// separates it, and a diamond of the grid holds twice the points of a
+/// square with its separator's length: nested dissection along diagonals
+/// does half the work of one along the axes. On the nine-point stencil a
+/// diagonal separator is two lines thick and the axes win. Parts of at
+/// most 32 vertices keep their order.
 ///
-/// On 2D 1000² grids this leaves 2.9× fewer factorisation flops than AMD
-/// for the nine-point Q1 stiffness and 6 % more for the five-point
-/// operator; on 3D 60³ grids it matches METIS for Q1 and leaves 30 % more
-/// for the seven-point one, at 1/10 to 1/25 of METIS's time (see
-/// [`crate::linear::Ordering::Automatic`]). The result depends only on the
-/// pattern and the points.
+/// On 2D 1000² grids this leaves 0.53× AMD's factorisation flops (0.69×
+/// METIS's) for the five-point operator and 2.9× fewer than AMD for the
+/// nine-point Q1 stiffness (at 500², METIS's to 1 %); on 3D 60³ grids it matches
+/// METIS for Q1 and leaves 30 % more for the seven-point one, at 1/10 to
+/// 1/25 of METIS's time (see [`crate::linear::Ordering::Automatic`]). The
+/// result depends only on the pattern and the points.
 ///
 /// ```
 /// use faer::sparse::{SparseColMat, Triplet};
@@ -273,9 +291,10 @@ const PARALLEL_PART: usize = 20_000;
 /// }
 /// let a = SparseColMat::<usize, f64>::try_new_from_triplets(m * m, m * m, &t).unwrap();
 /// let perm = coordinate_dissection(a.symbolic(), &points, 2).unwrap();
-/// // The first cut is the grid line x = 4, numbered last.
+/// // The diagonal x + y = 8 separates with as few points (9) as the line
+/// // x = 4; ties go to the diagonal, numbered last.
 /// let (forward, _) = perm.arrays();
-/// assert!(forward[m * m - m..].iter().all(|&v| v % m == 4));
+/// assert!(forward[m * m - m..].iter().all(|&v| v % m + v / m == 8));
 /// ```
 pub fn coordinate_dissection(
     pattern: SymbolicSparseColMatRef<'_, usize>,
@@ -313,7 +332,7 @@ fn dissect_with_leaf(
     };
     // n ≤ i32::MAX (Adjacency::of_pattern checked it).
     let mut order: Vec<u32> = (0..n as u32).collect();
-    parts.order(&mut order);
+    parts.order(&mut order, None);
     let forward: Box<[usize]> = order.iter().map(|&v| v as usize).collect();
     let mut inverse = vec![0usize; n].into_boxed_slice();
     for (k, &v) in forward.iter().enumerate() {
@@ -340,44 +359,76 @@ impl Dissection<'_> {
         self.points[v as usize * self.dimension + axis]
     }
 
-    /// Rearranges `part` into [left, right, separator], each side ordered
-    /// recursively.
-    fn order(&self, part: &mut [u32]) {
-        let n = part.len();
-        if n <= self.leaf {
-            return;
+    /// The value along `direction` of vertex v.
+    fn key(&self, v: u32, direction: Direction) -> f64 {
+        match direction {
+            Direction::Axis(a) => self.coordinate(v, a),
+            Direction::Sum => self.coordinate(v, 0) + self.coordinate(v, 1),
+            Direction::Difference => self.coordinate(v, 0) - self.coordinate(v, 1),
         }
-        // The widest axis; the first of equally wide ones.
-        let mut axis = 0;
-        let mut widest = f64::NEG_INFINITY;
-        for a in 0..self.dimension {
-            let (lo, hi) = part
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                    let x = self.coordinate(v, a);
-                    (lo.min(x), hi.max(x))
-                });
-            if hi - lo > widest {
-                (axis, widest) = (a, hi - lo);
+    }
+
+    /// The directions worth cutting `part` across: its widest axis and, in
+    /// the plane, its widest diagonal (the first of equally wide ones, in
+    /// the units of the axes); none when every point of the part is at one
+    /// position.
+    fn directions(&self, part: &[u32], family: Option<Family>) -> Vec<(Direction, f64)> {
+        let mut candidates: Vec<(Direction, f64)> = Vec::new();
+        if family != Some(Family::Diagonals) || self.dimension != 2 {
+            candidates.extend((0..self.dimension).map(|a| (Direction::Axis(a), 1.0)));
+        }
+        let axes = candidates.len();
+        if self.dimension == 2 && family != Some(Family::Axes) {
+            let half = std::f64::consts::FRAC_1_SQRT_2;
+            candidates.extend([(Direction::Sum, half), (Direction::Difference, half)]);
+        }
+        let widths: Vec<f64> = candidates
+            .iter()
+            .map(|&(direction, _)| {
+                let (lo, hi) =
+                    part.iter()
+                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                            let x = self.key(v, direction);
+                            (lo.min(x), hi.max(x))
+                        });
+                hi - lo
+            })
+            .collect();
+        let scaled = |k: usize| widths[k] * candidates[k].1;
+        let widest = |range: std::ops::Range<usize>| {
+            let mut best: Option<usize> = None;
+            for k in range {
+                if scaled(k) > 0.0 && best.is_none_or(|b| scaled(k) > scaled(b)) {
+                    best = Some(k);
+                }
             }
-        }
-        if widest <= 0.0 {
-            // Every point of the part at one position: nothing to cut.
-            return;
-        }
-        let x = |v: &u32| self.coordinate(*v, axis);
+            best.map(|k| (candidates[k].0, widths[k]))
+        };
+        let mut directions: Vec<(Direction, f64)> = widest(0..axes).into_iter().collect();
+        directions.extend(widest(axes..candidates.len()));
+        directions
+    }
+
+    /// Rearranges `part` into [left, right, separator] by the median along
+    /// `direction`, across which the part is `width` wide; `None` (and
+    /// `part` in some order) when no value lies below the largest.
+    fn cut(&self, part: &mut [u32], direction: Direction, width: f64) -> Option<Cut> {
+        let n = part.len();
+        let x = |v: &u32| self.key(*v, direction);
         part.select_nth_unstable_by(n / 2, |a, b| x(a).total_cmp(&x(b)));
         let median = x(&part[n / 2]);
+        // Points of one grid line differ by rounding (centroids, x ± y):
+        // values within `near` of the median count as on it, else a line
+        // is split point by point and its separator is two lines thick.
+        let near = MEDIAN_TOLERANCE * width;
         // Below the median goes left; when the median is the smallest
         // value, at or below it.
-        let mut left = partition(part, |v| x(v) < median);
+        let mut left = partition(part, |v| x(v) < median - near);
         if left == 0 {
-            left = partition(part, |v| x(v) <= median);
+            left = partition(part, |v| x(v) <= median + near);
         }
         if left == 0 || left == n {
-            // Unreachable with a positive width: some value lies below the
-            // largest, and the median is at most that.
-            return;
+            return None;
         }
         let cut = self.cuts.fetch_add(1, Relaxed) + 1;
         for &v in &part[..left] {
@@ -401,14 +452,107 @@ impl Dissection<'_> {
                 k += 1;
             }
         }
-        let (left_part, rest) = part.split_at_mut(left);
-        let right_part = &mut rest[..end - left];
-        if n > PARALLEL_PART {
-            rayon::join(|| self.order(left_part), || self.order(right_part));
-        } else {
-            self.order(left_part);
-            self.order(right_part);
+        Some(Cut {
+            direction,
+            left,
+            end,
+            len: n,
+        })
+    }
+
+    /// Rearranges `part` into [left, right, separator], each side ordered
+    /// recursively, by the candidate cut with the smallest separator. Of
+    /// equally small ones the later wins, a diagonal over an axis: on a
+    /// five-point grid a square's diagonal separates as well as its middle
+    /// line, and the triangles it leaves are cut by diagonals of half
+    /// their legs, where a line along an axis would take 0.7 of them.
+    fn order(&self, part: &mut [u32], family: Option<Family>) {
+        let n = part.len();
+        if n <= self.leaf {
+            return;
         }
+        let directions = self.directions(part, family);
+        let mut best: Option<Cut> = None;
+        // The best arrangement so far, when a later candidate overwrites it.
+        let mut saved: Vec<u32> = Vec::new();
+        let mut best_is_in_place = false;
+        for (k, &(direction, width)) in directions.iter().enumerate() {
+            let Some(cut) = self.cut(part, direction, width) else {
+                best_is_in_place = false;
+                continue;
+            };
+            if best.is_none_or(|b| cut.separator() <= b.separator()) {
+                best = Some(cut);
+                best_is_in_place = true;
+                if k + 1 < directions.len() {
+                    saved.clear();
+                    saved.extend_from_slice(part);
+                }
+            } else {
+                best_is_in_place = false;
+            }
+        }
+        let Some(best) = best else {
+            return;
+        };
+        if !best_is_in_place {
+            part.copy_from_slice(&saved);
+        }
+        let (left_part, rest) = part.split_at_mut(best.left);
+        let right_part = &mut rest[..best.end - best.left];
+        let inherit = |side: &[u32]| (side.len() <= TRIAL_PART).then(|| best.direction.family());
+        let (left_family, right_family) = (inherit(left_part), inherit(right_part));
+        if n > PARALLEL_PART {
+            rayon::join(
+                || self.order(left_part, left_family),
+                || self.order(right_part, right_family),
+            );
+        } else {
+            self.order(left_part, left_family);
+            self.order(right_part, right_family);
+        }
+    }
+}
+
+/// A direction a part is cut across: a coordinate axis, or in the plane
+/// the diagonals x + y and x − y.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Direction {
+    Axis(usize),
+    Sum,
+    Difference,
+}
+
+/// The kinds of [`Direction`]: a part of at most [`TRIAL_PART`] vertices
+/// is cut across its parent's kind only.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Family {
+    Axes,
+    Diagonals,
+}
+
+impl Direction {
+    fn family(self) -> Family {
+        match self {
+            Direction::Axis(_) => Family::Axes,
+            Direction::Sum | Direction::Difference => Family::Diagonals,
+        }
+    }
+}
+
+/// A part rearranged by [`Dissection::cut`]: `[..left]` the left side,
+/// `[left..end]` the right side, `[end..len]` the separator.
+#[derive(Clone, Copy)]
+struct Cut {
+    direction: Direction,
+    left: usize,
+    end: usize,
+    len: usize,
+}
+
+impl Cut {
+    fn separator(&self) -> usize {
+        self.len - self.end
     }
 }
 
@@ -576,6 +720,75 @@ mod tests {
             right_cut.iter().all(|&v| x(v) >= 4 && y(v) == 3),
             "{right_cut:?}"
         );
+    }
+
+    /// The lattice points of the diamond |x| + |y| ≤ r with their
+    /// five-point pattern (neighbours one unit apart along an axis).
+    fn five_point_diamond(r: i64) -> (SymbolicSparseColMat<usize>, Vec<f64>, Vec<(i64, i64)>) {
+        let sites: Vec<(i64, i64)> = (-r..=r)
+            .flat_map(|y| (-r..=r).map(move |x| (x, y)))
+            .filter(|(x, y)| x.abs() + y.abs() <= r)
+            .collect();
+        let index = |p: (i64, i64)| sites.iter().position(|&q| q == p);
+        let mut entries = Vec::new();
+        for (v, &(x, y)) in sites.iter().enumerate() {
+            entries.push((v, v));
+            for step in [(x + 1, y), (x - 1, y), (x, y + 1), (x, y - 1)] {
+                if let Some(w) = index(step) {
+                    entries.push((w, v));
+                }
+            }
+        }
+        let points = sites
+            .iter()
+            .flat_map(|&(x, y)| [x as f64, y as f64])
+            .collect();
+        (pattern(sites.len(), &entries), points, sites)
+    }
+
+    #[test]
+    fn a_diamond_of_the_five_point_grid_is_cut_along_its_diagonal() {
+        // On the diamond |x| + |y| ≤ 6 (85 points) the median of x is 0 and
+        // the grid line x = 0 separates with its 13 points; the median of
+        // x + y is 0 too, and the 7 points (k, −k), |k| ≤ 3, separate: the
+        // five-point stencil steps x + y by ±1, so the line x + y = 0 is
+        // crossed by no edge from x + y < 0 to x + y > 0, and each of its
+        // points has a neighbour at x + y = −1. The smaller separator is
+        // numbered last.
+        let (p, points, sites) = five_point_diamond(6);
+        assert_eq!(sites.len(), 85);
+        let perm = coordinate_dissection(p.as_ref(), &points, 2).unwrap();
+        assert_bijection(&perm, 85);
+        let last: Vec<(i64, i64)> = perm.arrays().0[85 - 7..]
+            .iter()
+            .map(|&v| sites[v])
+            .collect();
+        assert!(last.iter().all(|&(x, y)| x + y == 0), "{last:?}");
+    }
+
+    #[test]
+    fn rounding_in_the_points_does_not_split_a_grid_line() {
+        // A 5³ grid whose middle plane x = 2 holds 12 points at 2 and 13 one
+        // ulp above (as rounding leaves centroids): sorted by x, positions
+        // 50..62 are the plane's 2s and the median, position 62, is the
+        // first value above 2. Split at that value, the plane would lose 12
+        // points to the left side; within the tolerance they are one plane,
+        // the separator of 25 points numbered last.
+        let m = 5;
+        let (p, mut points) = grid(m, 3);
+        let above = f64::from_bits(2.0f64.to_bits() + 1);
+        let mut on_plane = 0;
+        for v in 0..m * m * m {
+            if v % m == 2 {
+                if on_plane >= 12 {
+                    points[3 * v] = above;
+                }
+                on_plane += 1;
+            }
+        }
+        let perm = coordinate_dissection(p.as_ref(), &points, 3).unwrap();
+        let last = &perm.arrays().0[m * m * m - m * m..];
+        assert!(last.iter().all(|&v| v % m == 2), "{last:?}");
     }
 
     #[test]
