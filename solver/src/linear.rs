@@ -106,15 +106,16 @@ pub enum Ordering {
     /// | 3D 60³ seven-point FV (`3d-60 solve`) | — | 1.44 + 2.42 | 0.23 + 2.89 |
     /// | 3D 60³ Q1 (`3d-60 q1-solve`) | — | 2.22 + 4.54 | 0.36 + 4.86 |
     ///
-    /// The five-point row predates the diagonal cuts of
-    /// [`crate::ordering::coordinate_dissection`]: with them the factor
-    /// holds 44.4 M entries instead of 68.4 M, and two runs on a slower
-    /// day gave 0.87 + 1.14 and 0.88 + 1.29 s, against plain faer's AMD
-    /// analysis and factorisation of 2.68 and 3.08 s in between.
+    /// The table predates the diagonal cuts of
+    /// [`crate::ordering::coordinate_dissection`]. With them, two runs on
+    /// a slower day gave 0.87 + 1.14 and 0.88 + 1.29 s on the five-point
+    /// grid (factor 44.4 M entries instead of 68.4 M), against plain
+    /// faer's AMD analysis and factorisation of 2.68 and 3.08 s in
+    /// between, and 0.39 + 2.37 and 0.37 + 1.84 s on the seven-point one.
     ///
     /// Factorisation work Σ c_j² ([`DirectSolver::factor_flops`]) against
     /// AMD: 0.53× on the five-point grid, 0.35× on the nine-point one; on
-    /// 3D grids 1.3× METIS's (seven-point) and 1.0× (Q1). The analysis
+    /// 3D grids 0.51× METIS's (seven-point) and 1.0× (Q1). The analysis
     /// costs a third to a tenth of AMD's or METIS's, which is what the
     /// whole solve saves where the factor is no smaller.
     #[default]
