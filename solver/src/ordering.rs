@@ -380,48 +380,46 @@ impl Dissection<'_> {
         }
     }
 
-    /// The directions worth cutting `part` across: its widest axis and, in
-    /// the plane, its widest diagonal (the first of equally wide ones, in
-    /// the units of the axes); none when every point of the part is at one
+    /// The directions worth cutting `part` across, with the part's width
+    /// along each: its widest axis and its widest diagonal (of
+    /// [`diagonals_of`]), each the first of equally wide ones, or only
+    /// those of `family`; none when every point of the part is at one
     /// position.
     fn directions(&self, part: &[u32], family: Option<Family>) -> Vec<(Direction, f64)> {
-        let mut candidates: Vec<(Direction, f64)> = Vec::new();
         let diagonals = diagonals_of(self.dimension);
-        if family != Some(Family::Diagonals) || diagonals.is_empty() {
-            candidates.extend((0..self.dimension).map(|a| (Direction::Axis(a), 1.0)));
-        }
-        let axes = candidates.len();
-        if family != Some(Family::Axes) {
-            for &signs in diagonals {
-                let length = signs.iter().map(|&x| f64::from(x * x)).sum::<f64>().sqrt();
-                candidates.push((Direction::Diagonal(signs), 1.0 / length));
+        let axes = (family != Some(Family::Diagonals) || diagonals.is_empty())
+            .then(|| self.widest(part, (0..self.dimension).map(Direction::Axis)));
+        let diagonal = (family != Some(Family::Axes))
+            .then(|| self.widest(part, diagonals.iter().map(|&s| Direction::Diagonal(s))));
+        axes.flatten()
+            .into_iter()
+            .chain(diagonal.flatten())
+            .collect()
+    }
+
+    /// The first of the widest `candidates` across `part` (extents in the
+    /// units of the axes) with the width of its key; `None` when every one
+    /// has width 0.
+    fn widest(
+        &self,
+        part: &[u32],
+        candidates: impl Iterator<Item = Direction>,
+    ) -> Option<(Direction, f64)> {
+        let mut best: Option<(Direction, f64, f64)> = None;
+        for direction in candidates {
+            let (lo, hi) = part
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    let x = self.key(v, direction);
+                    (lo.min(x), hi.max(x))
+                });
+            let width = hi - lo;
+            let scaled = width * direction.scale();
+            if scaled > 0.0 && best.is_none_or(|(_, _, s)| scaled > s) {
+                best = Some((direction, width, scaled));
             }
         }
-        let widths: Vec<f64> = candidates
-            .iter()
-            .map(|&(direction, _)| {
-                let (lo, hi) =
-                    part.iter()
-                        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                            let x = self.key(v, direction);
-                            (lo.min(x), hi.max(x))
-                        });
-                hi - lo
-            })
-            .collect();
-        let scaled = |k: usize| widths[k] * candidates[k].1;
-        let widest = |range: std::ops::Range<usize>| {
-            let mut best: Option<usize> = None;
-            for k in range {
-                if scaled(k) > 0.0 && best.is_none_or(|b| scaled(k) > scaled(b)) {
-                    best = Some(k);
-                }
-            }
-            best.map(|k| (candidates[k].0, widths[k]))
-        };
-        let mut directions: Vec<(Direction, f64)> = widest(0..axes).into_iter().collect();
-        directions.extend(widest(axes..candidates.len()));
-        directions
+        best.map(|(direction, width, _)| (direction, width))
     }
 
     /// Rearranges `part` into [left, right, separator] by the median along
@@ -487,30 +485,26 @@ impl Dissection<'_> {
             return;
         }
         let directions = self.directions(part, family);
-        let mut best: Option<Cut> = None;
-        // The best arrangement so far, when a later candidate overwrites it.
+        // Every candidate rearranges the part, so the best is in place only
+        // when it was the last one tried; before that it is saved.
+        let mut best: Option<(usize, Cut)> = None;
         let mut saved: Vec<u32> = Vec::new();
-        let mut best_is_in_place = false;
         for (k, &(direction, width)) in directions.iter().enumerate() {
             let Some(cut) = self.cut(part, direction, width) else {
-                best_is_in_place = false;
                 continue;
             };
-            if best.is_none_or(|b| cut.separator() <= b.separator()) {
-                best = Some(cut);
-                best_is_in_place = true;
+            if best.is_none_or(|(_, b)| cut.separator() <= b.separator()) {
+                best = Some((k, cut));
                 if k + 1 < directions.len() {
                     saved.clear();
                     saved.extend_from_slice(part);
                 }
-            } else {
-                best_is_in_place = false;
             }
         }
-        let Some(best) = best else {
+        let Some((k, best)) = best else {
             return;
         };
-        if !best_is_in_place {
+        if k + 1 < directions.len() {
             part.copy_from_slice(&saved);
         }
         let (left_part, rest) = part.split_at_mut(best.left);
@@ -563,6 +557,17 @@ enum Family {
 }
 
 impl Direction {
+    /// 1 over the length of the key's gradient: a key's width times this
+    /// is the part's extent along the direction.
+    fn scale(self) -> f64 {
+        match self {
+            Direction::Axis(_) => 1.0,
+            Direction::Diagonal(signs) => {
+                1.0 / signs.iter().map(|&x| f64::from(x * x)).sum::<f64>().sqrt()
+            }
+        }
+    }
+
     fn family(self) -> Family {
         match self {
             Direction::Axis(_) => Family::Axes,
