@@ -283,7 +283,7 @@ fn stiffness(
         .into_par_iter()
         .map_init(CellScratch::default, |scratch, c| {
             let k = &tensors.get(c);
-            match top.element_with(c, route, &mut scratch.edges)? {
+            match top.element_with(c, route, &mut scratch.edges, &mut scratch.q1)? {
                 Element::P1 => p1_weights(&top, c, k),
                 element => {
                     dense_block(&top, c, element, k, scratch)?;
@@ -312,6 +312,46 @@ struct CellScratch {
     key: Vec<usize>,
     /// Ω_c (edges × edges, row-major).
     omega: Vec<f64>,
+    /// The last Q1 cell's local incidence and what it fixes.
+    q1: Q1Memo,
+}
+
+/// What the local incidence of a Q1 cell fixes (its tensor order and
+/// A_c⁺), kept from the last cell looked up: neighbouring cells of a
+/// structured grid have the same local incidence, and comparing it is
+/// cheaper than finding the order again and looking A_c⁺ up by key.
+#[derive(Default)]
+struct Q1Memo {
+    /// Vertex count and each edge's (tail, head) in the sorted vertex
+    /// list, for the last cell whose order was found.
+    ends: Option<(usize, [[u8; 2]; 12])>,
+    order: Option<TensorOrder>,
+    /// A_c⁺ with its rows in tensor order (`pinv[l][e]`), valid when
+    /// `pinv_valid`, for the local incidence in `ends`.
+    pinv: [[f64; 12]; 8],
+    pinv_valid: bool,
+    /// Scratch for the A_c⁺ cache's key.
+    key: Vec<usize>,
+}
+
+impl Q1Memo {
+    /// The tensor order of a cell with `m` vertices, n-dimensional, whose
+    /// edges have the local `ends` (unused entries zero).
+    fn order(
+        &mut self,
+        m: usize,
+        n: usize,
+        ends: &[[u8; 2]; 12],
+        edges: usize,
+    ) -> Option<TensorOrder> {
+        if self.ends == Some((m, *ends)) {
+            return self.order;
+        }
+        self.order = tensor_order_of(m, n, ends, edges);
+        self.ends = Some((m, *ends));
+        self.pinv_valid = false;
+        self.order
+    }
 }
 
 /// Ω_c of a Q1 or virtual-element cell `c` into `scratch.omega`, over its
@@ -332,15 +372,7 @@ fn dense_block(
             let edges = scratch.edges.len();
             scratch.omega.clear();
             scratch.omega.resize(edges * edges, 0.0);
-            return q1_cell(
-                top,
-                c,
-                &order,
-                k,
-                &mut scratch.key,
-                &mut scratch.omega,
-                None,
-            );
+            return q1_cell(top, c, &order, k, &mut scratch.q1, &mut scratch.omega, None);
         }
         _ => {
             let kc = vem_stiffness(top, c, k)?;
@@ -412,7 +444,7 @@ fn dense_stiffness(
             let mut scratch = CellScratch::default();
             let (edge_base, value_base) = (edge_ptr[range.start], value_ptr[range.start]);
             for c in range.clone() {
-                let element = top.element_with(c, route, &mut scratch.edges)?;
+                let element = top.element_with(c, route, &mut scratch.edges, &mut scratch.q1)?;
                 let share = match (f, share_out.as_deref_mut()) {
                     (Some((f, offsets)), Some(out)) => {
                         let base = offsets[range.start];
@@ -427,7 +459,7 @@ fn dense_stiffness(
                 // same map.
                 match element {
                     Element::Q1(order) => {
-                        q1_cell(top, c, &order, &k, &mut scratch.key, omega, share)?
+                        q1_cell(top, c, &order, &k, &mut scratch.q1, omega, share)?
                     }
                     element => {
                         if let Some((f, out)) = share {
@@ -625,15 +657,17 @@ impl<'a> Topology<'a> {
     }
 
     fn element(&self, c: usize, route: Route) -> Result<Element, MetricError> {
-        self.element_with(c, route, &mut Vec::new())
+        self.element_with(c, route, &mut Vec::new(), &mut Q1Memo::default())
     }
 
-    /// [`Topology::element`] with a scratch vector for the cell's edges.
+    /// [`Topology::element`] with a scratch vector for the cell's edges
+    /// and the last Q1 cell's local incidence.
     fn element_with(
         &self,
         c: usize,
         route: Route,
         edges: &mut Vec<usize>,
+        memo: &mut Q1Memo,
     ) -> Result<Element, MetricError> {
         if self.is_simplex(c) && (route == Route::ByShape || self.n == 1) {
             return Ok(Element::P1);
@@ -651,7 +685,7 @@ impl<'a> Topology<'a> {
         if route == Route::Vem {
             return Ok(Element::Vem);
         }
-        Ok(match self.tensor_order(c, edges) {
+        Ok(match self.tensor_order(c, edges, memo) {
             Some(order) => Element::Q1(order),
             None => Element::Vem,
         })
@@ -660,7 +694,12 @@ impl<'a> Topology<'a> {
     /// Local vertex positions of a quadrilateral or hexahedron in tensor
     /// order (bit a of the index = side along local axis a), recovered from
     /// its edge graph; `None` when the graph is not a square or a cube.
-    fn tensor_order(&self, c: usize, edges: &mut Vec<usize>) -> Option<TensorOrder> {
+    fn tensor_order(
+        &self,
+        c: usize,
+        edges: &mut Vec<usize>,
+        memo: &mut Q1Memo,
+    ) -> Option<TensorOrder> {
         let vertices = self.complex.cell_vertices(self.n, c);
         let m = vertices.len();
         if m != 1 << self.n || self.n < 2 || self.n > 3 {
@@ -670,74 +709,85 @@ impl<'a> Topology<'a> {
         if edges.len() != self.n * m / 2 {
             return None;
         }
-        // At most 8 corners with 3 neighbours each: fixed arrays, since this
-        // runs for every cell of a Q1 mesh (stiffness and load).
-        let mut adjacent = [[0usize; 3]; 8];
-        let mut degree = [0usize; 8];
         let mut ends = [[0u8; 2]; 12];
         for (k, &e) in edges.iter().enumerate() {
             let (a, b) = self.local_ends(e, vertices, c).ok()?;
             // a, b < m ≤ 8.
             ends[k] = [a as u8, b as u8];
-            for (x, y) in [(a, b), (b, a)] {
-                if degree[x] == self.n {
-                    return None;
-                }
-                adjacent[x][degree[x]] = y;
-                degree[x] += 1;
-            }
         }
-        if degree[..m].iter().any(|&g| g != self.n) {
+        memo.order(m, self.n, &ends, edges.len())
+    }
+}
+
+/// The tensor order of a cell with `m` = 2ⁿ vertices from its local
+/// incidence: `ends[k]` = (tail, head) of its k-th edge (k < `edges`) as
+/// positions in its sorted vertex list. `None` when the edge graph is not
+/// a square or a cube.
+fn tensor_order_of(m: usize, n: usize, ends: &[[u8; 2]; 12], edges: usize) -> Option<TensorOrder> {
+    // At most 8 corners with 3 neighbours each: fixed arrays, since this
+    // runs for every cell of a Q1 mesh whose local incidence changes.
+    let mut adjacent = [[0usize; 3]; 8];
+    let mut degree = [0usize; 8];
+    for &[a, b] in &ends[..edges] {
+        let (a, b) = (usize::from(a), usize::from(b));
+        for (x, y) in [(a, b), (b, a)] {
+            if degree[x] == n {
+                return None;
+            }
+            adjacent[x][degree[x]] = y;
+            degree[x] += 1;
+        }
+    }
+    if degree[..m].iter().any(|&g| g != n) {
+        return None;
+    }
+    let neighbours = |x: usize| &adjacent[x][..n];
+    let mut order = [usize::MAX; 8];
+    order[0] = 0;
+    for (axis, &b) in neighbours(0).iter().enumerate() {
+        order[1 << axis] = b;
+    }
+    // Increasing index visits every corner after the corners one step
+    // closer to corner 0. A corner with two set bits a, b is the common
+    // neighbour of corners l^a and l^b other than l^a^b.
+    for l in 0..m {
+        if l.count_ones() < 2 {
+            continue;
+        }
+        let a = l.trailing_zeros();
+        let b = (l & !(1 << a)).trailing_zeros();
+        let (p, q, back) = (
+            order[l ^ (1 << a)],
+            order[l ^ (1 << b)],
+            order[l ^ (1 << a) ^ (1 << b)],
+        );
+        order[l] = *neighbours(p)
+            .iter()
+            .find(|&&x| x != back && neighbours(q).contains(&x))?;
+    }
+    let order = &order[..m];
+    let mut seen = [false; 8];
+    for &o in order {
+        if std::mem::replace(&mut seen[o], true) {
             return None;
         }
-        let neighbours = |x: usize| &adjacent[x][..self.n];
-        let mut order = [usize::MAX; 8];
-        order[0] = 0;
-        for (axis, &b) in neighbours(0).iter().enumerate() {
-            order[1 << axis] = b;
-        }
-        // Increasing index visits every corner after the corners one step
-        // closer to corner 0. A corner with two set bits a, b is the common
-        // neighbour of corners l^a and l^b other than l^a^b.
-        for l in 0..m {
-            if l.count_ones() < 2 {
-                continue;
-            }
-            let a = l.trailing_zeros();
-            let b = (l & !(1 << a)).trailing_zeros();
-            let (p, q, back) = (
-                order[l ^ (1 << a)],
-                order[l ^ (1 << b)],
-                order[l ^ (1 << a) ^ (1 << b)],
-            );
-            order[l] = *neighbours(p)
-                .iter()
-                .find(|&&x| x != back && neighbours(q).contains(&x))?;
-        }
-        let order = &order[..m];
-        let mut seen = [false; 8];
-        for &o in order {
-            if std::mem::replace(&mut seen[o], true) {
-                return None;
-            }
-        }
-        let mut slot = [0usize; 8];
-        for (l, &o) in order.iter().enumerate() {
-            slot[o] = l;
-        }
-        for &[a, b] in &ends[..edges.len()] {
-            if (slot[usize::from(a)] ^ slot[usize::from(b)]).count_ones() != 1 {
-                return None;
-            }
-        }
-        let mut slots = [0; 8];
-        slots[..m].copy_from_slice(order);
-        Some(TensorOrder {
-            slots,
-            len: m,
-            ends,
-        })
     }
+    let mut slot = [0usize; 8];
+    for (l, &o) in order.iter().enumerate() {
+        slot[o] = l;
+    }
+    for &[a, b] in &ends[..edges] {
+        if (slot[usize::from(a)] ^ slot[usize::from(b)]).count_ones() != 1 {
+            return None;
+        }
+    }
+    let mut slots = [0; 8];
+    slots[..m].copy_from_slice(order);
+    Some(TensorOrder {
+        slots,
+        len: m,
+        ends: *ends,
+    })
 }
 
 /// Measure of a simplex and the gradients of its barycentric coordinates,
@@ -953,13 +1003,13 @@ fn q1_cell(
     c: usize,
     order: &TensorOrder,
     k: &Tensor,
-    key: &mut Vec<usize>,
+    memo: &mut Q1Memo,
     out: &mut [f64],
     load: Option<(LoadFn, &mut [f64])>,
 ) -> Result<(), MetricError> {
     match top.n {
-        2 => q1_block::<4, 4>(top, c, order, k, key, out, load),
-        _ => q1_block::<8, 12>(top, c, order, k, key, out, load),
+        2 => q1_block::<4, 4>(top, c, order, k, memo, out, load),
+        _ => q1_block::<8, 12>(top, c, order, k, memo, out, load),
     }
 }
 
@@ -977,16 +1027,16 @@ fn q1_block<const N: usize, const E: usize>(
     c: usize,
     order: &TensorOrder,
     k: &Tensor,
-    key: &mut Vec<usize>,
+    memo: &mut Q1Memo,
     out: &mut [f64],
     load: Option<(LoadFn, &mut [f64])>,
 ) -> Result<(), MetricError> {
-    let n = top.n;
+    let n = N.trailing_zeros() as usize;
     debug_assert_eq!((order.len(), n << (n - 1), out.len()), (N, E, E * E));
     let x = tensor_points(top, c, order);
-    let map = q1_map::<N>(&x[..N], n, c)?;
+    let map = q1_map::<N>(&x, c)?;
     if let Some((f, shares)) = load {
-        q1_shares(top, c, order, &x[..N], &map.weights, f, shares)?;
+        q1_shares(top, c, order, &x, &map.weights, f, shares)?;
     }
     // K_c in tensor order.
     let mut kc = [[0.0; N]; N];
@@ -1009,18 +1059,28 @@ fn q1_block<const N: usize, const E: usize>(
             *entry = upper[j][l];
         }
     }
-    // A_c⁺ with its rows (the cell's sorted vertices) in tensor order.
-    key.clear();
-    key.push(N);
-    for &[t, h] in &order.ends[..E] {
-        key.extend([usize::from(t), usize::from(h)]);
-    }
-    let pinv = pseudo_inverse_of_key(key, c, "Q1")?;
-    let mut p = [[0.0; E]; N];
-    for (row, &o) in p.iter_mut().zip(order.iter()) {
-        for (e, entry) in row.iter_mut().enumerate() {
-            *entry = pinv[(o, e)];
+    // A_c⁺ with its rows (the cell's sorted vertices) in tensor order,
+    // kept for the next cell with the same local incidence.
+    if !(memo.pinv_valid && memo.ends == Some((N, order.ends))) {
+        let key = &mut memo.key;
+        key.clear();
+        key.push(N);
+        for &[t, h] in &order.ends[..E] {
+            key.extend([usize::from(t), usize::from(h)]);
         }
+        let pinv = pseudo_inverse_of_key(key, c, "Q1")?;
+        for (row, &o) in memo.pinv.iter_mut().zip(order.iter()) {
+            for (e, entry) in row.iter_mut().take(E).enumerate() {
+                *entry = pinv[(o, e)];
+            }
+        }
+        memo.ends = Some((N, order.ends));
+        memo.order = Some(*order);
+        memo.pinv_valid = true;
+    }
+    let mut p = [[0.0; E]; N];
+    for (row, memo_row) in p.iter_mut().zip(&memo.pinv) {
+        row.copy_from_slice(&memo_row[..E]);
     }
     // K_c A_c⁺ (N × E), then (A_c⁺)ᵀ K_c A_c⁺ on and above the diagonal.
     let mut half = [[0.0; E]; N];
@@ -1092,10 +1152,12 @@ struct Q1Map<const N: usize> {
 }
 
 /// [`Q1Map`] of the cell with corners `x` in tensor order (2 Gauss points
-/// per axis, weight 1 each on [−1, 1]^n, N = 2ⁿ).
+/// per axis, weight 1 each on [−1, 1]^n, N = 2ⁿ). The dimension is read
+/// from N, so every loop below has a length known at compile time and is
+/// unrolled: this runs for every cell of a Q1 mesh.
 #[inline(always)]
-fn q1_map<const N: usize>(x: &[Point], n: usize, cell: usize) -> Result<Q1Map<N>, MetricError> {
-    debug_assert_eq!((x.len(), 1 << n), (N, N));
+fn q1_map<const N: usize>(x: &[Point; N], cell: usize) -> Result<Q1Map<N>, MetricError> {
+    let n = N.trailing_zeros() as usize;
     let bad = MetricError::UnsupportedCell {
         method: "Q1",
         needs: "a quadrilateral or hexahedron whose isoparametric map keeps one orientation (convex, not inverted)",
@@ -1105,8 +1167,10 @@ fn q1_map<const N: usize>(x: &[Point], n: usize, cell: usize) -> Result<Q1Map<N>
         weights: [0.0; N],
         gradients: [[[0.0; 3]; N]; N],
     };
+    let reference = q1_reference(n);
     let mut orientation = 0.0;
-    for (q, (_, shape_gradients)) in q1_reference(n).iter().enumerate() {
+    for q in 0..N {
+        let shape_gradients = &reference.gradients[q];
         let mut jacobian = [[0.0; 3]; 3];
         for (xl, gl) in x.iter().zip(shape_gradients) {
             for (i, row) in jacobian.iter_mut().enumerate().take(n) {
@@ -1131,9 +1195,15 @@ fn q1_map<const N: usize>(x: &[Point], n: usize, cell: usize) -> Result<Q1Map<N>
     Ok(map)
 }
 
-/// Shape values and reference gradients at the 2ⁿ Gauss points of
-/// [−1, 1]^n: the same for every cell, so computed once per dimension.
-type Q1Reference = Vec<(Vec<f64>, Vec<Point>)>;
+/// Shape values (`values[q][l]`, corner l) and reference gradients at the
+/// 2ⁿ Gauss points q of [−1, 1]^n, in arrays of the largest size (n = 3)
+/// whose first 2ⁿ entries are used: the same for every cell, so computed
+/// once per dimension, and fixed-size so that the per-cell loops over
+/// them have known lengths.
+struct Q1Reference {
+    values: [[f64; 8]; 8],
+    gradients: [[Point; 8]; 8],
+}
 
 fn q1_reference(n: usize) -> &'static Q1Reference {
     static REFERENCE: [std::sync::OnceLock<Q1Reference>; 4] = [
@@ -1144,12 +1214,17 @@ fn q1_reference(n: usize) -> &'static Q1Reference {
     ];
     REFERENCE[n.min(3)].get_or_init(|| {
         let g = 1.0 / 3f64.sqrt();
-        (0..1usize << n)
-            .map(|q| {
-                let xi: Vec<f64> = (0..n).map(|a| g * corner_sign(q, a)).collect();
-                q1_shape(&xi, n)
-            })
-            .collect()
+        let mut reference = Q1Reference {
+            values: [[0.0; 8]; 8],
+            gradients: [[[0.0; 3]; 8]; 8],
+        };
+        for q in 0..1usize << n {
+            let xi: Vec<f64> = (0..n).map(|a| g * corner_sign(q, a)).collect();
+            let (values, gradients) = q1_shape(&xi, n);
+            reference.values[q][..values.len()].copy_from_slice(&values);
+            reference.gradients[q][..gradients.len()].copy_from_slice(&gradients);
+        }
+        reference
     })
 }
 
@@ -1187,10 +1262,10 @@ fn determinant_and_inverse(j: &[[f64; 3]; 3], n: usize) -> (f64, [[f64; 3]; 3]) 
     }
 }
 
-/// Corners of cell `c` in tensor order (the first `order.len()` entries).
-fn tensor_points(top: &Topology, c: usize, order: &[usize]) -> [Point; 8] {
+/// The N corners of cell `c` in tensor order.
+fn tensor_points<const N: usize>(top: &Topology, c: usize, order: &[usize]) -> [Point; N] {
     let vertices = top.complex.cell_vertices(top.n, c);
-    let mut points = [[0.0; 3]; 8];
+    let mut points = [[0.0; 3]; N];
     for (p, &o) in points.iter_mut().zip(order) {
         *p = top.point(vertices[o]);
     }
@@ -1235,7 +1310,7 @@ fn q1_gradients<const N: usize>(
     c: usize,
     order: &TensorOrder,
 ) -> Result<Vec<WeightedGradients>, MetricError> {
-    let map = q1_map::<N>(&tensor_points(top, c, order)[..N], top.n, c)?;
+    let map = q1_map::<N>(&tensor_points(top, c, order), c)?;
     Ok(map
         .weights
         .iter()
@@ -1527,24 +1602,25 @@ fn q1_load<const N: usize>(
     out: &mut [f64],
 ) -> Result<(), MetricError> {
     let x = tensor_points(top, c, order);
-    let map = q1_map::<N>(&x[..N], top.n, c)?;
-    q1_shares(top, c, order, &x[..N], &map.weights, f, out)
+    let map = q1_map::<N>(&x, c)?;
+    q1_shares(top, c, order, &x, &map.weights, f, out)
 }
 
 /// The tensor Gauss rule of [`q1_load`] on corners `x` (tensor order) with
 /// the map's weights |det J|, written over `out` (sorted vertex order).
-fn q1_shares(
+fn q1_shares<const N: usize>(
     top: &Topology,
     c: usize,
     order: &TensorOrder,
-    x: &[Point],
-    weights: &[f64],
+    x: &[Point; N],
+    weights: &[f64; N],
     f: LoadFn,
     out: &mut [f64],
 ) -> Result<(), MetricError> {
-    let (n, d) = (top.n, top.d);
+    let (n, d) = (N.trailing_zeros() as usize, top.d);
     out.fill(0.0);
-    for ((values, _), &weight) in q1_reference(n).iter().zip(weights) {
+    let reference = q1_reference(n);
+    for (values, &weight) in reference.values.iter().zip(weights) {
         let mut point = [0.0; 3];
         for (xl, &v) in x.iter().zip(values) {
             for i in 0..n {
@@ -1674,6 +1750,92 @@ mod tests {
                     _ => -2.0 / 6.0,
                 };
                 assert!((m[(i, j)] - expected).abs() < 1e-14, "({i},{j})");
+            }
+        }
+    }
+
+    /// Unit cells of an `sides` grid (2 or 3 axes) with vertex v renumbered
+    /// (7 v + 3) mod |V|, so that neighbouring cells see their vertices in
+    /// different sorted orders and have different local incidences: the
+    /// last cell's tensor order and A_c⁺ are reused when it matches and
+    /// found again when not. Returns the complex and each cell's corners
+    /// in tensor order, renumbered.
+    fn scrambled_grid(sides: &[usize]) -> (Complex, Vec<Vec<usize>>) {
+        let n = sides.len();
+        let stride: Vec<usize> = (0..n)
+            .map(|a| sides[..a].iter().map(|s| s + 1).product())
+            .collect();
+        let count: usize = sides.iter().map(|s| s + 1).product();
+        assert!(count % 7 != 0);
+        let renumber = |v: usize| (7 * v + 3) % count;
+        let mut points = vec![[0.0; 3]; count];
+        for v in 0..count {
+            for a in 0..n {
+                points[renumber(v)][a] = ((v / stride[a]) % (sides[a] + 1)) as f64;
+            }
+        }
+        let mut cells = Vec::new();
+        let cell_count: usize = sides.iter().product();
+        for c in 0..cell_count {
+            let mut base = 0;
+            let mut rest = c;
+            for a in 0..n {
+                base += (rest % sides[a]) * stride[a];
+                rest /= sides[a];
+            }
+            let corners: Vec<usize> = (0..1usize << n)
+                .map(|l| {
+                    let offset: usize = (0..n)
+                        .filter(|&a| (l >> a) & 1 == 1)
+                        .map(|a| stride[a])
+                        .sum();
+                    renumber(base + offset)
+                })
+                .collect();
+            cells.push(corners);
+        }
+        let coordinates: Vec<f64> = points.iter().flat_map(|p| p[..n].to_vec()).collect();
+        let vertices = Vertices::new(n, coordinates).unwrap();
+        let complex = Complex::build(vertices, TopCells::cuboids(cells.clone())).unwrap();
+        (complex, cells)
+    }
+
+    #[test]
+    fn q1_on_a_scrambled_numbering_is_the_element_matrix_summed() {
+        // The unit square's and the unit cube's Q1 stiffness, by the number
+        // of local axes along which corners i and j differ: 2/3, −1/6, −1/3
+        // in 2D; 1/3, 0, −1/12, −1/12 in 3D.
+        for (sides, element) in [
+            (vec![5, 4], vec![2.0 / 3.0, -1.0 / 6.0, -1.0 / 3.0]),
+            (
+                vec![3, 3, 2],
+                vec![1.0 / 3.0, 0.0, -1.0 / 12.0, -1.0 / 12.0],
+            ),
+        ] {
+            let (k, cells) = scrambled_grid(&sides);
+            let omega = stiffness_metric(&k, &vec![isotropic(1.0); cells.len()]).unwrap();
+            let m = crate::canonical::Canonical::new(k.coboundary(0), omega)
+                .unwrap()
+                .assemble()
+                .to_dense();
+            let vertices = k.cell_count(0);
+            let mut expected = vec![vec![0.0; vertices]; vertices];
+            for corners in &cells {
+                for (l, &u) in corners.iter().enumerate() {
+                    for (q, &w) in corners.iter().enumerate() {
+                        expected[u][w] += element[(l ^ q).count_ones() as usize];
+                    }
+                }
+            }
+            for u in 0..vertices {
+                for w in 0..vertices {
+                    assert!(
+                        (m[(u, w)] - expected[u][w]).abs() < 1e-14,
+                        "{sides:?}: ({u}, {w}) is {} instead of {}",
+                        m[(u, w)],
+                        expected[u][w]
+                    );
+                }
             }
         }
     }
