@@ -100,6 +100,51 @@ impl Complex {
         self.cell_geometry(p).map_or(&[], |g| &g.centroid)
     }
 
+    /// Measure and centroid (stride d) of the listed p-cells alone, in
+    /// list order, equal to the entries of [`Complex::measure`] and
+    /// [`Complex::centroid`]: read from them when they were computed, else
+    /// computed for these cells only (a boundary condition on the few
+    /// thousand boundary faces of a nodal problem needs their areas, not
+    /// those of the million faces inside). A cell id beyond the p-cells is
+    /// an error naming it.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// let k = rectangle(2, 1, [0.0, 4.0], [0.0, 1.0]).unwrap();
+    /// let (measure, centroid) = k.geometry_of(2, &[1]).unwrap();
+    /// assert_eq!(measure, vec![2.0]);
+    /// assert_eq!(centroid, k.centroid_of(2, 1));
+    /// assert!(k.geometry_of(2, &[2]).is_err());
+    /// ```
+    pub fn geometry_of(&self, p: usize, cells: &[usize]) -> Result<(Vec<f64>, Vec<f64>)> {
+        let count = self.cell_count(p);
+        if let Some(&i) = cells.iter().find(|&&i| i >= count) {
+            return Err(ComplexError::Invalid(format!(
+                "{p}-cell {i} does not exist: the complex has {count} {p}-cells (ids start at 0)"
+            )));
+        }
+        let d = self.embedding_dim();
+        let mut measure = Vec::with_capacity(cells.len());
+        let mut centroid = Vec::with_capacity(cells.len() * d);
+        match self.geometry.cells.get(p).and_then(OnceLock::get) {
+            Some(all) => {
+                for &i in cells {
+                    measure.push(all.measure[i]);
+                    centroid.extend_from_slice(&all.centroid[i * d..(i + 1) * d]);
+                }
+            }
+            None => {
+                let mesh = Mesh::new(self);
+                for &i in cells {
+                    let (m, c) = mesh.cell(p, i);
+                    measure.push(m);
+                    centroid.extend_from_slice(&c[..d]);
+                }
+            }
+        }
+        Ok((measure, centroid))
+    }
+
     /// Centroid of p-cell `i` (an empty slice when it does not exist).
     pub fn centroid_of(&self, p: usize, i: usize) -> &[f64] {
         let d = self.embedding_dim();
@@ -207,12 +252,7 @@ impl Complex {
         let mut centroid = vec![0.0; count * d];
         let mesh = Mesh::new(self);
         let write = |(i, (m, c)): (usize, (&mut f64, &mut [f64]))| {
-            let (mi, ci) = match p {
-                0 => (1.0, mesh.point(i)),
-                1 => mesh.segment(i),
-                2 => mesh.polygon(i),
-                _ => mesh.polyhedron(i),
-            };
+            let (mi, ci) = mesh.cell(p, i);
             *m = mi;
             c.copy_from_slice(&ci[..d]);
         };
@@ -330,6 +370,17 @@ impl<'a> Mesh<'a> {
             [a, b] => [a, b, 0.0],
             [a, b, c, ..] => [a, b, c],
             [] => [0.0; 3],
+        }
+    }
+
+    /// Measure and centroid of p-cell `i`.
+    #[inline(always)]
+    fn cell(&self, p: usize, i: usize) -> (f64, Point) {
+        match p {
+            0 => (1.0, self.point(i)),
+            1 => self.segment(i),
+            2 => self.polygon(i),
+            _ => self.polyhedron(i),
         }
     }
 

@@ -913,11 +913,16 @@ impl Diffusion {
         let d = complex.embedding_dim();
         let cells = complex.cell_count(n);
         let unknowns = rhs.len();
-        let face_area = complex.measure(n - 1);
-        let face_centre = complex.centroid(n - 1);
-        let x_face = |f: usize| &face_centre[f * d..(f + 1) * d];
-        let top = complex.boundary(n);
         let (faces, cell_diagonal) = (&layout.faces, &layout.cell_diagonal);
+        // Only the conditioned faces' geometry, by slot: computing that of
+        // every face would cost a nodal problem, which needs nothing else
+        // of it, a pass over all (n−1)-cells.
+        let conditioned: Vec<usize> = faces.condition.iter().map(|&(f, _)| f).collect();
+        let (face_area, face_centre) = complex
+            .geometry_of(n - 1, &conditioned)
+            .map_err(MetricError::from)?;
+        let x_face = |slot: usize| &face_centre[slot * d..(slot + 1) * d];
+        let top = complex.boundary(n);
         let mut fixed: Vec<Option<f64>> = vec![None; unknowns];
         let mut ghosts: Vec<(usize, f64, f64)> = Vec::new();
         let mut face_weight: Vec<(usize, f64)> = Vec::new();
@@ -925,8 +930,8 @@ impl Diffusion {
         let mut neumann_flux = vec![0.0; flux_rows];
         for (slot, &(f, k)) in faces.condition.iter().enumerate() {
             let bc = &self.boundary[k];
-            let area = face_area[f];
-            let xf = x_face(f);
+            let area = face_area[slot];
+            let xf = x_face(slot);
             match location {
                 Location::Nodal => {
                     let verts = complex.cell_vertices(n - 1, f);
