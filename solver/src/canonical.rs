@@ -785,45 +785,44 @@ fn pattern_by_columns(
 }
 
 /// n lists in one array (pointers, items): list j is what `fill(j, out)`
-/// leaves in the cleared `out`. Every list is formed twice, once to count
-/// it and once to write it straight into place, in parallel both times:
-/// fresh pages cost a fault each on this kind of machine, and a second
-/// copy of the lists would cost as much as forming them again.
+/// leaves in the cleared `out`. Each list is formed once, in parallel over
+/// a few ranges of j, into its range's own buffer; the buffers are then
+/// copied into place.
 fn compressed_lists(
     n: usize,
     fill: impl Fn(usize, &mut Vec<usize>) + Sync,
 ) -> (Vec<usize>, Vec<usize>) {
-    let list = |j: usize, scratch: &mut Vec<usize>| {
-        scratch.clear();
-        fill(j, scratch);
-    };
     let parts = ranges(n);
     let mut ptr = vec![0usize; n + 1];
     let counts = split_at_ranges(&mut ptr[1..], &parts, |j| j);
-    parts
+    let buffers: Vec<Vec<usize>> = parts
         .par_iter()
         .zip(counts)
-        .for_each_init(Vec::new, |scratch, (range, counts)| {
+        .map_init(Vec::new, |scratch, (range, counts)| {
+            let mut buffer = Vec::new();
             for (j, count) in range.clone().zip(counts) {
-                list(j, scratch);
+                scratch.clear();
+                fill(j, scratch);
                 *count = scratch.len();
+                if buffer.is_empty() {
+                    // The first list's length times the range's: one
+                    // allocation for lists of even length.
+                    buffer.reserve(scratch.len() * range.len() * 5 / 4);
+                }
+                buffer.extend_from_slice(scratch);
             }
-        });
+            buffer
+        })
+        .collect();
     for j in 0..n {
         ptr[j + 1] += ptr[j];
     }
     let mut items = vec![0usize; ptr[n]];
     let pieces = split_at_ranges(&mut items, &parts, |j| ptr[j]);
-    parts
-        .par_iter()
-        .zip(pieces)
-        .for_each_init(Vec::new, |scratch, (range, out)| {
-            let base = ptr[range.start];
-            for j in range.clone() {
-                list(j, scratch);
-                out[ptr[j] - base..ptr[j + 1] - base].copy_from_slice(scratch);
-            }
-        });
+    pieces
+        .into_par_iter()
+        .zip(buffers)
+        .for_each(|(out, buffer)| out.copy_from_slice(&buffer));
     (ptr, items)
 }
 
