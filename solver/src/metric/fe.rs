@@ -479,7 +479,8 @@ fn dense_stiffness(
         .collect::<Result<(), MetricError>>()?;
     Ok(BlockMetric::from_symmetric_blocks(
         top.complex.cell_count(1),
-        &edge_ptr,
+        edge_ptr,
+        value_ptr,
         indices,
         values,
         true,
