@@ -1246,6 +1246,15 @@ impl Canonical {
     ) {
         let (rows, cols, w) = self.metric.block(b);
         let (left, right) = local.sides(b);
+        // The Q1 cells' shapes (4 edges over 4 vertices, 12 over 8) in
+        // fixed-size arrays.
+        if local.is_shared(b) {
+            match (rows.len(), left.len()) {
+                (4, 4) => return self.square_block_columns::<4, 4>(rows, w, left, columns, add),
+                (12, 8) => return self.square_block_columns::<12, 8>(rows, w, left, columns, add),
+                _ => {}
+            }
+        }
         // A_S and A_R over the block's own unknowns: (local row, local
         // unknown, sign), in row order and each row's order; one list when
         // the block's rows are its columns.
@@ -1294,6 +1303,45 @@ impl Canonical {
                 dense[il] += sign * half[ri];
             }
             add(right[jl], left, dense);
+        }
+    }
+
+    /// [`Canonical::add_block_columns`] for a block over the same K rows
+    /// on both sides, touching M unknowns (`unknowns`, sorted), in arrays
+    /// of those sizes: A_c as a dense K × M matrix of signs, then
+    /// (W A_c)_{·j} and A_cᵀ (W A_c)_{·j}. Every sum adds its nonzero
+    /// terms in the order of the general path (rows in block order), and
+    /// the zero terms in between leave a sum as it is, so the values are
+    /// the general path's.
+    fn square_block_columns<const K: usize, const M: usize>(
+        &self,
+        rows: &[usize],
+        w: &[f64],
+        unknowns: &[usize],
+        columns: std::ops::Range<usize>,
+        mut add: impl FnMut(usize, &[usize], &[f64]),
+    ) {
+        let mut signs = [[0.0; M]; K];
+        for (signs_row, &r) in signs.iter_mut().zip(rows) {
+            let (row_unknowns, row_signs) = self.row(r);
+            for (&u, &sign) in row_unknowns.iter().zip(row_signs) {
+                signs_row[position(unknowns, u)] = f64::from(sign);
+            }
+        }
+        for jl in columns {
+            let mut half = [0.0; K];
+            for (h, w_row) in half.iter_mut().zip(w.chunks_exact(K)) {
+                for (&weight, signs_row) in w_row.iter().zip(&signs) {
+                    *h += weight * signs_row[jl];
+                }
+            }
+            let mut column = [0.0; M];
+            for (signs_row, &h) in signs.iter().zip(&half) {
+                for (c, &sign) in column.iter_mut().zip(signs_row) {
+                    *c += sign * h;
+                }
+            }
+            add(unknowns[jl], unknowns, &column);
         }
     }
 
