@@ -265,7 +265,38 @@ impl Complex {
 
     /// The coboundary δ^p = ∂_{p+1}ᵀ (|K_{p+1}| × |K_p|, CSR), 0 ≤ p < n.
     pub fn coboundary(&self, p: usize) -> CsMat<i8> {
+        if p == 0 && self.dim() >= 2 {
+            if let Some(delta) = self.edge_coboundary() {
+                return delta;
+            }
+        }
         self.boundary(p + 1).transpose_view().to_csr()
+    }
+
+    /// δ⁰ read off the edges' vertex lists. An edge is a simplex, so ∂₁
+    /// gives it −1 on its lower vertex and +1 on its higher (the sign of
+    /// a simplex's facet by the position it drops), and below the top
+    /// dimension no orientation changes that: row e of δ⁰ is row e of M₁
+    /// with the signs (−1, +1). Copying M₁ in parallel costs a fraction of
+    /// transposing ∂₁ (a serial scatter: 0.08 s at 2·10⁶ edges). `None`
+    /// when an edge does not have two vertices.
+    fn edge_coboundary(&self) -> Option<CsMat<i8>> {
+        let edges = self.lar.characteristic(1).ok()?;
+        let indptr = edges.indptr();
+        let uniform = indptr.raw_storage().first() == Some(&0)
+            && (0..=edges.rows())
+                .into_par_iter()
+                .all(|e| indptr.index(e) == 2 * e);
+        if !uniform {
+            return None;
+        }
+        let pointers: Vec<usize> = (0..=edges.rows()).into_par_iter().map(|e| 2 * e).collect();
+        let vertices = edges.indices()[..2 * edges.rows()].to_vec();
+        let signs: Vec<i8> = (0..2 * edges.rows())
+            .into_par_iter()
+            .map(|k| if k % 2 == 0 { -1 } else { 1 })
+            .collect();
+        CsMat::try_new((edges.rows(), edges.cols()), pointers, vertices, signs).ok()
     }
 
     /// [`Complex::coboundary`], built on first use and then shared (no
@@ -770,6 +801,26 @@ mod tests {
     fn dense(m: &CsMat<i8>) -> Vec<Vec<i8>> {
         let d = m.to_dense();
         d.rows().into_iter().map(|r| r.to_vec()).collect()
+    }
+
+    #[test]
+    fn the_edge_coboundary_is_the_transpose_of_the_edge_boundary() {
+        // δ⁰ is built from M₁ for n ≥ 2: it must be ∂₁ᵀ entry for entry,
+        // on grids, simplices, polygons and an embedded surface; a curve
+        // (n = 1, whose edges the top orientation may flip) transposes ∂₁.
+        let complexes = [
+            crate::generate::rectangle(3, 2, [0.0, 1.0], [0.0, 1.0]).unwrap(),
+            crate::generate::box3(2, 2, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap(),
+            crate::generate::kuhn(&[vec![0.0, 0.5, 1.0], vec![0.0, 1.0], vec![0.0, 1.0]]).unwrap(),
+            crate::generate::voronoi(12, [0.0, 1.0], [0.0, 1.0], 7, 1).unwrap(),
+            crate::generate::sphere(1.0, 1).unwrap(),
+            crate::generate::interval(4, 0.0, 1.0).unwrap(),
+        ];
+        for k in &complexes {
+            let transposed: CsMat<i8> = k.boundary(1).transpose_view().to_csr();
+            assert_eq!(k.coboundary(0), transposed, "dimension {}", k.dim());
+            assert_eq!(*k.shared_coboundary(0), transposed);
+        }
     }
 
     #[test]
