@@ -282,16 +282,9 @@ impl Complex {
     /// when an edge does not have two vertices.
     fn edge_coboundary(&self) -> Option<CsMat<i8>> {
         let edges = self.lar.characteristic(1).ok()?;
-        let indptr = edges.indptr();
-        let uniform = indptr.raw_storage().first() == Some(&0)
-            && (0..=edges.rows())
-                .into_par_iter()
-                .all(|e| indptr.index(e) == 2 * e);
-        if !uniform {
-            return None;
-        }
+        let pairs = self.lar.edge_vertex_pairs()?;
         let pointers: Vec<usize> = (0..=edges.rows()).into_par_iter().map(|e| 2 * e).collect();
-        let vertices = edges.indices()[..2 * edges.rows()].to_vec();
+        let vertices = pairs.to_vec();
         let signs: Vec<i8> = (0..2 * edges.rows())
             .into_par_iter()
             .map(|k| if k % 2 == 0 { -1 } else { 1 })

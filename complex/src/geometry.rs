@@ -30,6 +30,7 @@
 use crate::complex::Complex;
 use crate::error::{ComplexError, Result};
 use crate::frame::{self, Point};
+use crate::lar::Lar;
 use rayon::prelude::*;
 use sprs::CsMat;
 use std::borrow::Cow;
@@ -354,10 +355,7 @@ impl<'a> Mesh<'a> {
         Self {
             coords: complex.vertices().as_slice(),
             d: complex.embedding_dim(),
-            edges: complex
-                .lar()
-                .characteristic(1)
-                .map_or(Cow::Borrowed(&[][..]), edge_pairs),
+            edges: edge_pairs(complex.lar()),
             complex,
         }
     }
@@ -505,24 +503,25 @@ impl<'a> Mesh<'a> {
 }
 
 /// The vertex pairs of the edges as one flat slice: M₁'s own column
-/// indices when every row holds two entries (always, for a valid complex).
-fn edge_pairs(m: &CsMat<u8>) -> Cow<'_, [usize]> {
-    let indptr = m.indptr();
-    let uniform = indptr.raw_storage().first() == Some(&0)
-        && (0..=m.rows()).all(|i| indptr.index(i) == 2 * i);
-    if uniform {
-        Cow::Borrowed(&m.indices()[..2 * m.rows()])
-    } else {
-        Cow::Owned(
-            (0..m.rows())
-                .flat_map(|i| {
-                    let row = &m.indices()[indptr.outer_inds_sz(i)];
-                    let first = row.first().copied().unwrap_or(0);
-                    [first, row.get(1).copied().unwrap_or(first)]
-                })
-                .collect(),
-        )
+/// indices when every row holds two entries (always, for a valid complex),
+/// otherwise each row's first two (or its one vertex twice).
+fn edge_pairs(lar: &Lar) -> Cow<'_, [usize]> {
+    if let Some(pairs) = lar.edge_vertex_pairs() {
+        return Cow::Borrowed(pairs);
     }
+    let Ok(m) = lar.characteristic(1) else {
+        return Cow::Borrowed(&[][..]);
+    };
+    let indptr = m.indptr();
+    Cow::Owned(
+        (0..m.rows())
+            .flat_map(|i| {
+                let row = &m.indices()[indptr.outer_inds_sz(i)];
+                let first = row.first().copied().unwrap_or(0);
+                [first, row.get(1).copied().unwrap_or(first)]
+            })
+            .collect(),
+    )
 }
 
 /// Circumcentre of the simplex with these vertices: x₀ + B y with

@@ -170,6 +170,29 @@ impl Lar {
         Ok(Arc::clone(&self.characteristic[p - 1]))
     }
 
+    /// The edges' vertex pairs as one flat slice (edge e is entries 2e and
+    /// 2e + 1, lower vertex first): M₁'s own column indices, when every row
+    /// of M₁ holds exactly two entries. `None` for a complex without edges
+    /// or with an edge that is not a vertex pair.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let pairs = k.lar().edge_vertex_pairs().unwrap();
+    /// assert_eq!(pairs.len(), 2 * 4);
+    /// assert!(pairs.chunks(2).all(|e| e[0] < e[1]));
+    /// ```
+    pub fn edge_vertex_pairs(&self) -> Option<&[usize]> {
+        let edges = self.characteristic.first()?;
+        let indptr = edges.indptr();
+        // A parallel check: on a 10⁶-cell mesh M₁ has 2·10⁶ rows.
+        let uniform = indptr.raw_storage().first() == Some(&0)
+            && (0..=edges.rows())
+                .into_par_iter()
+                .all(|e| indptr.index(e) == 2 * e);
+        uniform.then(|| &edges.indices()[..2 * edges.rows()])
+    }
+
     /// Sorted vertices of p-cell `i`.
     #[inline]
     pub fn cell_vertices(&self, p: usize, i: usize) -> &[usize] {
