@@ -710,6 +710,23 @@ impl Diffusion {
     pub fn assemble(&self, complex: &Complex) -> Result<Assembled, DiffusionError> {
         let started = Instant::now();
         let n = complex.dim();
+        if self.location() == Location::Nodal && n >= 2 {
+            // A nodal assembly needs ∂ₙ by cells (for the centroids and the
+            // elements' edges), the vertex star (for the pattern) and δ⁰
+            // (its A). Each is built when first asked for, mostly serially
+            // (two transposes, a copy and sprs's check) and bound by page
+            // faults: side by side they took 0.13-0.15 s on the 2D 1000²
+            // grid, one after the other about 0.17 s.
+            rayon::join(
+                || complex.boundary_csc(n),
+                || {
+                    rayon::join(
+                        || complex.shared_vertex_star(n),
+                        || complex.shared_coboundary(0),
+                    )
+                },
+            );
+        }
         let conductivity = self.cell_conductivity(complex)?;
         let tensors = conductivity.cells();
         let faces = self.boundary_faces(complex)?;

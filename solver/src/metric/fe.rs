@@ -404,10 +404,7 @@ fn dense_stiffness(
     let cells = top.complex.cell_count(top.n);
     let sizes: Vec<usize> = (0..cells)
         .into_par_iter()
-        .map_init(Vec::new, |edges, c| {
-            top.edges_into(c, edges);
-            edges.len()
-        })
+        .map_init(Vec::new, |scratch, c| top.edge_count(c, scratch))
         .collect();
     let mut edge_ptr = Vec::with_capacity(cells + 1);
     let mut value_ptr = Vec::with_capacity(cells + 1);
@@ -630,6 +627,20 @@ impl<'a> Topology<'a> {
                 }
                 edges.sort_unstable();
                 edges.dedup();
+            }
+        }
+    }
+
+    /// The number of edges [`Topology::edges_into`] gives top cell `c`:
+    /// in 2D the length of its column of ∂₂, without forming the list
+    /// (`scratch` is used in 3D, where the faces' edges are merged).
+    pub(crate) fn edge_count(&self, c: usize, scratch: &mut Vec<usize>) -> usize {
+        match self.n {
+            1 => 1,
+            2 => self.facets_of(2, c).0.len(),
+            _ => {
+                self.edges_into(c, scratch);
+                scratch.len()
             }
         }
     }
@@ -1982,5 +1993,32 @@ mod tests {
             load(&k, &|x: &[f64]| 1.0 / (x[0] - x[0])),
             Err(MetricError::NonFinite { cell: 0 })
         ));
+    }
+
+    #[test]
+    fn a_cell_edge_count_is_its_edge_list_length() {
+        use hasse_complex::generate::{box3, interval, rectangle, voronoi};
+        // A polygon has as many edges as vertices; a hexahedron 12 edges.
+        let polygons = voronoi(40, [0.0, 1.0], [0.0, 1.0], 11, 2).unwrap();
+        let quads = rectangle(3, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let hexes = box3(2, 2, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+        let line = interval(3, 0.0, 1.0).unwrap();
+        let mut scratch = Vec::new();
+        for (k, expected) in [
+            (&polygons, None),
+            (&quads, Some(4)),
+            (&hexes, Some(12)),
+            (&line, Some(1)),
+        ] {
+            let top = Topology::new(k, "test").unwrap();
+            for c in 0..k.cell_count(k.dim()) {
+                let count = top.edge_count(c, &mut scratch);
+                let expected = expected.unwrap_or_else(|| k.cell_vertices(2, c).len());
+                assert_eq!(count, expected, "cell {c} of a {}-complex", k.dim());
+                let mut edges = Vec::new();
+                top.edges_into(c, &mut edges);
+                assert_eq!(count, edges.len());
+            }
+        }
     }
 }
