@@ -109,6 +109,11 @@ pub struct BlockMetric {
     /// Block b is the block of top cell b over that cell's edges, for
     /// every b (a nodal element metric built so); cleared by pushes.
     per_cell: bool,
+    /// Every block is exactly symmetric with finite values, as its builder
+    /// made it ([`BlockMetric::from_symmetric_blocks`]): the symmetry and
+    /// finiteness scans then read nothing (each is a pass over 128 MB of
+    /// values at 10⁶ Q1 cells). Cleared by pushes and by mutable access.
+    exact: bool,
 }
 
 impl PartialEq for BlockMetric {
@@ -145,6 +150,7 @@ impl BlockMetric {
             values: weights,
             identity: OnceLock::new(),
             per_cell: false,
+            exact: false,
         }
     }
 
@@ -185,6 +191,12 @@ impl BlockMetric {
     /// place (and in parallel) this way. `per_cell` says that block b is
     /// over the edges of top cell b of a complex, for every b
     /// ([`Canonical::with_cell_blocks`]).
+    ///
+    /// The caller guarantees that every block is exactly symmetric and
+    /// finite (the FE builders mirror each block and reject a cell with a
+    /// non-finite one), so [`BlockMetric::is_symmetric`] and the finiteness
+    /// check of [`Canonical`] need not read the values; debug builds check
+    /// it here.
     pub(crate) fn from_symmetric_blocks(
         size: usize,
         ptr: Vec<usize>,
@@ -200,6 +212,12 @@ impl BlockMetric {
             .all(|(p, v)| v[1] - v[0] == (p[1] - p[0]) * (p[1] - p[0])));
         debug_assert_eq!(value_ptr.last().copied().unwrap_or(0), values.len());
         debug_assert_eq!(ptr.last().copied().unwrap_or(0), indices.len());
+        debug_assert!(ptr.windows(2).zip(&value_ptr).all(|(p, &start)| {
+            let m = p[1] - p[0];
+            let w = &values[start..start + m * m];
+            w.iter().all(|v| v.is_finite())
+                && (0..m).all(|i| (0..i).all(|j| w[i * m + j] == w[j * m + i]))
+        }));
         Self {
             size,
             blocks: Vec::new(),
@@ -208,12 +226,14 @@ impl BlockMetric {
             values,
             identity: OnceLock::new(),
             per_cell,
+            exact: true,
         }
     }
 
     /// Add the block W (|rows| × |cols|, row-major) at rows × cols.
     pub fn push_block(&mut self, rows: &[usize], cols: &[usize], values: &[f64]) {
         self.per_cell = false;
+        self.exact = false;
         if let Some(square) = self.square.take() {
             self.blocks = square.records();
             if self.blocks.is_empty() {
@@ -326,6 +346,7 @@ impl BlockMetric {
 
     /// Mutable values of block `b` (row-major).
     pub fn block_values_mut(&mut self, b: usize) -> &mut [f64] {
+        self.exact = false;
         if let Some(square) = &self.square {
             return &mut self.values[square.value_ptr[b]..square.value_ptr[b + 1]];
         }
@@ -377,7 +398,8 @@ impl BlockMetric {
     /// symmetric to `tolerance` relative to its largest entry. This is a
     /// sufficient condition for Ω (and so Aᵀ Ω A) to be symmetric.
     pub fn is_symmetric(&self, tolerance: f64) -> bool {
-        self.diagonal_weights().is_some()
+        self.exact
+            || self.diagonal_weights().is_some()
             || (0..self.block_count()).into_par_iter().all(|b| {
                 let (rows, cols, w) = self.block(b);
                 if rows != cols {
@@ -402,6 +424,26 @@ impl BlockMetric {
             }
             return match w.iter().position(|v| !v.is_finite()) {
                 Some(block) => Err(CanonicalError::NonFinite { block }),
+                None => Ok(()),
+            };
+        }
+        if let (true, Some(square)) = (self.exact, &self.square) {
+            // Square, finite blocks by construction: only a row can be
+            // wrong, and the rows are one list.
+            let largest = self
+                .indices
+                .par_chunks(1 << 16)
+                .map(|chunk| chunk.iter().copied().max().unwrap_or(0))
+                .max();
+            if largest.is_none_or(|r| r < self.size) {
+                return Ok(());
+            }
+            return match self.indices.iter().position(|&r| r >= self.size) {
+                Some(k) => Err(CanonicalError::RowOutOfRange {
+                    block: square.ptr.partition_point(|&p| p <= k) - 1,
+                    row: self.indices[k],
+                    size: self.size,
+                }),
                 None => Ok(()),
             };
         }
@@ -1436,6 +1478,49 @@ mod tests {
         pushed.push_block(&[4], &[4], &[7.0]);
         assert_eq!(more, pushed);
         assert_eq!(more.apply(&[1.0; 5]), vec![1.0, 3.5, 6.5, 6.0, 7.0]);
+    }
+
+    #[test]
+    fn square_blocks_skip_the_value_scans_until_their_values_are_changed() {
+        let square = |indices: Vec<usize>| {
+            let values = [
+                2.0, -1.0, -1.0, 2.0, 3.0, 0.5, 0.0, 0.5, 4.0, 1.0, 0.0, 1.0, 5.0,
+            ];
+            BlockMetric::from_symmetric_blocks(
+                5,
+                vec![0, 2, 5],
+                vec![0, 4, 13],
+                indices,
+                values.to_vec(),
+                false,
+            )
+        };
+        let identity = || CsMat::<i8>::eye(5);
+        assert!(Canonical::new(identity(), square(vec![0, 2, 1, 2, 3])).is_ok());
+        // A row past Ω's size is still found, in the block that holds it.
+        let error = Canonical::new(identity(), square(vec![0, 2, 1, 2, 7])).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                CanonicalError::RowOutOfRange {
+                    block: 1,
+                    row: 7,
+                    size: 5
+                }
+            ),
+            "{error:?}"
+        );
+        // Changed values are scanned again.
+        let mut changed = square(vec![0, 2, 1, 2, 3]);
+        assert!(changed.is_symmetric(0.0));
+        changed.block_values_mut(1)[1] = 9.0;
+        assert!(!changed.is_symmetric(1e-12));
+        changed.block_values_mut(0)[3] = f64::NAN;
+        let error = Canonical::new(identity(), changed).unwrap_err();
+        assert!(
+            matches!(error, CanonicalError::NonFinite { block: 0 }),
+            "{error:?}"
+        );
     }
 
     /// M of `omega` on the nodal operator of `k`, through the blocks'
