@@ -330,6 +330,10 @@ struct Q1Memo {
     /// `pinv_valid`, for the local incidence in `ends`.
     pinv: [[f64; 12]; 8],
     pinv_valid: bool,
+    /// S_ab = (A_c⁺)ᵀ R_ab A_c⁺ of [`affine_block`] for every axis pair,
+    /// E × E each, valid for the same local incidence when `affine_valid`.
+    affine: Vec<f64>,
+    affine_valid: bool,
     /// Scratch for the A_c⁺ cache's key.
     key: Vec<usize>,
 }
@@ -350,7 +354,69 @@ impl Q1Memo {
         self.order = tensor_order_of(m, n, ends, edges);
         self.ends = Some((m, *ends));
         self.pinv_valid = false;
+        self.affine_valid = false;
         self.order
+    }
+
+    /// Make A_c⁺ (and with `affine` the S_ab) those of a Q1 cell with N
+    /// corners, E edges and tensor order `order`, unless they already are.
+    fn refresh<const N: usize, const E: usize>(
+        &mut self,
+        order: &TensorOrder,
+        c: usize,
+        affine: bool,
+    ) -> Result<(), MetricError> {
+        if !(self.pinv_valid && self.ends == Some((N, order.ends))) {
+            let key = &mut self.key;
+            key.clear();
+            key.push(N);
+            for &[t, h] in &order.ends[..E] {
+                key.extend([usize::from(t), usize::from(h)]);
+            }
+            let pinv = pseudo_inverse_of_key(key, c, "Q1")?;
+            for (row, &o) in self.pinv.iter_mut().zip(order.iter()) {
+                for (e, entry) in row.iter_mut().take(E).enumerate() {
+                    *entry = pinv[(o, e)];
+                }
+            }
+            self.ends = Some((N, order.ends));
+            self.order = Some(*order);
+            self.pinv_valid = true;
+            self.affine_valid = false;
+        }
+        if affine && !self.affine_valid {
+            let n = N.trailing_zeros() as usize;
+            let reference = q1_reference(n);
+            let p = self.tensor_pinv::<N, E>();
+            self.affine.clear();
+            self.affine.resize(axis_pairs(n).len() * E * E, 0.0);
+            for (&(a, b), sum) in axis_pairs(n)
+                .iter()
+                .zip(self.affine.chunks_exact_mut(E * E))
+            {
+                let mut r = [[0.0; N]; N];
+                for (l, row) in r.iter_mut().enumerate() {
+                    for (j, entry) in row.iter_mut().enumerate() {
+                        *entry = reference.products[a][b][l][j];
+                        if a != b {
+                            *entry += reference.products[b][a][l][j];
+                        }
+                    }
+                }
+                congruence::<N, E>(&r, &p, sum);
+            }
+            self.affine_valid = true;
+        }
+        Ok(())
+    }
+
+    /// A_c⁺ in tensor order (N × E), as [`Q1Memo::refresh`] left it.
+    fn tensor_pinv<const N: usize, const E: usize>(&self) -> [[f64; E]; N] {
+        let mut p = [[0.0; E]; N];
+        for (row, memo_row) in p.iter_mut().zip(&self.pinv) {
+            row.copy_from_slice(&memo_row[..E]);
+        }
+        p
     }
 }
 
@@ -1046,10 +1112,167 @@ fn q1_block<const N: usize, const E: usize>(
     let n = N.trailing_zeros() as usize;
     debug_assert_eq!((order.len(), n << (n - 1), out.len()), (N, E, E * E));
     let x = tensor_points(top, c, order);
-    let map = q1_map::<N>(&x, c)?;
+    let geometry = q1_geometry::<N>(&x, c)?;
     if let Some((f, shares)) = load {
-        q1_shares(top, c, order, &x, &map.weights, f, shares)?;
+        q1_shares(top, c, order, &x, &geometry.weights(), f, shares)?;
     }
+    match &geometry {
+        Q1Geometry::Affine { det, inverse } => {
+            memo.refresh::<N, E>(order, c, true)?;
+            affine_block::<N, E>(inverse, det.abs(), k, memo, out);
+        }
+        Q1Geometry::General(map) => {
+            memo.refresh::<N, E>(order, c, false)?;
+            gauss_block::<N, E>(map, k, memo, out);
+        }
+    }
+    if out.iter().any(|v| !v.is_finite()) {
+        return Err(MetricError::UnsupportedCell {
+            method: "Q1",
+            needs: "a non-degenerate cell (finite local stiffness)",
+            cell: c,
+        });
+    }
+    Ok(())
+}
+
+/// The error of a Q1 cell whose isoparametric map folds or collapses.
+fn q1_inverted(cell: usize) -> MetricError {
+    MetricError::UnsupportedCell {
+        method: "Q1",
+        needs: "a quadrilateral or hexahedron whose isoparametric map keeps one orientation (convex, not inverted)",
+        cell,
+    }
+}
+
+/// The map of a Q1 cell at its Gauss points: one constant Jacobian for a
+/// parallelogram or parallelepiped ([`affine_jacobian`]), else the full
+/// isoparametric map.
+enum Q1Geometry<const N: usize> {
+    Affine { det: f64, inverse: [[f64; 3]; 3] },
+    General(Q1Map<N>),
+}
+
+impl<const N: usize> Q1Geometry<N> {
+    /// |det J| at each Gauss point.
+    fn weights(&self) -> [f64; N] {
+        match self {
+            Self::Affine { det, .. } => [det.abs(); N],
+            Self::General(map) => map.weights,
+        }
+    }
+}
+
+/// [`Q1Geometry`] of the cell with corners `x` (tensor order).
+fn q1_geometry<const N: usize>(x: &[Point; N], cell: usize) -> Result<Q1Geometry<N>, MetricError> {
+    match affine_jacobian::<N>(x) {
+        Some(jacobian) => {
+            let (det, inverse) = determinant_and_inverse(&jacobian, N.trailing_zeros() as usize);
+            if det == 0.0 || !det.is_finite() {
+                return Err(q1_inverted(cell));
+            }
+            Ok(Q1Geometry::Affine { det, inverse })
+        }
+        None => Ok(Q1Geometry::General(q1_map::<N>(x, cell)?)),
+    }
+}
+
+/// The constant Jacobian of the map from [−1, 1]ⁿ onto a Q1 cell with
+/// corners `x` (tensor order) when the cell is a parallelogram or
+/// parallelepiped: every corner is corner 0 plus the edges along its set
+/// axes, to within 16 ulp of the largest coordinate or edge. Coordinates
+/// carry that rounding already, so the Jacobian's differences do too and
+/// the Gauss rule could not resolve a bilinear part that small. `None`
+/// for any other cell. J is taken at the centre, from all corners, as the
+/// Gauss rule's mean Jacobian.
+fn affine_jacobian<const N: usize>(x: &[Point; N]) -> Option<[[f64; 3]; 3]> {
+    let n = N.trailing_zeros() as usize;
+    let mut size = 0.0f64;
+    for p in x {
+        for &xi in &p[..n] {
+            size = size.max(xi.abs());
+        }
+    }
+    let tolerance = 16.0 * f64::EPSILON * size;
+    for (l, p) in x.iter().enumerate().skip(3) {
+        if l.count_ones() < 2 {
+            continue;
+        }
+        for i in 0..n {
+            let along: f64 = (0..n)
+                .filter(|&a| (l >> a) & 1 == 1)
+                .map(|a| x[1 << a][i] - x[0][i])
+                .sum();
+            if (p[i] - x[0][i] - along).abs() > tolerance {
+                return None;
+            }
+        }
+    }
+    let mut jacobian = [[0.0; 3]; 3];
+    let scale = 1.0 / N as f64;
+    for (l, p) in x.iter().enumerate() {
+        for a in 0..n {
+            let s = scale * corner_sign(l, a);
+            for (row, &pi) in jacobian.iter_mut().zip(&p[..n]) {
+                row[a] += s * pi;
+            }
+        }
+    }
+    Some(jacobian)
+}
+
+/// Ω_c of an affine Q1 cell: with the constant J the Gauss rule gives
+/// K_c = Σ_ab C_ab R_ab, C = |det J| J⁻¹ k J⁻ᵀ and R_ab the reference
+/// products of the a- and b-derivatives of the shape functions (weight 1
+/// per Gauss point), so Ω_c = Σ_{a≤b} C_ab S_ab with S_ab = (A_c⁺)ᵀ R_ab
+/// A_c⁺ (R_ab + R_ba off the diagonal), kept in the memo for the cell's
+/// local incidence. Every S_ab is exactly symmetric, so Ω_c is.
+fn affine_block<const N: usize, const E: usize>(
+    inverse: &[[f64; 3]; 3],
+    weight: f64,
+    k: &Tensor,
+    memo: &Q1Memo,
+    out: &mut [f64],
+) {
+    let n = N.trailing_zeros() as usize;
+    // J⁻¹ k, then C's entries on and above the diagonal, in pair order.
+    let mut inverse_k = [[0.0; 3]; 3];
+    for (row, inv) in inverse_k.iter_mut().zip(inverse) {
+        for (j, entry) in row.iter_mut().enumerate().take(n) {
+            *entry = (0..n).map(|i| inv[i] * k[i][j]).sum();
+        }
+    }
+    let mut coefficients = [0.0; 6];
+    for (coefficient, &(a, b)) in coefficients.iter_mut().zip(axis_pairs(n)) {
+        *coefficient = weight * (0..n).map(|j| inverse_k[a][j] * inverse[b][j]).sum::<f64>();
+    }
+    out.fill(0.0);
+    for (coefficient, sum) in coefficients.iter().zip(memo.affine.chunks_exact(E * E)) {
+        for (o, s) in out.iter_mut().zip(sum) {
+            *o += coefficient * s;
+        }
+    }
+}
+
+/// The axis pairs (a, b), a ≤ b, of n dimensions, in the order of the
+/// memo's S_ab.
+fn axis_pairs(n: usize) -> &'static [(usize, usize)] {
+    match n {
+        2 => &[(0, 0), (0, 1), (1, 1)],
+        _ => &[(0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2)],
+    }
+}
+
+/// Ω_c of any Q1 cell from its isoparametric map: K_c from the 2ⁿ Gauss
+/// points, then (A_c⁺)ᵀ K_c A_c⁺, both formed on and above the diagonal
+/// and mirrored.
+fn gauss_block<const N: usize, const E: usize>(
+    map: &Q1Map<N>,
+    k: &Tensor,
+    memo: &Q1Memo,
+    out: &mut [f64],
+) {
+    let n = N.trailing_zeros() as usize;
     // K_c in tensor order.
     let mut kc = [[0.0; N]; N];
     for (&weight, gradients) in map.weights[..N].iter().zip(&map.gradients) {
@@ -1071,33 +1294,21 @@ fn q1_block<const N: usize, const E: usize>(
             *entry = upper[j][l];
         }
     }
-    // A_c⁺ with its rows (the cell's sorted vertices) in tensor order,
-    // kept for the next cell with the same local incidence.
-    if !(memo.pinv_valid && memo.ends == Some((N, order.ends))) {
-        let key = &mut memo.key;
-        key.clear();
-        key.push(N);
-        for &[t, h] in &order.ends[..E] {
-            key.extend([usize::from(t), usize::from(h)]);
-        }
-        let pinv = pseudo_inverse_of_key(key, c, "Q1")?;
-        for (row, &o) in memo.pinv.iter_mut().zip(order.iter()) {
-            for (e, entry) in row.iter_mut().take(E).enumerate() {
-                *entry = pinv[(o, e)];
-            }
-        }
-        memo.ends = Some((N, order.ends));
-        memo.order = Some(*order);
-        memo.pinv_valid = true;
-    }
-    let mut p = [[0.0; E]; N];
-    for (row, memo_row) in p.iter_mut().zip(&memo.pinv) {
-        row.copy_from_slice(&memo_row[..E]);
-    }
-    // K_c A_c⁺ (N × E), then (A_c⁺)ᵀ K_c A_c⁺ on and above the diagonal.
+    let p = memo.tensor_pinv::<N, E>();
+    congruence::<N, E>(&kc, &p, out);
+}
+
+/// Pᵀ K P (E × E, row-major, into `out`) of a symmetric N × N matrix K,
+/// formed on and above the diagonal and mirrored.
+fn congruence<const N: usize, const E: usize>(
+    kc: &[[f64; N]; N],
+    p: &[[f64; E]; N],
+    out: &mut [f64],
+) {
+    // K P (N × E), then Pᵀ (K P) on and above the diagonal.
     let mut half = [[0.0; E]; N];
-    for (h, kl) in half.iter_mut().zip(&kc) {
-        for (a, pa) in kl.iter().zip(&p) {
+    for (h, kl) in half.iter_mut().zip(kc) {
+        for (a, pa) in kl.iter().zip(p) {
             for (he, pe) in h.iter_mut().zip(pa) {
                 *he += a * pe;
             }
@@ -1110,14 +1321,6 @@ fn q1_block<const N: usize, const E: usize>(
             out[f * E + e] = value;
         }
     }
-    if out.iter().any(|v| !v.is_finite()) {
-        return Err(MetricError::UnsupportedCell {
-            method: "Q1",
-            needs: "a non-degenerate cell (finite local stiffness)",
-            cell: c,
-        });
-    }
-    Ok(())
 }
 
 /// Sign (±1) of corner `l` along local axis `a`.
@@ -1170,11 +1373,7 @@ struct Q1Map<const N: usize> {
 #[inline(always)]
 fn q1_map<const N: usize>(x: &[Point; N], cell: usize) -> Result<Q1Map<N>, MetricError> {
     let n = N.trailing_zeros() as usize;
-    let bad = MetricError::UnsupportedCell {
-        method: "Q1",
-        needs: "a quadrilateral or hexahedron whose isoparametric map keeps one orientation (convex, not inverted)",
-        cell,
-    };
+    let bad = q1_inverted(cell);
     let mut map = Q1Map {
         weights: [0.0; N],
         gradients: [[[0.0; 3]; N]; N],
@@ -1215,6 +1414,9 @@ fn q1_map<const N: usize>(x: &[Point; N], cell: usize) -> Result<Q1Map<N>, Metri
 struct Q1Reference {
     values: [[f64; 8]; 8],
     gradients: [[Point; 8]; 8],
+    /// R_ab of [`affine_block`]: `products[a][b][l][j]` = Σ_q ∂_a N̂_l(q)
+    /// ∂_b N̂_j(q) over the Gauss points.
+    products: [[[[f64; 8]; 8]; 3]; 3],
 }
 
 fn q1_reference(n: usize) -> &'static Q1Reference {
@@ -1229,12 +1431,23 @@ fn q1_reference(n: usize) -> &'static Q1Reference {
         let mut reference = Q1Reference {
             values: [[0.0; 8]; 8],
             gradients: [[[0.0; 3]; 8]; 8],
+            products: [[[[0.0; 8]; 8]; 3]; 3],
         };
-        for q in 0..1usize << n {
+        let corners = 1usize << n;
+        for q in 0..corners {
             let xi: Vec<f64> = (0..n).map(|a| g * corner_sign(q, a)).collect();
             let (values, gradients) = q1_shape(&xi, n);
             reference.values[q][..values.len()].copy_from_slice(&values);
             reference.gradients[q][..gradients.len()].copy_from_slice(&gradients);
+            for a in 0..n {
+                for b in 0..n {
+                    for l in 0..corners {
+                        for j in 0..corners {
+                            reference.products[a][b][l][j] += gradients[l][a] * gradients[j][b];
+                        }
+                    }
+                }
+            }
         }
         reference
     })
@@ -1614,8 +1827,8 @@ fn q1_load<const N: usize>(
     out: &mut [f64],
 ) -> Result<(), MetricError> {
     let x = tensor_points(top, c, order);
-    let map = q1_map::<N>(&x, c)?;
-    q1_shares(top, c, order, &x, &map.weights, f, out)
+    let weights = q1_geometry::<N>(&x, c)?.weights();
+    q1_shares(top, c, order, &x, &weights, f, out)
 }
 
 /// The tensor Gauss rule of [`q1_load`] on corners `x` (tensor order) with
@@ -1764,6 +1977,197 @@ mod tests {
                 assert!((m[(i, j)] - expected).abs() < 1e-14, "({i},{j})");
             }
         }
+    }
+
+    /// uᵀ M v for the one-cell operator M = Aᵀ Ω A of Q1 on the cell with
+    /// corners `x0 + Σ_{a ∈ l} axes[a]` (corner l in tensor order, stored
+    /// as vertex (5 l + 2) mod 2ⁿ) and conductivity `k`, for corner values
+    /// `modes` given per tensor corner.
+    fn one_cell_forms(
+        x0: [f64; 3],
+        axes: &[[f64; 3]],
+        k: Tensor,
+        modes: &[Vec<f64>],
+    ) -> Vec<Vec<f64>> {
+        let n = axes.len();
+        let corners = 1usize << n;
+        let vertex = |l: usize| (5 * l + 2) % corners;
+        let mut coordinates = vec![0.0; corners * n];
+        for l in 0..corners {
+            for i in 0..n {
+                let along: f64 = (0..n)
+                    .filter(|&a| (l >> a) & 1 == 1)
+                    .map(|a| axes[a][i])
+                    .sum();
+                coordinates[vertex(l) * n + i] = x0[i] + along;
+            }
+        }
+        let v = Vertices::new(n, coordinates).unwrap();
+        let cell: Vec<usize> = (0..corners).map(vertex).collect();
+        let complex = Complex::build(v, TopCells::cuboids([cell])).unwrap();
+        let omega = stiffness_metric(&complex, &[k]).unwrap();
+        let m = crate::canonical::Canonical::new(complex.coboundary(0), omega)
+            .unwrap()
+            .assemble()
+            .to_dense();
+        let by_vertex = |mode: &[f64]| {
+            let mut u = vec![0.0; corners];
+            for (l, &value) in mode.iter().enumerate() {
+                u[vertex(l)] = value;
+            }
+            u
+        };
+        modes
+            .iter()
+            .map(|a| {
+                let u = by_vertex(a);
+                modes
+                    .iter()
+                    .map(|b| {
+                        let w = by_vertex(b);
+                        (0..corners)
+                            .map(|i| (0..corners).map(|j| u[i] * m[(i, j)] * w[j]).sum::<f64>())
+                            .sum()
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The corner values (tensor order) of ξ_a ξ_b … on [−1, 1]ⁿ for the
+    /// axes in `axes`, and of the physical coordinate `i` of a cell.
+    fn reference_mode(n: usize, axes: &[usize]) -> Vec<f64> {
+        (0..1usize << n)
+            .map(|l| axes.iter().map(|&a| corner_sign(l, a)).product())
+            .collect()
+    }
+
+    #[test]
+    fn q1_on_parallelograms_is_the_exact_galerkin_stiffness() {
+        // A sheared cell, edges e1 = (2, 0), e2 = (1, 1) from (0.5, −1),
+        // area 2, with k = [[2, ½], [½, 1]]. By hand: J = [e1 e2]/2,
+        // det J = ½, J⁻¹ = [[1, −1], [0, 2]], C = det J · J⁻¹ k J⁻ᵀ =
+        // [[1, −½], [−½, 2]]. Linear u, v: uᵀ M v = area · ∇uᵀ k ∇v, so
+        // 4, 1, 2 for (x, x), (x, y), (y, y). The hourglass ξ1ξ2 has
+        // ∇̂ = (ξ2, ξ1): ∫ over [−1, 1]² of ξ2² C11 + ξ1² C22 = 4/3 · 3 = 4,
+        // and it is orthogonal to linear modes and constants.
+        let (x0, e1, e2) = ([0.5, -1.0, 0.0], [2.0, 0.0, 0.0], [1.0, 1.0, 0.0]);
+        let coordinate = |i: usize| -> Vec<f64> {
+            (0..4)
+                .map(|l| {
+                    x0[i]
+                        + [e1, e2]
+                            .iter()
+                            .enumerate()
+                            .filter(|(a, _)| (l >> a) & 1 == 1)
+                            .map(|(_, e)| e[i])
+                            .sum::<f64>()
+                })
+                .collect()
+        };
+        let k = [[2.0, 0.5, 0.0], [0.5, 1.0, 0.0], [0.0; 3]];
+        let modes = [
+            coordinate(0),
+            coordinate(1),
+            reference_mode(2, &[0, 1]),
+            vec![1.0; 4],
+        ];
+        let forms = one_cell_forms(x0, &[e1, e2], k, &modes);
+        let expected = [
+            [4.0, 1.0, 0.0, 0.0],
+            [1.0, 2.0, 0.0, 0.0],
+            [0.0, 0.0, 4.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0],
+        ];
+        for (a, row) in expected.iter().enumerate() {
+            for (b, &value) in row.iter().enumerate() {
+                assert!(
+                    (forms[a][b] - value).abs() < 1e-13,
+                    "2D ({a}, {b}): {} vs {value}",
+                    forms[a][b]
+                );
+            }
+        }
+        // A parallelepiped: e1 = (2, 0, 0), e2 = (0, 2, 0), e3 = (1, 0, 2),
+        // volume 8, k = I. J = [e1 e2 e3]/2 has det 1 and J⁻¹ rows
+        // (1, 0, −½), (0, 1, 0), (0, 0, 1), so C = J⁻¹ J⁻ᵀ has C11 = 5/4,
+        // C13 = −½, C22 = C33 = 1 and C12 = C23 = 0. Over [−1, 1]³ with
+        // ∫ ξ² = 8/3 and ∫ ξ²η² = 8/9: ξ1ξ2 gives 8/3 (C11 + C22) = 6,
+        // ξ1ξ3 gives 6, ξ2ξ3 gives 16/3, ξ1ξ2ξ3 gives 8/9 · 13/4 = 26/9;
+        // ξ1ξ2 against ξ2ξ3 is ∫ ξ2² C13 = −4/3; u = x gives the volume.
+        let x0 = [1.0, 0.0, -2.0];
+        let axes = [[2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [1.0, 0.0, 2.0]];
+        let x: Vec<f64> = (0..8)
+            .map(|l| {
+                x0[0]
+                    + (0..3)
+                        .filter(|&a| (l >> a) & 1 == 1)
+                        .map(|a| axes[a][0])
+                        .sum::<f64>()
+            })
+            .collect();
+        let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let modes = [
+            reference_mode(3, &[0, 1]),
+            reference_mode(3, &[0, 2]),
+            reference_mode(3, &[1, 2]),
+            reference_mode(3, &[0, 1, 2]),
+            x,
+            vec![1.0; 8],
+        ];
+        let forms = one_cell_forms(x0, &axes, identity, &modes);
+        let expected = [
+            [6.0, 0.0, -4.0 / 3.0, 0.0, 0.0, 0.0],
+            [0.0, 6.0, 0.0, 0.0, 0.0, 0.0],
+            [-4.0 / 3.0, 0.0, 16.0 / 3.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 26.0 / 9.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0, 8.0, 0.0],
+            [0.0; 6],
+        ];
+        for (a, row) in expected.iter().enumerate() {
+            for (b, &value) in row.iter().enumerate() {
+                assert!(
+                    (forms[a][b] - value).abs() < 1e-13,
+                    "3D ({a}, {b}): {} vs {value}",
+                    forms[a][b]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn only_parallelograms_and_parallelepipeds_take_the_constant_jacobian() {
+        let square = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 1.0, 0.0],
+        ];
+        let jacobian = affine_jacobian::<4>(&square).unwrap();
+        assert_eq!(
+            (
+                jacobian[0][0],
+                jacobian[0][1],
+                jacobian[1][0],
+                jacobian[1][1]
+            ),
+            (0.5, 0.0, 0.0, 0.5)
+        );
+        // Corner 3 moved by 10⁻¹², far above 16 ulp of the unit size: a
+        // trapezoid, for the Gauss rule.
+        let mut moved = square;
+        moved[3][0] += 1e-12;
+        assert!(affine_jacobian::<4>(&moved).is_none());
+        // A unit cube with only corner 7 (all three axes) moved.
+        let mut cube = [[0.0; 3]; 8];
+        for (l, p) in cube.iter_mut().enumerate() {
+            for (a, x) in p.iter_mut().enumerate() {
+                *x = ((l >> a) & 1) as f64;
+            }
+        }
+        assert!(affine_jacobian::<8>(&cube).is_some());
+        cube[7][2] -= 1e-12;
+        assert!(affine_jacobian::<8>(&cube).is_none());
     }
 
     /// Unit cells of an `sides` grid (2 or 3 axes) with vertex v renumbered
