@@ -1993,13 +1993,9 @@ mod tests {
         let corners = 1usize << n;
         let vertex = |l: usize| (5 * l + 2) % corners;
         let mut coordinates = vec![0.0; corners * n];
-        for l in 0..corners {
-            for i in 0..n {
-                let along: f64 = (0..n)
-                    .filter(|&a| (l >> a) & 1 == 1)
-                    .map(|a| axes[a][i])
-                    .sum();
-                coordinates[vertex(l) * n + i] = x0[i] + along;
+        for i in 0..n {
+            for (l, x) in coordinate_mode(x0, axes, i).into_iter().enumerate() {
+                coordinates[vertex(l) * n + i] = x;
             }
         }
         let v = Vertices::new(n, coordinates).unwrap();
@@ -2035,11 +2031,37 @@ mod tests {
     }
 
     /// The corner values (tensor order) of ξ_a ξ_b … on [−1, 1]ⁿ for the
-    /// axes in `axes`, and of the physical coordinate `i` of a cell.
+    /// reference axes in `axes`.
     fn reference_mode(n: usize, axes: &[usize]) -> Vec<f64> {
         (0..1usize << n)
             .map(|l| axes.iter().map(|&a| corner_sign(l, a)).product())
             .collect()
+    }
+
+    /// The corner values (tensor order) of the physical coordinate x_i on
+    /// the cell of [`one_cell_forms`].
+    fn coordinate_mode(x0: [f64; 3], axes: &[[f64; 3]], i: usize) -> Vec<f64> {
+        (0..1usize << axes.len())
+            .map(|l| {
+                x0[i]
+                    + (0..axes.len())
+                        .filter(|&a| (l >> a) & 1 == 1)
+                        .map(|a| axes[a][i])
+                        .sum::<f64>()
+            })
+            .collect()
+    }
+
+    fn assert_forms(label: &str, forms: &[Vec<f64>], expected: &[&[f64]]) {
+        for (a, row) in expected.iter().enumerate() {
+            for (b, &value) in row.iter().enumerate() {
+                assert!(
+                    (forms[a][b] - value).abs() < 1e-13,
+                    "{label} ({a}, {b}): {} vs {value}",
+                    forms[a][b]
+                );
+            }
+        }
     }
 
     #[test]
@@ -2051,43 +2073,25 @@ mod tests {
         // 4, 1, 2 for (x, x), (x, y), (y, y). The hourglass ξ1ξ2 has
         // ∇̂ = (ξ2, ξ1): ∫ over [−1, 1]² of ξ2² C11 + ξ1² C22 = 4/3 · 3 = 4,
         // and it is orthogonal to linear modes and constants.
-        let (x0, e1, e2) = ([0.5, -1.0, 0.0], [2.0, 0.0, 0.0], [1.0, 1.0, 0.0]);
-        let coordinate = |i: usize| -> Vec<f64> {
-            (0..4)
-                .map(|l| {
-                    x0[i]
-                        + [e1, e2]
-                            .iter()
-                            .enumerate()
-                            .filter(|(a, _)| (l >> a) & 1 == 1)
-                            .map(|(_, e)| e[i])
-                            .sum::<f64>()
-                })
-                .collect()
-        };
+        let x0 = [0.5, -1.0, 0.0];
+        let axes = [[2.0, 0.0, 0.0], [1.0, 1.0, 0.0]];
         let k = [[2.0, 0.5, 0.0], [0.5, 1.0, 0.0], [0.0; 3]];
         let modes = [
-            coordinate(0),
-            coordinate(1),
+            coordinate_mode(x0, &axes, 0),
+            coordinate_mode(x0, &axes, 1),
             reference_mode(2, &[0, 1]),
             vec![1.0; 4],
         ];
-        let forms = one_cell_forms(x0, &[e1, e2], k, &modes);
-        let expected = [
-            [4.0, 1.0, 0.0, 0.0],
-            [1.0, 2.0, 0.0, 0.0],
-            [0.0, 0.0, 4.0, 0.0],
-            [0.0, 0.0, 0.0, 0.0],
-        ];
-        for (a, row) in expected.iter().enumerate() {
-            for (b, &value) in row.iter().enumerate() {
-                assert!(
-                    (forms[a][b] - value).abs() < 1e-13,
-                    "2D ({a}, {b}): {} vs {value}",
-                    forms[a][b]
-                );
-            }
-        }
+        assert_forms(
+            "2D",
+            &one_cell_forms(x0, &axes, k, &modes),
+            &[
+                &[4.0, 1.0, 0.0, 0.0],
+                &[1.0, 2.0, 0.0, 0.0],
+                &[0.0, 0.0, 4.0, 0.0],
+                &[0.0; 4],
+            ],
+        );
         // A parallelepiped: e1 = (2, 0, 0), e2 = (0, 2, 0), e3 = (1, 0, 2),
         // volume 8, k = I. J = [e1 e2 e3]/2 has det 1 and J⁻¹ rows
         // (1, 0, −½), (0, 1, 0), (0, 0, 1), so C = J⁻¹ J⁻ᵀ has C11 = 5/4,
@@ -2097,42 +2101,27 @@ mod tests {
         // ξ1ξ2 against ξ2ξ3 is ∫ ξ2² C13 = −4/3; u = x gives the volume.
         let x0 = [1.0, 0.0, -2.0];
         let axes = [[2.0, 0.0, 0.0], [0.0, 2.0, 0.0], [1.0, 0.0, 2.0]];
-        let x: Vec<f64> = (0..8)
-            .map(|l| {
-                x0[0]
-                    + (0..3)
-                        .filter(|&a| (l >> a) & 1 == 1)
-                        .map(|a| axes[a][0])
-                        .sum::<f64>()
-            })
-            .collect();
         let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
         let modes = [
             reference_mode(3, &[0, 1]),
             reference_mode(3, &[0, 2]),
             reference_mode(3, &[1, 2]),
             reference_mode(3, &[0, 1, 2]),
-            x,
+            coordinate_mode(x0, &axes, 0),
             vec![1.0; 8],
         ];
-        let forms = one_cell_forms(x0, &axes, identity, &modes);
-        let expected = [
-            [6.0, 0.0, -4.0 / 3.0, 0.0, 0.0, 0.0],
-            [0.0, 6.0, 0.0, 0.0, 0.0, 0.0],
-            [-4.0 / 3.0, 0.0, 16.0 / 3.0, 0.0, 0.0, 0.0],
-            [0.0, 0.0, 0.0, 26.0 / 9.0, 0.0, 0.0],
-            [0.0, 0.0, 0.0, 0.0, 8.0, 0.0],
-            [0.0; 6],
-        ];
-        for (a, row) in expected.iter().enumerate() {
-            for (b, &value) in row.iter().enumerate() {
-                assert!(
-                    (forms[a][b] - value).abs() < 1e-13,
-                    "3D ({a}, {b}): {} vs {value}",
-                    forms[a][b]
-                );
-            }
-        }
+        assert_forms(
+            "3D",
+            &one_cell_forms(x0, &axes, identity, &modes),
+            &[
+                &[6.0, 0.0, -4.0 / 3.0, 0.0, 0.0, 0.0],
+                &[0.0, 6.0, 0.0, 0.0, 0.0, 0.0],
+                &[-4.0 / 3.0, 0.0, 16.0 / 3.0, 0.0, 0.0, 0.0],
+                &[0.0, 0.0, 0.0, 26.0 / 9.0, 0.0, 0.0],
+                &[0.0, 0.0, 0.0, 0.0, 8.0, 0.0],
+                &[0.0; 6],
+            ],
+        );
     }
 
     #[test]
