@@ -54,26 +54,83 @@ struct Block {
 }
 
 /// Square blocks over their own rows, back to back (a builder that knew
-/// the block sizes in advance): block b covers the rows
-/// `indices[ptr[b]..ptr[b + 1]]` and its values are
-/// `values[value_ptr[b]..value_ptr[b + 1]]`. Two pointers a block instead
-/// of a 40-byte record: at 10⁶ Q1 cells, 16 MB instead of 40 MB.
+/// the block sizes in advance): block b covers the rows `rows` gives it
+/// and its values are `values[value_ptr[b]..value_ptr[b + 1]]`. Two
+/// pointers a block instead of a 40-byte record: at 10⁶ Q1 cells, 16 MB
+/// instead of 40 MB.
 #[derive(Clone, Debug, PartialEq)]
 struct SquareBlocks {
-    ptr: Vec<usize>,
+    rows: SquareRows,
     value_ptr: Vec<usize>,
 }
 
+/// Where square blocks keep their rows.
+#[derive(Clone, Debug, PartialEq)]
+enum SquareRows {
+    /// Block b covers the metric's `indices[ptr[b]..ptr[b + 1]]`.
+    Listed { ptr: Vec<usize> },
+    /// Block b covers the rows of column b of this CSC matrix, shared with
+    /// the complex (∂₂ by cells: a 2D cell's sorted edges, 40 MB at 10⁶
+    /// cells that a copy would write again); the metric keeps no indices.
+    Columns(Arc<CsMat<i8>>),
+}
+
 impl SquareBlocks {
-    /// The same blocks as records, for a metric that is pushed to.
-    fn records(&self) -> Vec<Block> {
-        self.ptr
-            .windows(2)
-            .zip(&self.value_ptr)
-            .map(|(w, &values)| Block {
-                rows: (w[0], w[1] - w[0]),
-                cols: (w[0], w[1] - w[0]),
-                values,
+    fn count(&self) -> usize {
+        self.value_ptr.len().saturating_sub(1)
+    }
+
+    /// Rows of block b, `indices` being the metric's.
+    fn rows<'a>(&'a self, indices: &'a [usize], b: usize) -> &'a [usize] {
+        match &self.rows {
+            SquareRows::Listed { ptr } => &indices[ptr[b]..ptr[b + 1]],
+            SquareRows::Columns(by_column) => {
+                &by_column.indices()[by_column.indptr().outer_inds_sz(b)]
+            }
+        }
+    }
+
+    /// Every block's rows in block order, one list, and the block holding
+    /// entry k of that list.
+    fn all_rows<'a>(&'a self, indices: &'a [usize]) -> &'a [usize] {
+        match &self.rows {
+            SquareRows::Listed { .. } => indices,
+            SquareRows::Columns(by_column) => {
+                let ptr = by_column.indptr();
+                let ptr = ptr.raw_storage();
+                &by_column.indices()[ptr[0]..ptr[ptr.len() - 1]]
+            }
+        }
+    }
+
+    fn block_of_entry(&self, k: usize) -> usize {
+        match &self.rows {
+            SquareRows::Listed { ptr } => ptr.partition_point(|&p| p <= k) - 1,
+            SquareRows::Columns(by_column) => {
+                let ptr = by_column.indptr();
+                let ptr = ptr.raw_storage();
+                ptr.partition_point(|&p| p - ptr[0] <= k) - 1
+            }
+        }
+    }
+
+    /// The same blocks as records over the metric's `indices`, for a
+    /// metric that is pushed to (shared rows are copied there first).
+    fn records(&self, indices: &mut Vec<usize>) -> Vec<Block> {
+        if let SquareRows::Columns(_) = &self.rows {
+            *indices = self.all_rows(&[]).to_vec();
+        }
+        let mut start = 0;
+        (0..self.count())
+            .map(|b| {
+                let m = self.rows(indices, b).len();
+                let block = Block {
+                    rows: (start, m),
+                    cols: (start, m),
+                    values: self.value_ptr[b],
+                };
+                start += m;
+                block
             })
             .collect()
     }
@@ -206,28 +263,54 @@ impl BlockMetric {
         per_cell: bool,
     ) -> Self {
         debug_assert_eq!(ptr.len(), value_ptr.len());
-        debug_assert!(ptr
-            .windows(2)
-            .zip(value_ptr.windows(2))
-            .all(|(p, v)| v[1] - v[0] == (p[1] - p[0]) * (p[1] - p[0])));
-        debug_assert_eq!(value_ptr.last().copied().unwrap_or(0), values.len());
         debug_assert_eq!(ptr.last().copied().unwrap_or(0), indices.len());
-        debug_assert!(ptr.windows(2).zip(&value_ptr).all(|(p, &start)| {
-            let m = p[1] - p[0];
-            let w = &values[start..start + m * m];
-            w.iter().all(|v| v.is_finite())
-                && (0..m).all(|i| (0..i).all(|j| w[i * m + j] == w[j * m + i]))
-        }));
-        Self {
+        let rows = SquareRows::Listed { ptr };
+        Self::exact_square(size, rows, value_ptr, indices, values, per_cell)
+    }
+
+    /// [`BlockMetric::from_symmetric_blocks`] with block b over the rows
+    /// of column b of `by_column` (CSC, shared, not copied), one block per
+    /// column.
+    pub(crate) fn from_symmetric_column_blocks(
+        size: usize,
+        by_column: Arc<CsMat<i8>>,
+        value_ptr: Vec<usize>,
+        values: Vec<f64>,
+        per_cell: bool,
+    ) -> Self {
+        debug_assert!(by_column.is_csc());
+        debug_assert_eq!(by_column.cols() + 1, value_ptr.len());
+        let rows = SquareRows::Columns(by_column);
+        Self::exact_square(size, rows, value_ptr, Vec::new(), values, per_cell)
+    }
+
+    fn exact_square(
+        size: usize,
+        rows: SquareRows,
+        value_ptr: Vec<usize>,
+        indices: Vec<usize>,
+        values: Vec<f64>,
+        per_cell: bool,
+    ) -> Self {
+        debug_assert_eq!(value_ptr.last().copied().unwrap_or(0), values.len());
+        let metric = Self {
             size,
             blocks: Vec::new(),
-            square: Some(SquareBlocks { ptr, value_ptr }),
+            square: Some(SquareBlocks { rows, value_ptr }),
             indices,
             values,
             identity: OnceLock::new(),
             per_cell,
             exact: true,
-        }
+        };
+        debug_assert!((0..metric.block_count()).all(|b| {
+            let (rows, _, w) = metric.block(b);
+            let m = rows.len();
+            w.len() == m * m
+                && w.iter().all(|v| v.is_finite())
+                && (0..m).all(|i| (0..i).all(|j| w[i * m + j] == w[j * m + i]))
+        }));
+        metric
     }
 
     /// Add the block W (|rows| × |cols|, row-major) at rows × cols.
@@ -235,7 +318,7 @@ impl BlockMetric {
         self.per_cell = false;
         self.exact = false;
         if let Some(square) = self.square.take() {
-            self.blocks = square.records();
+            self.blocks = square.records(&mut self.indices);
             if self.blocks.is_empty() {
                 // No blocks at all: the empty diagonal layout.
                 self.indices.clear();
@@ -297,7 +380,7 @@ impl BlockMetric {
     /// Number of blocks.
     pub fn block_count(&self) -> usize {
         match &self.square {
-            Some(square) => square.ptr.len().saturating_sub(1),
+            Some(square) => square.count(),
             None if self.blocks.is_empty() => self.values.len(),
             None => self.blocks.len(),
         }
@@ -306,7 +389,7 @@ impl BlockMetric {
     /// Rows, columns and values of block `b`.
     pub fn block(&self, b: usize) -> (&[usize], &[usize], &[f64]) {
         if let Some(square) = &self.square {
-            let rows = &self.indices[square.ptr[b]..square.ptr[b + 1]];
+            let rows = square.rows(&self.indices, b);
             return (
                 rows,
                 rows,
@@ -429,19 +512,25 @@ impl BlockMetric {
         }
         if let (true, Some(square)) = (self.exact, &self.square) {
             // Square, finite blocks by construction: only a row can be
-            // wrong, and the rows are one list.
-            let largest = self
-                .indices
+            // wrong, and the rows are one list (columns of a matrix with
+            // no more rows than Ω cannot be).
+            if let SquareRows::Columns(by_column) = &square.rows {
+                if by_column.rows() <= self.size {
+                    return Ok(());
+                }
+            }
+            let rows = square.all_rows(&self.indices);
+            let largest = rows
                 .par_chunks(1 << 16)
                 .map(|chunk| chunk.iter().copied().max().unwrap_or(0))
                 .max();
             if largest.is_none_or(|r| r < self.size) {
                 return Ok(());
             }
-            return match self.indices.iter().position(|&r| r >= self.size) {
+            return match rows.iter().position(|&r| r >= self.size) {
                 Some(k) => Err(CanonicalError::RowOutOfRange {
-                    block: square.ptr.partition_point(|&p| p <= k) - 1,
-                    row: self.indices[k],
+                    block: square.block_of_entry(k),
+                    row: rows[k],
                     size: self.size,
                 }),
                 None => Ok(()),
@@ -1521,6 +1610,71 @@ mod tests {
             matches!(error, CanonicalError::NonFinite { block: 0 }),
             "{error:?}"
         );
+    }
+
+    #[test]
+    fn blocks_over_shared_columns_read_like_listed_rows() {
+        // The two blocks of the test above, their rows {0, 2} and
+        // {1, 2, 3} as the columns of a 5 × 2 CSC matrix.
+        let values = vec![
+            2.0, -1.0, -1.0, 2.0, 3.0, 0.5, 0.0, 0.5, 4.0, 1.0, 0.0, 1.0, 5.0,
+        ];
+        let columns = |rows: usize, last: usize| {
+            Arc::new(CsMat::new_csc(
+                (rows, 2),
+                vec![0, 2, 5],
+                vec![0, 2, 1, 2, last],
+                vec![1i8; 5],
+            ))
+        };
+        let listed = |last: usize| {
+            BlockMetric::from_symmetric_blocks(
+                5,
+                vec![0, 2, 5],
+                vec![0, 4, 13],
+                vec![0, 2, 1, 2, last],
+                values.clone(),
+                true,
+            )
+        };
+        let shared = |rows: usize, last: usize| {
+            BlockMetric::from_symmetric_column_blocks(
+                5,
+                columns(rows, last),
+                vec![0, 4, 13],
+                values.clone(),
+                true,
+            )
+        };
+        let metric = shared(5, 3);
+        assert_eq!(metric.block_count(), 2);
+        for b in 0..2 {
+            assert_eq!(metric.block(b), listed(3).block(b));
+        }
+        assert_eq!(metric.to_dense(), listed(3).to_dense());
+        let identity = || CsMat::<i8>::eye(5);
+        assert!(Canonical::new(identity(), metric.clone()).is_ok());
+        // A row past Ω's size, in a matrix with more rows than Ω: named
+        // with its block, as for listed rows.
+        let error = Canonical::new(identity(), shared(8, 7)).unwrap_err();
+        assert!(
+            matches!(
+                error,
+                CanonicalError::RowOutOfRange {
+                    block: 1,
+                    row: 7,
+                    size: 5
+                }
+            ),
+            "{error:?}"
+        );
+        // A push copies the rows out and continues as records.
+        let mut pushed = metric;
+        pushed.push_block(&[4], &[4], &[7.0]);
+        let mut expected = listed(3);
+        expected.push_block(&[4], &[4], &[7.0]);
+        assert_eq!(pushed, expected);
+        assert_eq!(pushed.apply(&[1.0; 5]), vec![1.0, 3.5, 6.5, 6.0, 7.0]);
     }
 
     /// M of `omega` on the nodal operator of `k`, through the blocks'

@@ -468,23 +468,46 @@ fn dense_stiffness(
     load: Option<(LoadFn, &[usize], &mut [f64])>,
 ) -> Result<BlockMetric, MetricError> {
     let cells = top.complex.cell_count(top.n);
-    let sizes: Vec<usize> = (0..cells)
-        .into_par_iter()
-        .map_init(Vec::new, |scratch, c| top.edge_count(c, scratch))
-        .collect();
-    let mut edge_ptr = Vec::with_capacity(cells + 1);
+    // A 2D cell's sorted edges are its column of ∂₂ by cells: Ω's blocks
+    // take their rows from that matrix, shared, and no edge list is
+    // written. In 3D the faces' edges are merged per cell.
+    let by_cell = (top.n == 2).then(|| top.complex.shared_boundary_csc(2));
+    let edge_ptr: std::borrow::Cow<[usize]> = match &by_cell {
+        Some(by_cell) => by_cell.proper_indptr(),
+        None => {
+            let sizes: Vec<usize> = (0..cells)
+                .into_par_iter()
+                .map_init(Vec::new, |scratch, c| top.edge_count(c, scratch))
+                .collect();
+            let mut edge_ptr = Vec::with_capacity(cells + 1);
+            edge_ptr.push(0);
+            for &m in &sizes {
+                edge_ptr.push(edge_ptr[edge_ptr.len() - 1] + m);
+            }
+            edge_ptr.into()
+        }
+    };
     let mut value_ptr = Vec::with_capacity(cells + 1);
-    edge_ptr.push(0);
     value_ptr.push(0);
-    for &m in &sizes {
-        edge_ptr.push(edge_ptr[edge_ptr.len() - 1] + m);
+    for w in edge_ptr.windows(2) {
+        let m = w[1] - w[0];
         value_ptr.push(value_ptr[value_ptr.len() - 1] + m * m);
     }
-    drop(sizes);
-    let mut indices = vec![0usize; edge_ptr[cells]];
+    let listed = by_cell.is_none();
+    let mut indices = vec![0usize; if listed { edge_ptr[cells] } else { 0 }];
     let mut values = vec![0.0; value_ptr[cells]];
     let parts = ranges(cells);
-    let index_parts = split_at_ranges(&mut indices, &parts, |c| edge_ptr[c]);
+    let index_parts = split_at_ranges(
+        &mut indices,
+        &parts,
+        |c| {
+            if listed {
+                edge_ptr[c]
+            } else {
+                0
+            }
+        },
+    );
     let value_parts = split_at_ranges(&mut values, &parts, |c| value_ptr[c]);
     let (f, share_parts) = match load {
         Some((f, offsets, shares)) => (
@@ -532,22 +555,32 @@ fn dense_stiffness(
                         omega.copy_from_slice(&scratch.omega);
                     }
                 }
-                index_out[edge_ptr[c] - edge_base..edge_ptr[c + 1] - edge_base]
-                    .copy_from_slice(&scratch.edges);
+                if listed {
+                    index_out[edge_ptr[c] - edge_base..edge_ptr[c + 1] - edge_base]
+                        .copy_from_slice(&scratch.edges);
+                } else {
+                    debug_assert_eq!(scratch.edges, top.facets_of(2, c).0);
+                }
             }
             Ok(())
         })
         .collect::<Vec<_>>()
         .into_iter()
         .collect::<Result<(), MetricError>>()?;
-    Ok(BlockMetric::from_symmetric_blocks(
-        top.complex.cell_count(1),
-        edge_ptr,
-        value_ptr,
-        indices,
-        values,
-        true,
-    ))
+    let edges = top.complex.cell_count(1);
+    Ok(match by_cell {
+        Some(by_cell) => {
+            BlockMetric::from_symmetric_column_blocks(edges, by_cell, value_ptr, values, true)
+        }
+        None => BlockMetric::from_symmetric_blocks(
+            edges,
+            edge_ptr.into_owned(),
+            value_ptr,
+            indices,
+            values,
+            true,
+        ),
+    })
 }
 
 /// One cell's share of Ω.
