@@ -1569,6 +1569,22 @@ mod tests {
         assert_eq!(more.apply(&[1.0; 5]), vec![1.0, 3.5, 6.5, 6.0, 7.0]);
     }
 
+    /// The error of a five-row Ω whose block 1 lists row 7.
+    fn assert_row_7_of_block_1(built: Result<Canonical, CanonicalError>) {
+        let error = built.unwrap_err();
+        assert!(
+            matches!(
+                error,
+                CanonicalError::RowOutOfRange {
+                    block: 1,
+                    row: 7,
+                    size: 5
+                }
+            ),
+            "{error:?}"
+        );
+    }
+
     #[test]
     fn square_blocks_skip_the_value_scans_until_their_values_are_changed() {
         let square = |indices: Vec<usize>| {
@@ -1587,18 +1603,7 @@ mod tests {
         let identity = || CsMat::<i8>::eye(5);
         assert!(Canonical::new(identity(), square(vec![0, 2, 1, 2, 3])).is_ok());
         // A row past Ω's size is still found, in the block that holds it.
-        let error = Canonical::new(identity(), square(vec![0, 2, 1, 2, 7])).unwrap_err();
-        assert!(
-            matches!(
-                error,
-                CanonicalError::RowOutOfRange {
-                    block: 1,
-                    row: 7,
-                    size: 5
-                }
-            ),
-            "{error:?}"
-        );
+        assert_row_7_of_block_1(Canonical::new(identity(), square(vec![0, 2, 1, 2, 7])));
         // Changed values are scanned again.
         let mut changed = square(vec![0, 2, 1, 2, 3]);
         assert!(changed.is_symmetric(0.0));
@@ -1656,18 +1661,7 @@ mod tests {
         assert!(Canonical::new(identity(), metric.clone()).is_ok());
         // A row past Ω's size, in a matrix with more rows than Ω: named
         // with its block, as for listed rows.
-        let error = Canonical::new(identity(), shared(8, 7)).unwrap_err();
-        assert!(
-            matches!(
-                error,
-                CanonicalError::RowOutOfRange {
-                    block: 1,
-                    row: 7,
-                    size: 5
-                }
-            ),
-            "{error:?}"
-        );
+        assert_row_7_of_block_1(Canonical::new(identity(), shared(8, 7)));
         // A push copies the rows out and continues as records.
         let mut pushed = metric;
         pushed.push_block(&[4], &[4], &[7.0]);
