@@ -1126,13 +1126,14 @@ fn q1_cell(
 
 /// Ω_c of a Q1 cell with N = 2ⁿ corners and E edges (n = 2: 4, 4; n = 3:
 /// 8, 12) into `out` (E × E), over its sorted edges (left in the scratch
-/// by the element lookup that found the tensor order):
-/// K_c from the 2ⁿ Gauss points, then (A_c⁺)ᵀ K_c A_c⁺ as in
-/// [`edge_block`], in fixed arrays, with A_c's pattern taken from the
-/// tensor order (no second walk of the edges).
-/// K_c and Ω_c are formed on and above the diagonal and mirrored, so both
-/// are exactly symmetric. With `load` = (f, shares), the cell's load
-/// shares are written too, from the same map (as [`q1_load`]).
+/// by the element lookup that found the tensor order), in fixed arrays,
+/// with A_c's pattern taken from the tensor order (no second walk of the
+/// edges): for a parallelogram or parallelepiped from its one Jacobian
+/// ([`affine_block`]), for any other cell K_c from the 2ⁿ Gauss points
+/// and then (A_c⁺)ᵀ K_c A_c⁺ as in [`edge_block`] ([`gauss_block`]).
+/// Either way Ω_c is exactly symmetric. With `load` = (f, shares), the
+/// cell's load shares are written too, from the same map (as
+/// [`q1_load`]).
 fn q1_block<const N: usize, const E: usize>(
     top: &Topology,
     c: usize,
@@ -1213,7 +1214,7 @@ fn q1_geometry<const N: usize>(x: &[Point; N], cell: usize) -> Result<Q1Geometry
 /// The constant Jacobian of the map from [−1, 1]ⁿ onto a Q1 cell with
 /// corners `x` (tensor order) when the cell is a parallelogram or
 /// parallelepiped: every corner is corner 0 plus the edges along its set
-/// axes, to within 16 ulp of the largest coordinate or edge. Coordinates
+/// axes, to within 16 ulp of the largest coordinate. Coordinates
 /// carry that rounding already, so the Jacobian's differences do too and
 /// the Gauss rule could not resolve a bilinear part that small. `None`
 /// for any other cell. J is taken at the centre, from all corners, as the
