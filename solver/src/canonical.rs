@@ -90,8 +90,7 @@ impl SquareBlocks {
         }
     }
 
-    /// Every block's rows in block order, one list, and the block holding
-    /// entry k of that list.
+    /// Every block's rows in block order, one list.
     fn all_rows<'a>(&'a self, indices: &'a [usize]) -> &'a [usize] {
         match &self.rows {
             SquareRows::Listed { .. } => indices,
@@ -103,6 +102,7 @@ impl SquareBlocks {
         }
     }
 
+    /// The block holding entry k of [`SquareBlocks::all_rows`].
     fn block_of_entry(&self, k: usize) -> usize {
         match &self.rows {
             SquareRows::Listed { ptr } => ptr.partition_point(|&p| p <= k) - 1,
