@@ -73,13 +73,13 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
-use hasse_solver::diffusion::{
+use hasse_solver::la::direct::{relative_residual, DirectSolver, Factorization, Ordering};
+use hasse_solver::la::iterative::CgOptions;
+use hasse_solver::multigrid::{CellProlongation, Hierarchy, MultigridOptions};
+use hasse_solver::physics::diffusion::{
     solve_with_fixed, Assembled, BoundaryKind, Conductivity, Diffusion, Iterative, Method,
     Preconditioning,
 };
-use hasse_solver::iterative::CgOptions;
-use hasse_solver::linear::{relative_residual, DirectSolver, Factorization, Ordering};
-use hasse_solver::multigrid::{CellProlongation, Hierarchy, MultigridOptions};
 use std::io::Write;
 use std::sync::Arc;
 use std::time::Instant;

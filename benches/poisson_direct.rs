@@ -16,9 +16,9 @@
 
 use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::{generate, Complex};
-use hasse_solver::canonical::Canonical;
-use hasse_solver::linear::{DirectSolver, Factorization};
+use hasse_solver::la::direct::{DirectSolver, Factorization};
 use hasse_solver::metric::{fe, fv};
+use hasse_solver::operator::Canonical;
 use std::time::Instant;
 
 #[path = "common/measure.rs"]

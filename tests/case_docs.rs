@@ -2,8 +2,8 @@
 //! that solve; the full one has a manufactured solution and must meet the
 //! accuracy of P1 elements on its mesh.
 
-use hasse_solver::case::Case;
-use hasse_solver::run;
+use hasse_solver::frontend::case::Case;
+use hasse_solver::frontend::run;
 
 fn examples() -> Vec<String> {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../cases/README.md"))

@@ -11,9 +11,9 @@ use hasse_complex::generate::{
     box3, delaunay, graded_axis, grid, perturb, rectangle, uniform_axis,
 };
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::canonical::{BlockMetric, Canonical};
-use hasse_solver::linear::{self, Factorization};
+use hasse_solver::la::direct::{self, Factorization};
 use hasse_solver::metric::{fd, fv, isotropic, Tensor};
+use hasse_solver::operator::{BlockMetric, Canonical};
 use nalgebra::DMatrix;
 use sprs::{CsMat, TriMat};
 use std::f64::consts::PI;
@@ -96,7 +96,7 @@ fn solve_dirichlet(m: &SparseColMat<usize, f64>, fixed: &[Option<f64>], rhs: &[f
         }
     }
     let reduced = SparseColMat::try_new_from_triplets(free, free, &triplets).unwrap();
-    let (y, report) = linear::solve(&reduced, &reduced_rhs, Factorization::Llt).unwrap();
+    let (y, report) = direct::solve(&reduced, &reduced_rhs, Factorization::Llt).unwrap();
     assert!(report.relative_residual < 1e-12, "{report:?}");
     fixed
         .iter()
@@ -438,7 +438,7 @@ fn two_point_linear_error(k: &Complex) -> f64 {
     }
     let op = Canonical::new(a, fv::two_point(k, &vec![isotropic(1.0); cells]).unwrap()).unwrap();
     let rhs = op.sum_transpose(&op.metric().apply(&w));
-    let (x, _) = linear::solve(&op.assemble(), &rhs, Factorization::Llt).unwrap();
+    let (x, _) = direct::solve(&op.assemble(), &rhs, Factorization::Llt).unwrap();
     (0..cells)
         .map(|c| (x[c] - u(k.centroid_of(n, c))).abs())
         .fold(0.0, f64::max)
@@ -635,7 +635,7 @@ fn mimetic_hybrid_reduces_to_two_point_on_a_graded_grid() {
 
     let op = Canonical::new(d2.clone(), fv::two_point(&k, &tensors).unwrap()).unwrap();
     let rhs = op.sum_transpose(&op.metric().apply(&w));
-    let (tpfa, _) = linear::solve(&op.assemble(), &rhs, Factorization::Llt).unwrap();
+    let (tpfa, _) = direct::solve(&op.assemble(), &rhs, Factorization::Llt).unwrap();
     for c in 0..cells {
         assert!(
             (hybrid[c] - tpfa[c]).abs() < 1e-10,

@@ -2,11 +2,11 @@
 //! `hasse converge` end to end (tables, CSV, JSON, PNG, SVG, `--expect`
 //! exit codes), and uniform refinement of the generators.
 
-use hasse_solver::converge::{
+use hasse_solver::physics::diffusion::Method;
+use hasse_solver::study::{
     least_squares_order, pairwise_orders, Norm, OrderError, PlotFormat, PlotOptions, Refinement,
     Study, StudyError,
 };
-use hasse_solver::diffusion::Method;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -22,9 +22,13 @@
 
 use hasse_complex::generate::{kuhn, rectangle, uniform_axis};
 use hasse_complex::Complex;
-use hasse_solver::coupled::{Coupled, CoupledError, CoupledField, CoupledSolution, Reaction};
-use hasse_solver::diffusion::{BoundaryKind, Conductivity, Diffusion, DiffusionError, Method};
-use hasse_solver::linear::Factorization;
+use hasse_solver::la::direct::Factorization;
+use hasse_solver::physics::coupled::{
+    Coupled, CoupledError, CoupledField, CoupledSolution, Reaction,
+};
+use hasse_solver::physics::diffusion::{
+    BoundaryKind, Conductivity, Diffusion, DiffusionError, Method,
+};
 use std::f64::consts::PI;
 use std::sync::Arc;
 

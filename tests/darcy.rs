@@ -9,11 +9,11 @@
 
 use hasse_complex::generate::{delaunay, grid, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, DualKind};
-use hasse_solver::darcy::{
+use hasse_solver::la::direct::Factorization;
+use hasse_solver::metric::{isotropic, MetricError, Tensor};
+use hasse_solver::physics::darcy::{
     self, BoundaryConditions, DarcyError, DarcySolution, FaceCondition, FluxMass,
 };
-use hasse_solver::linear::Factorization;
-use hasse_solver::metric::{isotropic, MetricError, Tensor};
 use std::f64::consts::PI;
 
 #[path = "common/orders.rs"]

@@ -8,7 +8,7 @@
 
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
-use hasse_solver::diffusion::{
+use hasse_solver::physics::diffusion::{
     conservation_residual, errors, flux_error, BoundaryKind, CellPoints, Conductivity, Diffusion,
     DiffusionError, Method, ScalarFn, VectorFn,
 };
@@ -670,14 +670,14 @@ fn cell_points_are_checked() {
 /// analysis is then not used.
 #[test]
 fn analysis_beside_the_assembly_gives_the_plain_solution() {
-    use hasse_solver::diffusion::{lumped_vertex_volumes, Assembled, Location};
+    use hasse_solver::physics::diffusion::{lumped_vertex_volumes, Assembled, Location};
     // The weights of the zero mean of a pure-Neumann solution.
     let mean_weights = |system: &Assembled, mesh: &Complex| match system.location {
         Location::Nodal => lumped_vertex_volumes(mesh),
         _ => mesh.measure(mesh.dim()).to_vec(),
     };
-    use hasse_solver::diffusion::solve_with_fixed;
-    use hasse_solver::linear::{Factorization, Ordering};
+    use hasse_solver::la::direct::{Factorization, Ordering};
+    use hasse_solver::physics::diffusion::solve_with_fixed;
     let u = scalar(|x| x[0] * x[0] + 3.0 * x[1] + x[0] * x[1]);
     let mixed = |method: Method| {
         Diffusion::new(

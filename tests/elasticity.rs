@@ -18,8 +18,8 @@
 
 use hasse_complex::generate::{box3, kuhn, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::diffusion::VectorFn;
-use hasse_solver::elasticity::{
+use hasse_solver::physics::diffusion::VectorFn;
+use hasse_solver::physics::elasticity::{
     Coefficient, ElasticBoundary, Elasticity, ElasticityError, Material, PlaneModel,
 };
 use nalgebra::DMatrix;
@@ -64,7 +64,7 @@ fn traction(g: &[[f64; 3]; 3], n: &[f64], d: usize, lambda: f64, mu: f64) -> [f6
 /// and max |u_h − u| / max |u|.
 fn errors(
     mesh: &Complex,
-    u: &hasse_solver::elasticity::Displacement,
+    u: &hasse_solver::physics::elasticity::Displacement,
     exact: &VectorFn,
 ) -> (f64, f64) {
     let (n, d) = (mesh.dim(), mesh.embedding_dim());

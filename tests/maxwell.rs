@@ -10,8 +10,8 @@
 
 use hasse_complex::dual::DualKind;
 use hasse_complex::generate::{box3, delaunay, interval, kuhn, rectangle, uniform_axis};
-use hasse_solver::eigen::EigenError;
-use hasse_solver::maxwell::{Cavity, Mass, MaxwellError};
+use hasse_solver::la::eigen::EigenError;
+use hasse_solver::physics::maxwell::{Cavity, Mass, MaxwellError};
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
 

@@ -11,8 +11,8 @@
 use hasse_complex::dual::DualKind;
 use hasse_complex::generate::{box3, delaunay, kuhn, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::canonical::{BlockMetric, Canonical};
 use hasse_solver::metric::{dec, fe, isotropic, MetricError, Tensor};
+use hasse_solver::operator::{BlockMetric, Canonical};
 use nalgebra::DMatrix;
 use std::collections::HashMap;
 

@@ -17,7 +17,7 @@ mod pyenv;
 
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::output::{
+use hasse_solver::frontend::output::{
     write_mesh_series, write_run, Cochain, MeshStep, Provenance, RunOutput, SeriesOutput, Step,
 };
 use serde_json::{json, Value};

@@ -20,7 +20,9 @@
 use hasse_complex::generate::{delaunay, grid, kuhn, perturb, rectangle, uniform_axis, voronoi};
 use hasse_complex::split::{split, Hyperplane, Refinement, SplitOptions};
 use hasse_complex::{Complex, DualKind, Vertices};
-use hasse_solver::diffusion::{errors, BoundaryKind, Conductivity, Diffusion, Method, ScalarFn};
+use hasse_solver::physics::diffusion::{
+    errors, BoundaryKind, Conductivity, Diffusion, Method, ScalarFn,
+};
 use nalgebra::DMatrix;
 use proptest::prelude::*;
 use sprs::CsMat;

@@ -2,8 +2,8 @@
 //! against uniform refinement at a corner singularity, warm starts, and
 //! the tissue-division case.
 
-use hasse_solver::case::Case;
-use hasse_solver::refinement::{refine_and_solve, RefineSpec, Strategy};
+use hasse_solver::frontend::case::Case;
+use hasse_solver::refine::{refine_and_solve, RefineSpec, Strategy};
 use std::path::Path;
 
 fn case(name: &str, overrides: &[&str]) -> Case {

@@ -21,8 +21,8 @@
 
 use hasse_complex::generate::{kuhn, rectangle, uniform_axis};
 use hasse_complex::Complex;
-use hasse_solver::diffusion::{Conductivity, Method, ScalarFn};
-use hasse_solver::transient::{Heat, HeatBoundary, HeatError, TimeFn};
+use hasse_solver::physics::diffusion::{Conductivity, Method, ScalarFn};
+use hasse_solver::physics::heat::{Heat, HeatBoundary, HeatError, TimeFn};
 use std::f64::consts::PI;
 use std::sync::Arc;
 

@@ -6,9 +6,9 @@
 
 use hasse_complex::generate::{perturb, rectangle};
 use hasse_complex::DualKind;
-use hasse_solver::darcy::{self, BoundaryConditions, FaceCondition, FluxMass};
-use hasse_solver::linear::Factorization;
+use hasse_solver::la::direct::Factorization;
 use hasse_solver::metric::isotropic;
+use hasse_solver::physics::darcy::{self, BoundaryConditions, FaceCondition, FluxMass};
 
 fn main() {
     let n: usize = std::env::args()

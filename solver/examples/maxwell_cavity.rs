@@ -8,7 +8,7 @@
 
 use hasse_complex::dual::DualKind;
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
-use hasse_solver::maxwell::{Cavity, Mass};
+use hasse_solver::physics::maxwell::{Cavity, Mass};
 use std::f64::consts::PI;
 
 fn table(title: &str, exact: &[f64], levels: &[usize], build: impl Fn(usize) -> Cavity) {

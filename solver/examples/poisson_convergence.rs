@@ -12,7 +12,7 @@
 
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
-use hasse_solver::diffusion::{
+use hasse_solver::physics::diffusion::{
     errors, flux_error, BoundaryKind, CellPoints, Conductivity, Diffusion, Method,
 };
 use std::f64::consts::PI;
@@ -38,9 +38,9 @@ fn table(title: &str, method: Method, meshes: &[Complex]) {
 
 /// One table row per (mesh, cell points of FV, h).
 fn table_at(title: &str, method: Method, levels: &[(Complex, CellPoints, f64)]) {
-    let exact: hasse_solver::diffusion::ScalarFn =
+    let exact: hasse_solver::physics::diffusion::ScalarFn =
         Arc::new(|x: &[f64]| (PI * x[0]).sin() * (PI * x[1]).sin() + x[0] * x[1]);
-    let gradient: hasse_solver::diffusion::VectorFn = Arc::new(|x: &[f64]| {
+    let gradient: hasse_solver::physics::diffusion::VectorFn = Arc::new(|x: &[f64]| {
         [
             PI * (PI * x[0]).cos() * (PI * x[1]).sin() + x[1],
             PI * (PI * x[0]).sin() * (PI * x[1]).cos() + x[0],

@@ -7,8 +7,8 @@
 #![allow(dead_code)]
 
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::case::expr::Scope;
-use hasse_solver::case::Case;
+use hasse_solver::frontend::case::expr::Scope;
+use hasse_solver::frontend::case::Case;
 
 /// The case-file reader must turn any text into a case or diagnostics.
 /// Meshes small enough to build quickly are built too, which exercises the

@@ -1,8 +1,9 @@
 //! The `hasse` command line.
 
 use clap::{Parser, Subcommand};
-use hasse_solver::case::{Case, CaseError};
-use hasse_solver::{info, mesh_spec, refinement, run};
+use hasse_solver::frontend::case::{Case, CaseError};
+use hasse_solver::frontend::{info, mesh_spec, run};
+use hasse_solver::refine as refinement;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -341,7 +342,7 @@ fn check_case(path: &Path, set: &[String]) -> ExitCode {
 }
 
 fn describe_problem(case: &Case) -> String {
-    use hasse_solver::case::Problem;
+    use hasse_solver::frontend::case::Problem;
     match &case.problem {
         Problem::Diffusion(d) => format!("diffusion, method {}", d.method.name()),
         Problem::Gradient(_) => "gradient".to_string(),
@@ -416,7 +417,7 @@ fn run_case(
         .map(Path::to_path_buf)
         .unwrap_or_else(|| case.output.directory.join(&case.output.name));
     if case.output.write || output.is_some() {
-        if let Err(e) = hasse_solver::output::check_writable(&stem) {
+        if let Err(e) = hasse_solver::frontend::output::check_writable(&stem) {
             eprintln!(
                 "error: {}: output {}: {e}\n    help: choose a writable place with -o DIR/NAME or [output] directory",
                 path.display(),
@@ -504,7 +505,7 @@ fn run_case(
                 // The partial output of an earlier transient run under
                 // this stem is stale once this output is in place.
                 run::write_levels(&case, levels, report, &stem).and_then(|files| {
-                    hasse_solver::output::remove_partial(&stem)?;
+                    hasse_solver::frontend::output::remove_partial(&stem)?;
                     Ok(files)
                 })
             }
@@ -563,7 +564,7 @@ fn complex_kind(complex: &hasse_complex::Complex) -> String {
     )
 }
 
-/// `hasse converge`: a thin layer over [`hasse_solver::converge::Study`].
+/// `hasse converge`: a thin layer over [`hasse_solver::study::Study`].
 #[allow(clippy::too_many_arguments)]
 fn converge(
     path: &Path,
@@ -575,7 +576,7 @@ fn converge(
     set: &[String],
     quiet: bool,
 ) -> ExitCode {
-    use hasse_solver::converge::{
+    use hasse_solver::study::{
         parse_method, Expectation, PlotFormat, PlotOptions, Refinement, Study, StudyError,
     };
     let bad_input = |message: String| {

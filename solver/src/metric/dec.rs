@@ -40,7 +40,7 @@
 
 use super::fe::{gather, k_dot, simplex_gradients, Local, Point, Topology};
 use super::{check_tensors, CellTensors, MetricError, Tensor};
-use crate::canonical::BlockMetric;
+use crate::operator::BlockMetric;
 use hasse_complex::{Complex, DualKind};
 use rayon::prelude::*;
 
@@ -55,7 +55,7 @@ use rayon::prelude::*;
 ///
 /// ```
 /// use hasse_complex::{dual::DualKind, generate::kuhn, generate::uniform_axis};
-/// use hasse_solver::canonical::Canonical;
+/// use hasse_solver::operator::Canonical;
 /// use hasse_solver::metric::{dec, isotropic};
 /// let x = uniform_axis(2, 0.0, 1.0).unwrap();
 /// let k = kuhn(&[x.clone(), x]).unwrap();
@@ -436,7 +436,7 @@ mod tests {
         let dense = hodge_metric(&k, DualKind::Circumcentric, &[isotropic(1.0)])
             .unwrap()
             .to_dense();
-        let whitney = crate::canonical::Canonical::new(
+        let whitney = crate::operator::Canonical::new(
             k.coboundary(0),
             whitney_metric(&k, &[isotropic(1.0)]).unwrap(),
         )

@@ -11,7 +11,7 @@
 //! sums the fluxes of each cell.
 
 use super::{check_tensors, CellTensors, MetricError};
-use crate::canonical::BlockMetric;
+use crate::operator::BlockMetric;
 use hasse_complex::Complex;
 
 const METHOD: &str = "finite differences";
@@ -128,7 +128,7 @@ fn face_axis(complex: &Complex, face: usize, b: &Box3) -> Option<usize> {
 ///
 /// ```
 /// use hasse_complex::generate::rectangle;
-/// use hasse_solver::canonical::Canonical;
+/// use hasse_solver::operator::Canonical;
 /// use hasse_solver::metric::{fd, isotropic};
 /// // 3×3 cells of 0.5 × 0.25: the centre row is |K|·(2/hx² + 2/hy²) on
 /// // the diagonal and −|K|/hx², −|K|/hy² to the neighbours.

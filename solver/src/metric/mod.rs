@@ -14,7 +14,7 @@
 //! per cell or one scalar λ per cell (K = λ·I, stored as 8 bytes a cell
 //! instead of 72).
 //!
-//! [`BlockMetric`]: crate::canonical::BlockMetric
+//! [`BlockMetric`]: crate::operator::BlockMetric
 
 pub mod dec;
 pub mod fd;

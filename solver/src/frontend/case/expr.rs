@@ -1,0 +1,391 @@
+//! Expressions of case files: coefficients, sources, boundary values and
+//! exact solutions written as text in `x`, `y`, `z` and `t`.
+//!
+//! Parsing and evaluation are exmex's (`+ - * / ^`, `sin cos tan asin acos
+//! atan atan2 sinh cosh tanh exp ln log10 log2 sqrt cbrt abs signum floor
+//! ceil round trunc fract min max`, the constants `PI`/`π`, `TAU`/`τ`, `E`).
+//! On top of that a [`Scope`] supplies `pi` (the usual spelling in
+//! engineering texts), the case's named constants and its definitions:
+//! named expressions that later expressions may use, evaluated point by
+//! point in the order the case file gives them.
+//!
+//! Names are checked when an expression is parsed, so a misspelt variable
+//! is reported with a suggestion before anything is solved.
+//!
+//! ```
+//! use hasse_solver::frontend::case::expr::Scope;
+//! let mut scope = Scope::new();
+//! scope.add_constant("k", 2.0).unwrap();
+//! scope.add_definition("r", "sqrt(x^2 + y^2)").unwrap();
+//! let e = scope.parse("k * r * sin(pi * t)").unwrap();
+//! assert!((e.eval(&[3.0, 4.0], 0.5) - 10.0).abs() < 1e-12);
+//! ```
+
+use exmex::prelude::*;
+use exmex::{FloatOpsFactory, MatchLiteral};
+use std::sync::Arc;
+
+/// Number literals with an optional exponent (`2.5e-3`, `1E6`): exmex's own
+/// matcher stops at the `e`, so `1e-3` would parse as `1·e − 3`, and TOML
+/// numbers such as `1e-7` (which case files pass on as expression text)
+/// could not be read at all.
+#[derive(Clone, Debug)]
+pub struct ScientificNumbers;
+
+impl MatchLiteral for ScientificNumbers {
+    fn is_literal(text: &str) -> Option<&str> {
+        let bytes = text.as_bytes();
+        let digits = |from: usize| {
+            bytes[from..]
+                .iter()
+                .take_while(|b| b.is_ascii_digit())
+                .count()
+        };
+        let mut end = digits(0);
+        if bytes.get(end) == Some(&b'.') && digits(end + 1) > 0 {
+            end += 1 + digits(end + 1);
+        }
+        if end == 0 {
+            return None;
+        }
+        if matches!(bytes.get(end), Some(b'e' | b'E')) {
+            let sign = usize::from(matches!(bytes.get(end + 1), Some(b'+' | b'-')));
+            let exponent = digits(end + 1 + sign);
+            if exponent > 0 {
+                end += 1 + sign + exponent;
+            }
+        }
+        Some(&text[..end])
+    }
+}
+
+type Flat = FlatEx<f64, FloatOpsFactory<f64>, ScientificNumbers>;
+
+/// Names every expression may use without declaring them.
+pub const COORDINATES: [&str; 4] = ["x", "y", "z", "t"];
+
+/// Why an expression or a name was refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ExprError {
+    /// The text is not an expression.
+    #[error("cannot parse `{text}`: {message}")]
+    Syntax { text: String, message: String },
+    /// The expression uses a name that is neither a coordinate, a constant
+    /// nor a definition.
+    #[error("unknown variable `{name}` in `{text}`{}", suggestion_text(.suggestion))]
+    UnknownVariable {
+        text: String,
+        name: String,
+        suggestion: Option<String>,
+    },
+    /// A constant or definition would shadow a coordinate, a built-in or
+    /// an earlier name.
+    #[error("`{name}` cannot be used as a name: {reason}")]
+    ReservedName { name: String, reason: String },
+    /// A constant whose value is NaN or infinite.
+    #[error("constant `{name}` is not finite ({value})")]
+    NonFiniteConstant { name: String, value: f64 },
+}
+
+fn suggestion_text(suggestion: &Option<String>) -> String {
+    match suggestion {
+        Some(s) => format!(" (did you mean `{s}`?)"),
+        None => String::new(),
+    }
+}
+
+/// Where the value of one exmex variable comes from.
+#[derive(Clone, Debug)]
+enum Slot {
+    Coordinate(usize),
+    Time,
+    Constant(f64),
+    Definition(Arc<Expression>),
+}
+
+/// A parsed expression, ready to evaluate at points.
+#[derive(Clone, Debug)]
+pub struct Expression {
+    text: String,
+    /// Boxed: exmex keeps its nodes in large inline arrays (~20 kB).
+    flat: Box<Flat>,
+    /// One slot per exmex variable, in exmex's (alphabetical) order.
+    slots: Vec<Slot>,
+    /// True when the value depends on neither position nor time.
+    constant: bool,
+    uses_time: bool,
+}
+
+impl Expression {
+    /// The text as written in the case file.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// True when the expression depends on no coordinate and not on t.
+    pub fn is_constant(&self) -> bool {
+        self.constant
+    }
+
+    /// True when the expression depends on t (directly or through a definition).
+    pub fn uses_time(&self) -> bool {
+        self.uses_time
+    }
+
+    /// The value at `point` (missing coordinates are 0) and time `t`.
+    ///
+    /// Division by zero and the like give non-finite values, not errors:
+    /// callers check the values they evaluate and say where it happened.
+    pub fn eval(&self, point: &[f64], t: f64) -> f64 {
+        // Almost every expression has a handful of variables: keep them on
+        // the stack; this runs once per cell or quadrature point.
+        let mut stack = [0.0; 16];
+        let mut heap;
+        let values: &mut [f64] = if self.slots.len() <= stack.len() {
+            &mut stack[..self.slots.len()]
+        } else {
+            heap = vec![0.0; self.slots.len()];
+            &mut heap
+        };
+        for (value, slot) in values.iter_mut().zip(&self.slots) {
+            *value = match slot {
+                Slot::Coordinate(i) => point.get(*i).copied().unwrap_or(0.0),
+                Slot::Time => t,
+                Slot::Constant(c) => *c,
+                Slot::Definition(e) => e.eval(point, t),
+            };
+        }
+        // The slot count equals the variable count by construction, which is
+        // the only way exmex's evaluation fails for floats.
+        self.flat.eval(values).unwrap_or(f64::NAN)
+    }
+}
+
+/// Names available to expressions: coordinates, `pi`, constants and
+/// definitions.
+#[derive(Clone, Debug, Default)]
+pub struct Scope {
+    constants: Vec<(String, f64)>,
+    definitions: Vec<(String, Arc<Expression>)>,
+}
+
+/// Names exmex already gives a meaning to; a user name equal to one of
+/// them would be parsed as the operator or constant instead.
+const BUILTINS: [&str; 38] = [
+    "abs", "acos", "acosh", "asin", "asinh", "atan", "atan2", "atanh", "cbrt", "ceil", "cos",
+    "cosh", "exp", "floor", "fract", "ln", "log", "log10", "log2", "max", "min", "round", "signum",
+    "sin", "sinh", "sqrt", "tan", "tanh", "trunc", "PI", "π", "E", "e", "TAU", "τ", "pi", "if",
+    "else",
+];
+
+impl Scope {
+    /// A scope with the coordinates and `pi` only.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Every name an expression may use, for suggestions and messages.
+    pub fn names(&self) -> Vec<String> {
+        let mut names: Vec<String> = COORDINATES.iter().map(|s| s.to_string()).collect();
+        names.push("pi".into());
+        names.extend(self.constants.iter().map(|(n, _)| n.clone()));
+        names.extend(self.definitions.iter().map(|(n, _)| n.clone()));
+        names
+    }
+
+    fn check_new_name(&self, name: &str) -> Result<(), ExprError> {
+        let reserved = |reason: &str| ExprError::ReservedName {
+            name: name.to_string(),
+            reason: reason.to_string(),
+        };
+        let mut chars = name.chars();
+        let valid = chars.next().is_some_and(|c| c.is_alphabetic() || c == '_')
+            && chars.all(|c| c.is_alphanumeric() || c == '_');
+        if !valid {
+            return Err(reserved(
+                "names start with a letter or `_` and continue with letters, digits or `_`",
+            ));
+        }
+        if COORDINATES.contains(&name) {
+            return Err(reserved("it is a coordinate (x, y, z) or the time (t)"));
+        }
+        if BUILTINS.contains(&name) {
+            return Err(reserved("it is a built-in function or constant"));
+        }
+        if self.constants.iter().any(|(n, _)| n == name)
+            || self.definitions.iter().any(|(n, _)| n == name)
+        {
+            return Err(reserved("it is already defined"));
+        }
+        Ok(())
+    }
+
+    /// Add a named constant.
+    pub fn add_constant(&mut self, name: &str, value: f64) -> Result<(), ExprError> {
+        self.check_new_name(name)?;
+        if !value.is_finite() {
+            return Err(ExprError::NonFiniteConstant {
+                name: name.to_string(),
+                value,
+            });
+        }
+        self.constants.push((name.to_string(), value));
+        Ok(())
+    }
+
+    /// Add a named expression; it may use the coordinates, constants and
+    /// earlier definitions.
+    pub fn add_definition(&mut self, name: &str, text: &str) -> Result<(), ExprError> {
+        self.check_new_name(name)?;
+        let expression = self.parse(text)?;
+        self.definitions
+            .push((name.to_string(), Arc::new(expression)));
+        Ok(())
+    }
+
+    /// Parse `text` against this scope.
+    pub fn parse(&self, text: &str) -> Result<Expression, ExprError> {
+        let flat = Flat::parse(text).map_err(|e| ExprError::Syntax {
+            text: text.to_string(),
+            message: e.msg().to_string(),
+        })?;
+        let mut slots = Vec::with_capacity(flat.var_names().len());
+        let mut constant = true;
+        let mut uses_time = false;
+        for name in flat.var_names() {
+            let slot = if let Some(i) = ["x", "y", "z"].iter().position(|c| c == name) {
+                constant = false;
+                Slot::Coordinate(i)
+            } else if name == "t" {
+                constant = false;
+                uses_time = true;
+                Slot::Time
+            } else if name == "pi" {
+                Slot::Constant(std::f64::consts::PI)
+            } else if let Some((_, v)) = self.constants.iter().find(|(n, _)| n == name) {
+                Slot::Constant(*v)
+            } else if let Some((_, e)) = self.definitions.iter().find(|(n, _)| n == name) {
+                constant &= e.constant;
+                uses_time |= e.uses_time;
+                Slot::Definition(e.clone())
+            } else {
+                return Err(ExprError::UnknownVariable {
+                    text: text.to_string(),
+                    name: name.clone(),
+                    suggestion: closest(name, &self.names()),
+                });
+            };
+            slots.push(slot);
+        }
+        Ok(Expression {
+            text: text.to_string(),
+            flat: Box::new(flat),
+            slots,
+            constant,
+            uses_time,
+        })
+    }
+}
+
+/// The candidate closest to `word`, if it is close enough to be a likely
+/// typo (Jaro–Winkler similarity above 0.8).
+pub fn closest(word: &str, candidates: &[String]) -> Option<String> {
+    candidates
+        .iter()
+        .map(|c| (strsim::jaro_winkler(word, c), c))
+        .filter(|(score, _)| *score > 0.8)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, c)| c.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coordinates_time_and_constants() {
+        let scope = Scope::new();
+        let e = scope.parse("2*x + 3*y - z + t").unwrap();
+        assert_eq!(
+            e.eval(&[1.0, 10.0, 100.0], 1000.0),
+            2.0 + 30.0 - 100.0 + 1000.0
+        );
+        // Missing coordinates are zero: a 2D point has z = 0.
+        assert_eq!(e.eval(&[1.0, 10.0], 0.0), 32.0);
+        assert!(!e.is_constant());
+        assert!(e.uses_time());
+        let c = scope.parse("pi * 2").unwrap();
+        assert!(c.is_constant());
+        assert_eq!(c.eval(&[], 0.0), 2.0 * std::f64::consts::PI);
+    }
+
+    #[test]
+    fn definitions_chain_in_order() {
+        let mut scope = Scope::new();
+        scope.add_constant("l", 50.0).unwrap();
+        scope.add_definition("xi", "l * x").unwrap();
+        scope.add_definition("xi2", "xi * xi").unwrap();
+        let e = scope.parse("xi2 + 1").unwrap();
+        assert_eq!(e.eval(&[0.1], 0.0), 26.0);
+        // A definition may not use a later one.
+        let mut scope = Scope::new();
+        assert!(matches!(
+            scope.add_definition("a", "b + 1"),
+            Err(ExprError::UnknownVariable { .. })
+        ));
+    }
+
+    #[test]
+    fn unknown_names_come_with_a_suggestion() {
+        let mut scope = Scope::new();
+        scope.add_constant("alpha", 1.0).unwrap();
+        match scope.parse("alpah * x") {
+            Err(ExprError::UnknownVariable {
+                name, suggestion, ..
+            }) => {
+                assert_eq!(name, "alpah");
+                assert_eq!(suggestion.as_deref(), Some("alpha"));
+            }
+            other => panic!("expected an unknown variable, got {other:?}"),
+        }
+        assert!(matches!(
+            scope.parse("sin(x"),
+            Err(ExprError::Syntax { .. })
+        ));
+    }
+
+    #[test]
+    fn reserved_names_are_refused() {
+        let mut scope = Scope::new();
+        for name in ["x", "t", "sin", "pi", "E", "2a", ""] {
+            assert!(
+                matches!(
+                    scope.add_constant(name, 1.0),
+                    Err(ExprError::ReservedName { .. })
+                ),
+                "{name}"
+            );
+        }
+        scope.add_constant("k", 1.0).unwrap();
+        assert!(scope.add_constant("k", 2.0).is_err());
+        assert!(scope.add_constant("inf", f64::INFINITY).is_err());
+    }
+
+    #[test]
+    fn numbers_in_scientific_notation() {
+        let scope = Scope::new();
+        let e = scope.parse("1e-320").unwrap();
+        assert_eq!(e.eval(&[], 0.0), 1e-320);
+        let e = scope.parse("2.5E+3*x + .5e1 - 3e2").unwrap();
+        assert_eq!(e.eval(&[2.0], 0.0), 5000.0 + 5.0 - 300.0);
+        // `e` alone is still Euler's number, and `2*e` its double.
+        let e = scope.parse("2*e").unwrap();
+        assert_eq!(e.eval(&[], 0.0), 2.0 * std::f64::consts::E);
+    }
+
+    #[test]
+    fn division_by_zero_gives_a_non_finite_value() {
+        let e = Scope::new().parse("1 / x").unwrap();
+        assert!(!e.eval(&[0.0], 0.0).is_finite());
+    }
+}

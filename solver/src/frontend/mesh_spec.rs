@@ -1,0 +1,565 @@
+//! The `[mesh]` table of a case file: a generator with its parameters, or
+//! a mesh file (Gmsh .msh v4 or hasse JSON) relative to the case file.
+//!
+//! ```toml
+//! [mesh]
+//! generator = "rectangle"   # interval | rectangle | box | annulus | torus | sphere | hollow-box | voronoi
+//! n = [32, 32]              # cells per axis
+//! x = [0.0, 1.0]            # extent per axis (default [0, 1])
+//! y = [0.0, 1.0]
+//! cells = "simplex"         # "cuboid" (default) or "simplex" (Kuhn triangles / tetrahedra)
+//! perturb = 0.2             # optional: move interior vertices by up to 0.2 × local h
+//! seed = 7                  # seed of the perturbation (default 0)
+//! ```
+//! or a polygonal mesh, the Voronoi diagram of `n` random sites clipped
+//! to the rectangle `x × y` (seeded, so the same table gives the same
+//! mesh), optionally smoothed by `lloyd` iterations of Lloyd's algorithm:
+//! ```toml
+//! [mesh]
+//! generator = "voronoi"
+//! n = [400]                 # number of sites = number of polygons
+//! x = [0.0, 1.0]
+//! y = [0.0, 1.0]
+//! seed = 3                  # site positions (default 0)
+//! lloyd = 5                 # optional, default 0
+//! ```
+//! or
+//! ```toml
+//! [mesh]
+//! file = "l-shape.msh"
+//! ```
+
+use hasse_complex::{generate, gmsh, json, Complex};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// What went wrong while reading or building a mesh, with where.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("{path}: cannot read: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Syntax { path: String, message: String },
+    #[error("{path}: key `mesh.{key}`: {message}")]
+    Key {
+        path: String,
+        key: &'static str,
+        message: String,
+    },
+    #[error("{path}: {source}")]
+    Complex {
+        path: String,
+        source: hasse_complex::ComplexError,
+    },
+    #[error(transparent)]
+    Gmsh(#[from] gmsh::GmshError),
+    #[error(transparent)]
+    Json(#[from] json::JsonError),
+}
+
+/// The `[mesh]` table.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSpec {
+    /// Generator name (exclusive with `file`).
+    pub generator: Option<String>,
+    /// Mesh file, relative to the case file (exclusive with `generator`).
+    pub file: Option<PathBuf>,
+    /// Cells per axis (or per radial/angular direction).
+    pub n: Option<Vec<usize>>,
+    pub x: Option<[f64; 2]>,
+    pub y: Option<[f64; 2]>,
+    pub z: Option<[f64; 2]>,
+    /// Geometric grading ratio per axis (spacing multiplies by it cell to cell).
+    pub grading: Option<Vec<f64>>,
+    /// "cuboid" (default) or "simplex".
+    pub cells: Option<String>,
+    pub perturb: Option<f64>,
+    /// Seed of the perturbation, or of the Voronoi sites.
+    pub seed: Option<u64>,
+    /// Lloyd iterations of the Voronoi generator.
+    pub lloyd: Option<usize>,
+    /// Sphere radius.
+    pub radius: Option<f64>,
+    /// Icosphere subdivision levels.
+    pub subdivisions: Option<u32>,
+    pub inner_radius: Option<f64>,
+    pub outer_radius: Option<f64>,
+    pub major_radius: Option<f64>,
+    pub minor_radius: Option<f64>,
+    /// Cell index range [first, last] of the cavity (hollow-box).
+    pub cavity: Option<[usize; 2]>,
+}
+
+/// Only the `[mesh]` table is read here; deserialising it in place (not
+/// through a `toml::Value`) keeps toml's line and column in messages.
+#[derive(Deserialize)]
+struct CaseMeshOnly {
+    mesh: Option<MeshSpec>,
+}
+
+/// Read the `[mesh]` table of a case file (other tables are left to the
+/// case reader).
+pub fn read_case_mesh(path: &Path) -> Result<MeshSpec, MeshError> {
+    let shown = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| MeshError::Io {
+        path: shown.clone(),
+        source,
+    })?;
+    let case: CaseMeshOnly = toml::from_str(&text).map_err(|e| MeshError::Syntax {
+        path: shown.clone(),
+        message: e.to_string(),
+    })?;
+    case.mesh.ok_or_else(|| MeshError::Syntax {
+        path: shown,
+        message: "no [mesh] table: add one with `generator = ...` or `file = ...`".into(),
+    })
+}
+
+impl MeshSpec {
+    /// Build the complex; `case_path` names the case file in messages and
+    /// anchors relative mesh paths.
+    pub fn build(&self, case_path: &Path) -> Result<Complex, MeshError> {
+        let shown = case_path.display().to_string();
+        let key = |key: &'static str, message: String| MeshError::Key {
+            path: shown.clone(),
+            key,
+            message,
+        };
+        let complex_err = |source| MeshError::Complex {
+            path: shown.clone(),
+            source,
+        };
+        let complex = match (&self.generator, &self.file) {
+            (Some(_), Some(_)) => {
+                return Err(key(
+                    "file",
+                    "give either `generator` or `file`, not both".into(),
+                ))
+            }
+            (None, None) => {
+                return Err(key(
+                    "generator",
+                    "missing: set `generator = \"rectangle\"` (or another generator) or `file = \"mesh.msh\"`".into(),
+                ))
+            }
+            (None, Some(file)) => {
+                let base = case_path.parent().unwrap_or(Path::new("."));
+                let full = base.join(file);
+                let read = match full.extension().and_then(|e| e.to_str()) {
+                    Some("msh") => gmsh::read_msh(&full).map_err(|e| key("file", e.to_string()))?,
+                    Some("json") => json::read_json(&full).map_err(|e| key("file", e.to_string()))?,
+                    _ => {
+                        return Err(key(
+                            "file",
+                            format!(
+                                "{}: unknown mesh format; use a Gmsh .msh (v4) or a hasse .json file",
+                                full.display()
+                            ),
+                        ))
+                    }
+                };
+                check_mesh(&read).map_err(|e| key("file", format!("{}: {e}", full.display())))?;
+                read
+            }
+            (Some(name), None) => {
+                if let Some(estimate) = self.estimate(name) {
+                    estimate.check().map_err(|message| key(estimate.key, message))?;
+                }
+                self.generate(name, &key).map_err(|e| match e {
+                Generated::Key(k) => k,
+                Generated::Complex(c) => complex_err(c),
+            })?
+            }
+        };
+        match self.perturb {
+            Some(amplitude) if amplitude != 0.0 => {
+                generate::perturb(&complex, amplitude, self.seed.unwrap_or(0)).map_err(complex_err)
+            }
+            _ => Ok(complex),
+        }
+    }
+
+    /// A lower bound on what a generated mesh costs, from its parameters
+    /// alone (nothing is built), or `None` when the parameters are invalid
+    /// (generation reports them).
+    pub fn estimate(&self, generator: &str) -> Option<MemoryEstimate> {
+        let n: Vec<f64> = self.n.as_deref()?.iter().map(|&k| k as f64).collect();
+        let simplex = self.cells.as_deref() == Some("simplex");
+        // Top cells, cells of every dimension per top cell, dimension.
+        let (top, per_top, dim, key) = match (generator, n.as_slice()) {
+            ("interval", [a]) => (*a, 2.0, 1, "n"),
+            // Kuhn: 2 triangles per square (6 cells of all dimensions per
+            // square: 1 vertex, 3 edges, 2 triangles), 6 tetrahedra per cube
+            // (1 + 7 + 12 + 6 = 26 cells).
+            ("rectangle", [a, b]) if simplex => (2.0 * a * b, 3.0, 2, "n"),
+            ("rectangle" | "annulus" | "torus", [a, b]) => (a * b, 4.0, 2, "n"),
+            ("box", [a, b, c]) if simplex => (6.0 * a * b * c, 26.0 / 6.0, 3, "n"),
+            ("box", [a, b, c]) => (a * b * c, 8.0, 3, "n"),
+            ("voronoi", [a]) => (*a, 6.0, 2, "n"),
+            ("sphere", _) => (
+                20.0 * 4f64.powi(self.subdivisions.unwrap_or(2).min(64) as i32),
+                3.0,
+                2,
+                "subdivisions",
+            ),
+            _ => return None,
+        };
+        let cells = top * per_top;
+        // The sparsest system any method builds: a two-point stencil, 2n + 1
+        // entries per top cell.
+        let nonzeros = top * (2 * dim + 1) as f64;
+        Some(MemoryEstimate {
+            key,
+            top_cells: top,
+            cells,
+            nonzeros,
+            bytes: BYTES_PER_CELL * cells + BYTES_PER_NONZERO * nonzeros,
+        })
+    }
+
+    fn counts(
+        &self,
+        wanted: usize,
+        key: &dyn Fn(&'static str, String) -> MeshError,
+    ) -> Result<Vec<usize>, MeshError> {
+        let n = self.n.clone().ok_or_else(|| {
+            key(
+                "n",
+                format!(
+                    "missing: give {wanted} cell count(s), e.g. n = {:?}",
+                    vec![8; wanted]
+                ),
+            )
+        })?;
+        if n.len() != wanted {
+            return Err(key(
+                "n",
+                format!("expected {wanted} cell count(s), found {}", n.len()),
+            ));
+        }
+        if n.contains(&0) {
+            return Err(key("n", "cell counts must be at least 1".into()));
+        }
+        Ok(n)
+    }
+
+    fn axes(
+        &self,
+        counts: &[usize],
+        key: &dyn Fn(&'static str, String) -> MeshError,
+    ) -> Result<Vec<Vec<f64>>, Generated> {
+        let extents = [self.x, self.y, self.z];
+        let names = ["x", "y", "z"];
+        let mut axes = Vec::new();
+        for (a, &n) in counts.iter().enumerate() {
+            let [lo, hi] = extents[a].unwrap_or([0.0, 1.0]);
+            if lo.is_nan() || hi.is_nan() || lo >= hi {
+                return Err(Generated::Key(key(
+                    names[a],
+                    format!("extent [{lo}, {hi}] must be increasing"),
+                )));
+            }
+            let axis = match self.grading.as_ref().and_then(|g| g.get(a)) {
+                Some(&ratio) => generate::graded_axis(n, lo, hi, ratio),
+                None => generate::uniform_axis(n, lo, hi),
+            };
+            axes.push(axis.map_err(Generated::Complex)?);
+        }
+        Ok(axes)
+    }
+
+    fn generate(
+        &self,
+        name: &str,
+        key: &dyn Fn(&'static str, String) -> MeshError,
+    ) -> Result<Complex, Generated> {
+        let need = |v: Option<f64>, k: &'static str| {
+            v.ok_or_else(|| Generated::Key(key(k, "missing: this generator needs it".into())))
+        };
+        let simplicial = match self.cells.as_deref() {
+            None | Some("cuboid") => false,
+            Some("simplex") => true,
+            Some(other) => {
+                return Err(Generated::Key(key(
+                    "cells",
+                    format!("unknown cell kind \"{other}\": use \"cuboid\" or \"simplex\""),
+                )))
+            }
+        };
+        let grid = |dim: usize| -> Result<Complex, Generated> {
+            let counts = self.counts(dim, key).map_err(Generated::Key)?;
+            let axes = self.axes(&counts, key)?;
+            if simplicial {
+                generate::kuhn(&axes).map_err(Generated::Complex)
+            } else {
+                generate::grid(&axes).map_err(Generated::Complex)
+            }
+        };
+        match name {
+            "interval" => grid(1),
+            "rectangle" => grid(2),
+            "box" => grid(3),
+            "annulus" => {
+                let n = self.counts(2, key).map_err(Generated::Key)?;
+                generate::annulus(
+                    need(self.inner_radius, "inner_radius")?,
+                    need(self.outer_radius, "outer_radius")?,
+                    n[0],
+                    n[1],
+                )
+                .map_err(Generated::Complex)
+            }
+            "torus" => {
+                let n = self.counts(2, key).map_err(Generated::Key)?;
+                generate::torus(
+                    need(self.major_radius, "major_radius")?,
+                    need(self.minor_radius, "minor_radius")?,
+                    n[0],
+                    n[1],
+                )
+                .map_err(Generated::Complex)
+            }
+            "sphere" => generate::sphere(
+                self.radius.unwrap_or(1.0),
+                self.subdivisions.unwrap_or(2),
+            )
+            .map_err(Generated::Complex),
+            "hollow-box" => {
+                let n = self.counts(1, key).map_err(Generated::Key)?;
+                let cavity = self.cavity.ok_or_else(|| {
+                    Generated::Key(key(
+                        "cavity",
+                        "missing: give the cavity's cell index range, e.g. cavity = [2, 3]".into(),
+                    ))
+                })?;
+                generate::hollow_box(n[0], cavity).map_err(Generated::Complex)
+            }
+            "voronoi" => {
+                let n = self.counts(1, key).map_err(Generated::Key)?;
+                let extent = |e: Option<[f64; 2]>, k: &'static str| {
+                    let [lo, hi] = e.unwrap_or([0.0, 1.0]);
+                    if lo.is_nan() || hi.is_nan() || lo >= hi {
+                        return Err(Generated::Key(key(
+                            k,
+                            format!("extent [{lo}, {hi}] must be increasing"),
+                        )));
+                    }
+                    Ok([lo, hi])
+                };
+                generate::voronoi(
+                    n[0],
+                    extent(self.x, "x")?,
+                    extent(self.y, "y")?,
+                    self.seed.unwrap_or(0),
+                    self.lloyd.unwrap_or(0),
+                )
+                .map_err(Generated::Complex)
+            }
+            other => Err(Generated::Key(key(
+                "generator",
+                format!(
+                    "unknown generator \"{other}\"; known: interval, rectangle, box, annulus, torus, sphere, hollow-box, voronoi"
+                ),
+            ))),
+        }
+    }
+}
+
+/// Bytes per cell (any dimension) of a built complex with its geometry:
+/// about 130 measured on a 500 × 500 rectangle (`hasse info --timing`);
+/// rounded down, as the estimate is a lower bound.
+const BYTES_PER_CELL: f64 = 100.0;
+/// A value and a row index of a sparse matrix.
+const BYTES_PER_NONZERO: f64 = 16.0;
+
+/// What a generated mesh will at least cost, before it is built.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MemoryEstimate {
+    /// The `[mesh]` key that sets the size.
+    pub key: &'static str,
+    pub top_cells: f64,
+    /// Cells of every dimension.
+    pub cells: f64,
+    /// Nonzeros of the sparsest system a method assembles on it.
+    pub nonzeros: f64,
+    /// Lower bound on the memory needed to build and solve.
+    pub bytes: f64,
+}
+
+impl MemoryEstimate {
+    /// Refuse, with the numbers, an estimate above the memory available:
+    /// `HASSE_MEMORY_LIMIT` (bytes) if set, else MemAvailable of
+    /// /proc/meminfo; no check where neither is known.
+    pub fn check(&self) -> Result<(), String> {
+        let Some((available, source)) = available_memory() else {
+            return Ok(());
+        };
+        if self.bytes <= available as f64 {
+            return Ok(());
+        }
+        Err(format!(
+            "this mesh would have {:.3e} top cells ({:.3e} cells of all dimensions, at least {:.3e} nonzeros in the system): at least {} of memory, but {} is available ({source}); use a smaller mesh.{}",
+            self.top_cells,
+            self.cells,
+            self.nonzeros,
+            human_bytes(self.bytes),
+            human_bytes(available as f64),
+            self.key,
+        ))
+    }
+}
+
+/// Memory the process may still use, and where the number comes from.
+pub fn available_memory() -> Option<(u64, &'static str)> {
+    if let Some(limit) = std::env::var("HASSE_MEMORY_LIMIT")
+        .ok()
+        .and_then(|v| v.trim().parse::<u64>().ok())
+    {
+        return Some((limit, "HASSE_MEMORY_LIMIT"));
+    }
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some((kib.saturating_mul(1024), "MemAvailable in /proc/meminfo"))
+}
+
+fn human_bytes(bytes: f64) -> String {
+    let units = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
+    let mut value = bytes;
+    let mut unit = 0;
+    while value >= 1024.0 && unit + 1 < units.len() {
+        value /= 1024.0;
+        unit += 1;
+    }
+    format!("{value:.1} {}", units[unit])
+}
+
+/// Defects of a mesh file that make a valid complex but a wrong domain for
+/// the solver; generated meshes have none by construction.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshDefect {
+    #[error("vertices {first} and {second} coincide at {point:?}: the cells on either side are not connected there (a crack); merge duplicate nodes (Gmsh: Geometry.Tolerance / Coherence Mesh) or remesh")]
+    DuplicateVertices {
+        first: usize,
+        second: usize,
+        point: Vec<f64>,
+    },
+    #[error("{dim}-cell {face} (vertices {vertices:?}) bounds {count} top cells ({cells:?}): the mesh is not a manifold there, and fluxes through a face need exactly one cell on each side; split the mesh into separate surfaces or remesh")]
+    NonManifold {
+        dim: usize,
+        face: usize,
+        vertices: Vec<usize>,
+        count: usize,
+        cells: Vec<usize>,
+    },
+}
+
+/// Check a mesh read from a file for coincident vertices and faces shared
+/// by more than two cells.
+///
+/// ```
+/// use hasse_complex::{Complex, TopCells, Vertices};
+/// use hasse_solver::frontend::mesh_spec::{check_mesh, MeshDefect};
+/// // Two triangles whose common diagonal has a duplicated end.
+/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [1.0, 1.0]]).unwrap();
+/// let k = Complex::build(v, TopCells::simplices([[0, 1, 2], [0, 4, 3]])).unwrap();
+/// assert!(matches!(check_mesh(&k), Err(MeshDefect::DuplicateVertices { first: 2, second: 4, .. })));
+/// ```
+pub fn check_mesh(complex: &Complex) -> Result<(), MeshDefect> {
+    let n = complex.dim();
+    if n > 0 {
+        let top = complex.boundary(n);
+        for (face, row) in top.outer_iterator().enumerate() {
+            if row.nnz() > 2 {
+                return Err(MeshDefect::NonManifold {
+                    dim: n - 1,
+                    face,
+                    vertices: complex.cell_vertices(n - 1, face).to_vec(),
+                    count: row.nnz(),
+                    cells: row.indices().to_vec(),
+                });
+            }
+        }
+    }
+    duplicate_vertices(complex)
+}
+
+/// Vertices closer than 1e-10 of the mesh's extent, found by hashing
+/// points into boxes of that size and comparing with neighbouring boxes
+/// (linear time, unlike comparing all pairs).
+fn duplicate_vertices(complex: &Complex) -> Result<(), MeshDefect> {
+    use std::collections::HashMap;
+    let vertices = complex.vertices();
+    let d = vertices.dim();
+    let count = vertices.len();
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for v in 0..count {
+        for (a, &x) in vertices.point(v).iter().enumerate() {
+            lo[a] = lo[a].min(x);
+            hi[a] = hi[a].max(x);
+        }
+    }
+    let extent = (0..d).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+    if extent.is_nan() || extent <= 0.0 {
+        return Ok(());
+    }
+    let tolerance = 1e-10 * extent;
+    let key = |v: usize| -> [i64; 3] {
+        let mut k = [0i64; 3];
+        for (a, &x) in vertices.point(v).iter().enumerate() {
+            k[a] = ((x - lo[a]) / tolerance).floor() as i64;
+        }
+        k
+    };
+    let mut boxes: HashMap<[i64; 3], Vec<usize>> = HashMap::with_capacity(count);
+    for v in 0..count {
+        boxes.entry(key(v)).or_default().push(v);
+    }
+    let offsets: Vec<[i64; 3]> = (0..3i64.pow(d as u32))
+        .map(|mut i| {
+            let mut o = [0i64; 3];
+            for slot in o.iter_mut().take(d) {
+                *slot = i % 3 - 1;
+                i /= 3;
+            }
+            o
+        })
+        .collect();
+    for v in 0..count {
+        let k = key(v);
+        let x = vertices.point(v);
+        for o in &offsets {
+            let neighbour = [k[0] + o[0], k[1] + o[1], k[2] + o[2]];
+            for &w in boxes.get(&neighbour).map_or(&[][..], Vec::as_slice) {
+                if w <= v {
+                    continue;
+                }
+                let y = vertices.point(w);
+                let distance = x
+                    .iter()
+                    .zip(y)
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                if distance <= tolerance {
+                    return Err(MeshDefect::DuplicateVertices {
+                        first: v,
+                        second: w,
+                        point: x.to_vec(),
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+enum Generated {
+    Key(MeshError),
+    Complex(hasse_complex::ComplexError),
+}

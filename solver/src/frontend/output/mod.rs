@@ -1,0 +1,929 @@
+//! Output of a run: one HDF5 file holding the complex, every cochain of
+//! every time level and the provenance, plus XDMF 3 files beside it (one
+//! per cochain degree grid) so ParaView, VisIt and meshio open the same data.
+//!
+//! # HDF5 layout (`<stem>.h5`)
+//!
+//! Everything is readable with h5py alone; `cases/OUTPUT.md` has examples.
+//!
+//! | path | content |
+//! | --- | --- |
+//! | `/` attrs `step_count` (u64), `times` (f64 array), `format` = `"hasse-output"`, `format_version` (u64: 1, or 2 for a mesh series), `mesh_changes` (u64: 0, or 1 for a mesh series) | |
+//! | `/mesh` attrs `dim` (n), `embedding_dim` (d) | |
+//! | `/mesh/vertices` | (N, 3) f64, zero-padded when d < 3; attr `embedding_dim` |
+//! | `/mesh/cells/<p>/indptr`, `indices` | CSR characteristic matrix M_p (u64), p = 0..=n; attr `shape` = (rows, cols). Row i lists the sorted vertex ids of p-cell i; p-cell ids everywhere else are these row numbers |
+//! | `/mesh/boundary/<p>/indptr`, `indices` (u64), `data` (i8) | signed ∂_p in CSR, rows (p-1)-cells, columns p-cells, p = 1..=n; attr `shape` |
+//! | `/mesh/tags/<name>` | u64 ids of the tagged cells; attr `dim` |
+//! | `/steps/<k>` attr `time` | one group per time level k = 0, 1, … |
+//! | `/steps/<k>/<name>` | f64 cochain, one value per p-cell; attrs `dim`, and `units`, `method`, `description` when given |
+//! | `/provenance` attrs `hasse_version`, `written_at` (RFC 3339 UTC), `case_path` (if known) | |
+//! | `/provenance/case_text`, `/provenance/report` | scalar UTF-8 string datasets (the case file, the run report as JSON) |
+//! | `/xdmf/<p>/topology` | connectivity of the XDMF grid of the p-cells (i64), see below |
+//! | `/xdmf/<p>/cell_ids` | only when the grid's elements are not the p-cells one to one: the p-cell of each element |
+//! | `/xdmf/<p>/steps/<k>/<name>` | only with `cell_ids`: the cochain expanded to the elements |
+//!
+//! Strings are variable-length UTF-8, so h5py returns attributes as `str`
+//! (string datasets need `.asstr()[()]`).
+//!
+//! # Series whose mesh changes ([`write_mesh_series`])
+//!
+//! Root attr `mesh_changes` = 1, `format_version` = 2; there is no `/mesh`
+//! and no `/xdmf`. Instead each level k has its own mesh inside its step:
+//! `/steps/<k>/mesh` holds what `/mesh` holds above (attrs, `vertices`,
+//! `cells/<p>`, `boundary/<p>`, `tags/<name>`, with that step's cell ids),
+//! and `/steps/<k>/mesh/xdmf` what `/xdmf` holds, for level k only
+//! (`<p>/topology`, `<p>/cell_ids`, `<p>/steps/<k>/<name>`). The cochains
+//! stay in `/steps/<k>/<name>`, so no cochain of a series may be named
+//! `mesh`. In the XDMF files, the k-th grid of the temporal collection
+//! reads its geometry and topology from `/steps/<k>/mesh`.
+//!
+//! # Partial output of a running series ([`PartialOutput`])
+//!
+//! A time series can also be written level by level while it is computed:
+//! `<stem>.partial/mesh.h5` (a run file without steps), one
+//! `<stem>.partial/level-<k>.h5` per completed level (`/steps/<k>` as
+//! above, plus root attrs `step` and `time`), and `<stem>.partial.xdmf`,
+//! rewritten after each level, whose k-th grid reads the mesh file and
+//! level k's file. Each file is renamed into place complete, so a killed
+//! run leaves every listed level readable; [`PartialOutput::finish`]
+//! writes the final output with [`write_run`] and then removes them.
+//!
+//! # XDMF (`<stem>.xdmf`, `<stem>.edges.xdmf`, `<stem>.faces.xdmf`)
+//!
+//! ParaView and VisIt ignore `Center="Edge"`/`"Face"`, so each cochain
+//! degree gets its own grid with ordinary cell data: the top cells
+//! (carrying the top-degree cochains as cell data and the 0-cochains as
+//! point data), the edges as 2-node polylines when n ≥ 2 and there are
+//! 1-cochains, and the faces as polygons when n = 3 and there are
+//! 2-cochains. Cells are written with VTK vertex order (cyclic polygons,
+//! VTK hexahedra, positive tetrahedra), rebuilt from ∂ since hasse keeps
+//! only sorted vertex sets. Triangles, quadrilaterals, tetrahedra and
+//! hexahedra keep their own types (uniform topology when all cells agree,
+//! `Mixed` otherwise); polygons with five or more vertices are XDMF
+//! `Polygon` cells; other convex polyhedra are split into tetrahedra from
+//! their lowest vertex (XDMF `Polyhedron` is read by neither meshio nor
+//! reliably by ParaView), with `cell_ids` mapping elements back.
+//!
+//! Each grid is a document of its own: the top grid is `<stem>.xdmf`
+//! (written even when no cochain lives on it, as the mesh), the edges
+//! `<stem>.edges.xdmf`, the faces `<stem>.faces.xdmf`, all pointing into
+//! the one `<stem>.h5`. `meshio.read` accepts only a domain with a single
+//! uniform grid (a spatial collection fails with "Unknown section
+//! 'Grid'") and `meshio.xdmf.TimeSeriesReader` only one temporal
+//! collection, so one grid per file lets meshio read every file, while
+//! ParaView opens each. One time level gives a plain uniform grid,
+//! several give a temporal collection. `TimeSeriesReader` takes the mesh of the
+//! first grid only, so it cannot read a series whose mesh changes; h5py
+//! can (`cases/OUTPUT.md`).
+
+mod hdf5_file;
+mod partial;
+mod topology;
+mod xdmf;
+
+pub use partial::{remove_partial, PartialOutput};
+
+use hasse_complex::Complex;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// One cochain: values on the p-cells of the complex (`values.len() == complex.cell_count(dim)`).
+///
+/// ```
+/// use hasse_solver::frontend::output::Cochain;
+/// let u = Cochain::new("u", 0, vec![0.0, 1.0, 2.0]).with_units("K");
+/// assert_eq!(u.units.as_deref(), Some("K"));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Cochain {
+    /// Name of the field; unique within a step, used as HDF5 and XDMF name.
+    pub name: String,
+    /// Degree p: the values live on the p-cells.
+    pub dim: usize,
+    /// One value per p-cell, in cell-id order.
+    pub values: Vec<f64>,
+    /// Physical units, e.g. `"K"`.
+    pub units: Option<String>,
+    /// Discretisation that produced the values, e.g. `"fe"`.
+    pub method: Option<String>,
+    /// Free text.
+    pub description: Option<String>,
+}
+
+impl Cochain {
+    /// A cochain without metadata.
+    pub fn new(name: impl Into<String>, dim: usize, values: Vec<f64>) -> Self {
+        Self {
+            name: name.into(),
+            dim,
+            values,
+            units: None,
+            method: None,
+            description: None,
+        }
+    }
+
+    /// The same cochain with its units set.
+    pub fn with_units(mut self, units: impl Into<String>) -> Self {
+        self.units = Some(units.into());
+        self
+    }
+
+    /// The same cochain with the method that produced it.
+    pub fn with_method(mut self, method: impl Into<String>) -> Self {
+        self.method = Some(method.into());
+        self
+    }
+
+    /// The same cochain with a description.
+    pub fn with_description(mut self, description: impl Into<String>) -> Self {
+        self.description = Some(description.into());
+        self
+    }
+}
+
+/// One time level (a steady run has exactly one step with time 0.0).
+///
+/// ```
+/// use hasse_solver::frontend::output::{Cochain, Step};
+/// let step = Step { time: 0.5, cochains: vec![Cochain::new("u", 0, vec![1.0])] };
+/// assert_eq!(step.cochains.len(), 1);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Step {
+    /// Time of the level; times must be finite and strictly increasing.
+    pub time: f64,
+    /// The fields at this time.
+    pub cochains: Vec<Cochain>,
+}
+
+/// Where a run came from, stored under `/provenance`.
+///
+/// ```
+/// use hasse_solver::frontend::output::Provenance;
+/// let p = Provenance::new(serde_json::json!({"iterations": 3}));
+/// assert_eq!(p.hasse_version, env!("CARGO_PKG_VERSION"));
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Provenance {
+    /// Full text of the case file.
+    pub case_text: Option<String>,
+    /// Path of the case file as given.
+    pub case_path: Option<String>,
+    /// Version of hasse that wrote the file.
+    pub hasse_version: String,
+    /// The run report (errors, iterations, timings…), stored as JSON text.
+    pub report: serde_json::Value,
+}
+
+impl Provenance {
+    /// Provenance of this build of hasse with the given report and no case file.
+    pub fn new(report: serde_json::Value) -> Self {
+        Self {
+            case_text: None,
+            case_path: None,
+            hasse_version: env!("CARGO_PKG_VERSION").to_string(),
+            report,
+        }
+    }
+}
+
+/// Everything [`write_run`] stores: the complex, the time levels and the provenance.
+///
+/// ```
+/// use hasse_solver::frontend::output::{Provenance, RunOutput};
+/// let k = hasse_complex::generate::interval(2, 0.0, 1.0).unwrap();
+/// let run = RunOutput { complex: &k, steps: vec![], provenance: Provenance::new(serde_json::Value::Null) };
+/// assert!(run.steps.is_empty());
+/// ```
+#[derive(Clone, Debug)]
+pub struct RunOutput<'a> {
+    /// The complex every cochain lives on.
+    pub complex: &'a Complex,
+    /// Time levels in increasing time (may be empty: mesh only).
+    pub steps: Vec<Step>,
+    /// Where the run came from.
+    pub provenance: Provenance,
+}
+
+/// One time level with its own complex, for [`write_mesh_series`].
+///
+/// ```
+/// use hasse_solver::frontend::output::{Cochain, MeshStep};
+/// let k = hasse_complex::generate::interval(3, 0.0, 1.0).unwrap();
+/// let step = MeshStep { time: 0.5, complex: &k, cochains: vec![Cochain::new("q", 1, vec![1.0; 3])] };
+/// assert_eq!(step.cochains[0].values.len(), step.complex.cell_count(1));
+/// ```
+#[derive(Clone, Debug)]
+pub struct MeshStep<'a> {
+    /// Time of the level; times must be finite and strictly increasing.
+    pub time: f64,
+    /// The complex of this level; the cochains live on it.
+    pub complex: &'a Complex,
+    /// The fields at this time, on `complex`.
+    pub cochains: Vec<Cochain>,
+}
+
+/// Everything [`write_mesh_series`] stores: time levels, each with its own
+/// complex, and the provenance.
+///
+/// ```
+/// use hasse_solver::frontend::output::{MeshStep, Provenance, SeriesOutput};
+/// let coarse = hasse_complex::generate::interval(2, 0.0, 1.0).unwrap();
+/// let fine = hasse_complex::generate::interval(4, 0.0, 1.0).unwrap();
+/// let series = SeriesOutput {
+///     steps: vec![
+///         MeshStep { time: 0.0, complex: &coarse, cochains: vec![] },
+///         MeshStep { time: 1.0, complex: &fine, cochains: vec![] },
+///     ],
+///     provenance: Provenance::new(serde_json::Value::Null),
+/// };
+/// assert_eq!(series.steps[1].complex.cell_count(1), 4);
+/// ```
+#[derive(Clone, Debug)]
+pub struct SeriesOutput<'a> {
+    /// Time levels in increasing time; at least one.
+    pub steps: Vec<MeshStep<'a>>,
+    /// Where the run came from.
+    pub provenance: Provenance,
+}
+
+/// The files [`write_run`] or [`write_mesh_series`] wrote.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct OutputFiles {
+    /// `<stem>.h5`.
+    pub hdf5: PathBuf,
+    /// `<stem>.xdmf`: the top-cell grid (0-cochains as point data,
+    /// n-cochains as cell data), referring to the h5 file by its bare name.
+    pub xdmf: PathBuf,
+    /// `<stem>.edges.xdmf` and `<stem>.faces.xdmf`, in increasing degree:
+    /// one per lower degree that carries cochains (empty when none does).
+    pub extra_xdmf: Vec<PathBuf>,
+}
+
+/// Why an output could not be written. Nothing is left under the final
+/// file names when any of these is returned, except for an [`Io`] error on
+/// removing a stale degree file of an older output, or the partial output
+/// ([`PartialOutput::finish`], [`remove_partial`]), which happens only
+/// after the new output is complete and in place.
+///
+/// [`Io`]: OutputError::Io
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// A directory or file could not be created, written or renamed.
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The HDF5 library refused an operation on the (temporary) h5 file.
+    #[error("{path}: HDF5 error: {message}")]
+    Hdf5 { path: PathBuf, message: String },
+    /// A cochain's length is not the number of cells of its degree (in
+    /// the complex of its step).
+    #[error(
+        "cochain '{name}' (step {step}) of degree {dim} has {got} values, the complex has {expected} {dim}-cells"
+    )]
+    Shape {
+        step: usize,
+        name: String,
+        dim: usize,
+        expected: usize,
+        got: usize,
+    },
+    /// A cochain's degree exceeds the dimension of the complex.
+    #[error(
+        "cochain '{name}' (step {step}) has degree {dim}, the complex has dimension {complex_dim}"
+    )]
+    Degree {
+        step: usize,
+        name: String,
+        dim: usize,
+        complex_dim: usize,
+    },
+    /// NaN or ±∞ in a cochain; `cell` is the first bad cell id.
+    #[error(
+        "cochain '{name}' (step {step}) has the non-finite value {value} on {dim}-cell {cell}"
+    )]
+    NonFinite {
+        step: usize,
+        name: String,
+        dim: usize,
+        cell: usize,
+        value: f64,
+    },
+    /// Two cochains of one step share a name.
+    #[error("step {step} has two cochains named '{name}'")]
+    DuplicateName { step: usize, name: String },
+    /// A cochain name that cannot be an HDF5 link name or an XDMF reference.
+    #[error("cochain name '{name}' cannot be stored: {reason}")]
+    InvalidName { name: String, reason: &'static str },
+    /// Times must be finite and strictly increasing.
+    #[error("step {step} has time {time}: times must be finite and strictly increasing")]
+    Time { step: usize, time: f64 },
+    /// A series whose mesh changes needs at least one time level: the
+    /// complexes come with the levels.
+    #[error("a series whose mesh changes needs at least one step")]
+    EmptySeries,
+    /// The complexes of a series must all have the same dimension (the
+    /// XDMF files are one per cell degree).
+    #[error("step {step} has a complex of dimension {dim}, step 0 one of dimension {expected}")]
+    MeshDimension {
+        step: usize,
+        dim: usize,
+        expected: usize,
+    },
+    /// The output stem cannot name the output files.
+    #[error("output stem '{path}': {reason}")]
+    Stem { path: PathBuf, reason: &'static str },
+    /// A provenance or metadata string cannot be stored (e.g. it contains NUL).
+    #[error("{field} cannot be stored as an HDF5 string: {reason}")]
+    Text { field: String, reason: String },
+    /// [`PartialOutput::finish`] was given a run that is not the series it
+    /// streamed (other times or another complex); nothing was written.
+    #[error("{path}: {reason}")]
+    Partial { path: PathBuf, reason: String },
+    /// The reader-order connectivity of some cell could not be rebuilt.
+    #[error("cannot write the XDMF cells: {message}")]
+    Topology { message: String },
+}
+
+/// Writes `<stem>.h5`, `<stem>.xdmf` and one `<stem>.<grid>.xdmf` per
+/// lower cochain degree (stem may include a directory, created if missing)
+/// and returns their paths.
+///
+/// Inputs are checked before anything is written. All files are first
+/// written under temporary names in the target directory and renamed into
+/// place only when all are complete (the h5 first, then the degree files,
+/// `<stem>.xdmf` last), so an error never leaves a truncated file and
+/// never replaces an older output. Once the new output is in place, degree
+/// files of an older output that this run does not have are removed.
+///
+/// ```
+/// use hasse_solver::frontend::output::{write_run, Cochain, Provenance, RunOutput, Step};
+/// let k = hasse_complex::generate::rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// let x: Vec<f64> = (0..k.cell_count(0)).map(|v| k.vertices().point(v)[0]).collect();
+/// let run = RunOutput {
+///     complex: &k,
+///     steps: vec![Step { time: 0.0, cochains: vec![Cochain::new("x", 0, x)] }],
+///     provenance: Provenance::new(serde_json::json!({"note": "doctest"})),
+/// };
+/// let dir = std::env::temp_dir().join(format!("hasse-doc-{}", std::process::id()));
+/// let files = write_run(&dir.join("run"), &run).unwrap();
+/// assert!(files.hdf5.ends_with("run.h5") && files.xdmf.exists());
+/// assert!(files.extra_xdmf.is_empty()); // no edge cochain, no run.edges.xdmf
+/// let xdmf = std::fs::read_to_string(&files.xdmf).unwrap();
+/// assert!(xdmf.contains("run.h5:/steps/0/x"));
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputError> {
+    write_levels(stem, &Levels::of_run(run))
+}
+
+/// Writes `<stem>.h5`, `<stem>.xdmf` and one `<stem>.<grid>.xdmf` per
+/// lower cochain degree for a time series whose complex changes from one
+/// level to the next (refinement studies, growing tissues), and returns
+/// their paths.
+///
+/// Each level k stores its own complex under `/steps/<k>/mesh` (the layout
+/// of `/mesh` in a [`write_run`] file, plus the XDMF arrays under
+/// `/steps/<k>/mesh/xdmf`) next to its cochains `/steps/<k>/<name>`; the
+/// root attribute `mesh_changes` is 1 (0 in [`write_run`] files). In every
+/// XDMF file the k-th grid of the temporal collection has its own geometry
+/// and topology pointing into `/steps/<k>/mesh`.
+///
+/// Checks, temporary files and renames are those of [`write_run`]. Besides
+/// its checks, the series must have at least one level
+/// ([`OutputError::EmptySeries`]), all complexes the same dimension
+/// ([`OutputError::MeshDimension`]), and no cochain may be named `mesh`.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::frontend::output::{write_mesh_series, Cochain, MeshStep, Provenance, SeriesOutput};
+/// let coarse = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let fine = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let x = |k: &hasse_complex::Complex| -> Vec<f64> {
+///     (0..k.cell_count(0)).map(|v| k.vertices().point(v)[0]).collect()
+/// };
+/// let series = SeriesOutput {
+///     steps: vec![
+///         MeshStep { time: 0.0, complex: &coarse, cochains: vec![Cochain::new("x", 0, x(&coarse))] },
+///         MeshStep { time: 1.0, complex: &fine, cochains: vec![Cochain::new("x", 0, x(&fine))] },
+///     ],
+///     provenance: Provenance::new(serde_json::json!({"note": "doctest"})),
+/// };
+/// let dir = std::env::temp_dir().join(format!("hasse-doc-series-{}", std::process::id()));
+/// let files = write_mesh_series(&dir.join("grow"), &series).unwrap();
+/// let xdmf = std::fs::read_to_string(&files.xdmf).unwrap();
+/// assert!(xdmf.contains("grow.h5:/steps/1/mesh/vertices"));
+/// assert!(xdmf.contains("grow.h5:/steps/1/x"));
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn write_mesh_series(stem: &Path, series: &SeriesOutput) -> Result<OutputFiles, OutputError> {
+    write_levels(stem, &Levels::of_series(series))
+}
+
+/// Check, before any long computation, that output can be written under
+/// `stem`: the directory is created if missing and a probe file is created
+/// and removed in it. An unwritable place is then reported at once instead
+/// of after the solve.
+///
+/// ```
+/// use hasse_solver::frontend::output::check_writable;
+/// let dir = std::env::temp_dir().join(format!("hasse-doc-probe-{}", std::process::id()));
+/// assert!(check_writable(&dir.join("run")).is_ok());
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// // Under a regular file nothing can be created.
+/// let file = std::env::temp_dir().join(format!("hasse-doc-file-{}", std::process::id()));
+/// std::fs::write(&file, "").unwrap();
+/// assert!(check_writable(&file.join("run")).is_err());
+/// std::fs::remove_file(&file).unwrap();
+/// ```
+pub fn check_writable(stem: &Path) -> Result<(), OutputError> {
+    let dir = match stem.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| OutputError::Io { path, source }
+    };
+    std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+    let probe = dir.join(format!(".hasse-probe.tmp-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(io(&dir))?;
+    std::fs::remove_file(&probe).map_err(io(&probe))
+}
+
+/// The directory of `stem` (`.` when it has none) and its file name, which
+/// every output file name starts with.
+fn split_stem(stem: &Path) -> Result<(PathBuf, String), OutputError> {
+    let stem_error = |reason| OutputError::Stem {
+        path: stem.to_path_buf(),
+        reason,
+    };
+    let file_name = stem
+        .file_name()
+        .ok_or_else(|| stem_error("it has no file name"))?
+        .to_str()
+        .ok_or_else(|| stem_error("the file name is not UTF-8"))?
+        .to_string();
+    if file_name.contains(':') {
+        // XDMF readers split "file.h5:/path" at the first ':'.
+        return Err(stem_error(
+            "':' in the file name breaks XDMF data references",
+        ));
+    }
+    let dir = match stem.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Ok((dir, file_name))
+}
+
+/// A tag unique per process and per call, so concurrent writers of the
+/// same stem never share a temporary.
+fn temporary_tag() -> String {
+    static CALLS: AtomicU64 = AtomicU64::new(0);
+    format!(
+        "{}-{}",
+        std::process::id(),
+        CALLS.fetch_add(1, Ordering::Relaxed)
+    )
+}
+
+/// The temporary that becomes `path`: in the same directory, so that the
+/// rename is atomic, and hidden, so that listings and globs skip it.
+fn temporary(path: &Path, tag: &str) -> PathBuf {
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!(".{name}.tmp-{tag}"))
+}
+
+/// Remove temporaries of `finals` left in `dir` by writers that were
+/// killed: those whose tag names a process that no longer runs. Temporaries
+/// of running processes (this one included) are kept, since a concurrent
+/// writer may still rename them. Best effort: without `/proc` nothing is
+/// removed, and a file that cannot be removed is left alone.
+fn remove_orphaned_temporaries(dir: &Path, finals: &[PathBuf]) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefixes: Vec<String> = finals
+        .iter()
+        .filter_map(|f| f.file_name())
+        .map(|name| format!(".{}.tmp-", name.to_string_lossy()))
+        .collect();
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let Some(tag) = prefixes.iter().find_map(|p| name.strip_prefix(p.as_str())) else {
+            continue;
+        };
+        let Some(pid) = tag.split('-').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Whether a file name is one of [`temporary`]'s.
+fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && name.contains(".tmp-")
+}
+
+/// Write one file under a temporary name with `write`, make it durable
+/// and rename it to `path`: readers see the old file or the complete new
+/// one, never a part, and an error leaves nothing behind.
+fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), OutputError>,
+) -> Result<(), OutputError> {
+    let mut temps = Temporaries(vec![temporary(path, &temporary_tag())]);
+    write(&temps.0[0])?;
+    sync(&temps.0[0])?;
+    rename(&temps.0[0], path)?;
+    temps.0.clear();
+    Ok(())
+}
+
+fn write_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    std::fs::write(path, text).map_err(|source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn create_dir(dir: &Path) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
+/// The shared body of [`write_run`] and [`write_mesh_series`].
+fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, OutputError> {
+    validate(levels)?;
+    let (dir, file_name) = split_stem(stem)?;
+    let degrees = xdmf::degrees(levels);
+    let grids = xdmf::grids(levels, &degrees)?;
+
+    create_dir(&dir)?;
+    let h5_name = format!("{file_name}.h5");
+    let files = xdmf::Files::one(&h5_name);
+    let n = levels.dim();
+    let final_h5 = dir.join(&h5_name);
+    let final_xdmf = dir.join(format!("{file_name}.xdmf"));
+    // One XDMF document per degree: the top grid (first in `degrees`) under
+    // `<stem>.xdmf`, each lower degree under `<stem>.<grid>.xdmf`.
+    let mut extra_xdmf = Vec::new();
+    let mut documents = Vec::new();
+    for (i, &p) in degrees.iter().enumerate() {
+        let text = xdmf::document(levels, &grids, i, &files);
+        if i == 0 {
+            documents.push((final_xdmf.clone(), text));
+        } else {
+            let path = dir.join(format!("{file_name}.{}.xdmf", xdmf::grid_name(p, n)));
+            extra_xdmf.push(path.clone());
+            documents.push((path, text));
+        }
+    }
+    // Rename order: the h5 first, because no xdmf may point at a file that
+    // is not there; the main xdmf last, because it is the one users open,
+    // so once it appears the whole output is in place.
+    documents.rotate_left(1);
+
+    let tag = temporary_tag();
+    let mut finals = vec![final_h5.clone()];
+    finals.extend(documents.iter().map(|(path, _)| path.clone()));
+    let mut temps = Temporaries(finals.iter().map(|path| temporary(path, &tag)).collect());
+    let mut known = finals.clone();
+    known.extend(
+        LOWER_GRID_NAMES
+            .iter()
+            .map(|grid| dir.join(format!("{file_name}.{grid}.xdmf"))),
+    );
+    remove_orphaned_temporaries(&dir, &known);
+
+    hdf5_file::write(&temps.0[0], levels, &grids, &rfc3339_now())?;
+    for (path, (_, text)) in temps.0[1..].iter().zip(&documents) {
+        write_text(path, text)?;
+    }
+
+    // Contents reach the disk before the names do, so a crash right after
+    // the renames cannot leave an empty file under a final name.
+    for path in &temps.0 {
+        sync(path)?;
+    }
+    for target in &finals {
+        rename(&temps.0[0], target)?;
+        temps.0.remove(0);
+    }
+    // Degree files of an earlier output under this stem that this run does
+    // not have would point at datasets the new h5 may lack: remove them.
+    for grid_name in LOWER_GRID_NAMES {
+        let path = dir.join(format!("{file_name}.{grid_name}.xdmf"));
+        if extra_xdmf.contains(&path) {
+            continue;
+        }
+        remove_if_present(&path)?;
+    }
+    Ok(OutputFiles {
+        hdf5: final_h5,
+        xdmf: final_xdmf,
+        extra_xdmf,
+    })
+}
+
+/// Remove a file; whether it was there.
+fn remove_if_present(path: &Path) -> Result<bool, OutputError> {
+    match std::fs::remove_file(path) {
+        Ok(()) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
+        Err(source) => Err(OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        }),
+    }
+}
+
+/// An output as the writers see it, whichever entry point built it: the
+/// meshes with the h5 groups they go to, and the time levels on them.
+pub(crate) struct Levels<'a> {
+    /// One mesh shared by every level ([`write_run`]) or one per level.
+    pub meshes: Vec<MeshAt<'a>>,
+    pub steps: Vec<Level<'a>>,
+    pub provenance: &'a Provenance,
+    /// Each level has its own mesh under `/steps/<k>/mesh`.
+    pub mesh_changes: bool,
+}
+
+/// A complex and where it goes in the h5 file.
+pub(crate) struct MeshAt<'a> {
+    pub complex: &'a Complex,
+    /// Group of the mesh, from the root without a leading `/`: `mesh`, or
+    /// `steps/<k>/mesh` in a series.
+    pub group: String,
+    /// Group of its XDMF arrays: `xdmf`, or `steps/<k>/mesh/xdmf`.
+    pub xdmf_group: String,
+    /// The levels whose cochains live on it, in increasing order.
+    pub steps: Vec<usize>,
+}
+
+/// One time level: its cochains live on `meshes[mesh]`.
+pub(crate) struct Level<'a> {
+    pub time: f64,
+    pub cochains: &'a [Cochain],
+    pub mesh: usize,
+}
+
+impl<'a> Levels<'a> {
+    fn of_run(run: &'a RunOutput) -> Self {
+        Levels {
+            meshes: vec![MeshAt {
+                complex: run.complex,
+                group: "mesh".into(),
+                xdmf_group: "xdmf".into(),
+                steps: (0..run.steps.len()).collect(),
+            }],
+            steps: run
+                .steps
+                .iter()
+                .map(|s| Level {
+                    time: s.time,
+                    cochains: &s.cochains,
+                    mesh: 0,
+                })
+                .collect(),
+            provenance: &run.provenance,
+            mesh_changes: false,
+        }
+    }
+
+    fn of_series(series: &'a SeriesOutput) -> Self {
+        let meshes = series
+            .steps
+            .iter()
+            .enumerate()
+            .map(|(k, s)| MeshAt {
+                complex: s.complex,
+                group: format!("steps/{k}/mesh"),
+                xdmf_group: format!("steps/{k}/mesh/xdmf"),
+                steps: vec![k],
+            })
+            .collect();
+        Levels {
+            meshes,
+            steps: series
+                .steps
+                .iter()
+                .enumerate()
+                .map(|(k, s)| Level {
+                    time: s.time,
+                    cochains: &s.cochains,
+                    mesh: k,
+                })
+                .collect(),
+            provenance: &series.provenance,
+            mesh_changes: true,
+        }
+    }
+
+    /// Dimension n of the top cells (the same on every mesh, see `validate`).
+    pub fn dim(&self) -> usize {
+        self.meshes.first().map_or(0, |m| m.complex.dim())
+    }
+}
+
+/// Every name a lower-degree grid file can have (see `xdmf::grid_name`).
+const LOWER_GRID_NAMES: [&str; 2] = ["edges", "faces"];
+
+fn sync(path: &Path) -> Result<(), OutputError> {
+    std::fs::File::open(path)
+        .and_then(|f| f.sync_all())
+        .map_err(|source| OutputError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+}
+
+fn rename(from: &Path, to: &Path) -> Result<(), OutputError> {
+    std::fs::rename(from, to).map_err(|source| OutputError::Io {
+        path: to.to_path_buf(),
+        source,
+    })
+}
+
+/// Temporary files removed on drop unless taken out of the list.
+struct Temporaries(Vec<PathBuf>);
+
+impl Drop for Temporaries {
+    fn drop(&mut self) {
+        for path in &self.0 {
+            // Best effort: the file may not have been created yet.
+            let _ = std::fs::remove_file(path);
+        }
+    }
+}
+
+fn validate(levels: &Levels) -> Result<(), OutputError> {
+    if levels.meshes.is_empty() {
+        return Err(OutputError::EmptySeries);
+    }
+    let mut previous: Option<f64> = None;
+    for (k, step) in levels.steps.iter().enumerate() {
+        check_level(levels, k, step, previous)?;
+        previous = Some(step.time);
+    }
+    Ok(())
+}
+
+/// The checks of one level `k` of `levels` (`step`, which need not be in
+/// `levels.steps`), whose predecessor has time `previous`.
+fn check_level(
+    levels: &Levels,
+    k: usize,
+    step: &Level,
+    previous: Option<f64>,
+) -> Result<(), OutputError> {
+    if !step.time.is_finite() || previous.is_some_and(|t| step.time <= t) {
+        return Err(OutputError::Time {
+            step: k,
+            time: step.time,
+        });
+    }
+    let complex = levels.meshes[step.mesh].complex;
+    let n = levels.dim();
+    if complex.dim() != n {
+        return Err(OutputError::MeshDimension {
+            step: k,
+            dim: complex.dim(),
+            expected: n,
+        });
+    }
+    let mut names = HashSet::new();
+    for c in step.cochains {
+        check_name(&c.name)?;
+        if levels.mesh_changes && c.name == "mesh" {
+            return Err(OutputError::InvalidName {
+                name: c.name.clone(),
+                reason: "'mesh' is the group of the step's own mesh in a series",
+            });
+        }
+        if !names.insert(c.name.as_str()) {
+            return Err(OutputError::DuplicateName {
+                step: k,
+                name: c.name.clone(),
+            });
+        }
+        if c.dim > complex.dim() {
+            return Err(OutputError::Degree {
+                step: k,
+                name: c.name.clone(),
+                dim: c.dim,
+                complex_dim: complex.dim(),
+            });
+        }
+        let expected = complex.cell_count(c.dim);
+        if c.values.len() != expected {
+            return Err(OutputError::Shape {
+                step: k,
+                name: c.name.clone(),
+                dim: c.dim,
+                expected,
+                got: c.values.len(),
+            });
+        }
+        if let Some(cell) = c.values.iter().position(|v| !v.is_finite()) {
+            return Err(OutputError::NonFinite {
+                step: k,
+                name: c.name.clone(),
+                dim: c.dim,
+                cell,
+                value: c.values[cell],
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Names become HDF5 link names and XML attribute values.
+fn check_name(name: &str) -> Result<(), OutputError> {
+    let reason = if name.is_empty() {
+        Some("it is empty")
+    } else if name == "." || name == ".." {
+        Some("'.' and '..' are HDF5 path components")
+    } else if name.contains('/') {
+        Some("'/' separates HDF5 groups")
+    } else if name.contains(':') {
+        Some("':' separates file and path in XDMF data references")
+    } else if name.chars().any(char::is_control) {
+        Some("it contains a control character")
+    } else {
+        None
+    };
+    match reason {
+        Some(reason) => Err(OutputError::InvalidName {
+            name: name.to_string(),
+            reason,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The current time as RFC 3339 UTC (`YYYY-MM-DDTHH:MM:SSZ`).
+fn rfc3339_now() -> String {
+    let seconds = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    rfc3339(seconds)
+}
+
+/// Civil date from days since 1970-01-01 (H. Hinnant's algorithm).
+fn rfc3339(seconds: u64) -> String {
+    let days = (seconds / 86_400) as i64;
+    let rem = seconds % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        (rem / 60) % 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rfc3339_matches_known_dates() {
+        assert_eq!(rfc3339(0), "1970-01-01T00:00:00Z");
+        // 2000-02-29 is a leap day of a century leap year.
+        assert_eq!(rfc3339(951_782_400 + 3661), "2000-02-29T01:01:01Z");
+        assert_eq!(rfc3339(1_700_000_000), "2023-11-14T22:13:20Z");
+    }
+
+    #[test]
+    fn names_that_break_paths_are_rejected() {
+        for bad in ["", ".", "a/b", "a:b", "a\nb"] {
+            assert!(matches!(
+                check_name(bad),
+                Err(OutputError::InvalidName { .. })
+            ));
+        }
+        assert!(check_name("u_h (K)").is_ok());
+    }
+}

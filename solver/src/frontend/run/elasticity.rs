@@ -1,0 +1,151 @@
+//! Running a linear elasticity case: the vector displacement of
+//! [`crate::physics::elasticity`] on the vertices, one field per component, errors
+//! against an exact displacement.
+
+use super::{check_residual, scalar_fn, Field, RunError, RunResult};
+use crate::frontend::case::expr::Expression;
+use crate::frontend::case::{Case, ElasticBoundaryKind, ElasticitySpec, MaterialSpec};
+use crate::physics::diffusion::{Errors, VectorFn};
+use crate::physics::elasticity::{
+    Coefficient, ElasticBoundary, Elasticity, ElasticityError, Material,
+};
+use hasse_complex::Complex;
+use std::time::Instant;
+
+fn vector_fn(components: &[Expression]) -> VectorFn {
+    super::vector_fn(components)
+}
+
+fn problem(case: &Case, spec: &ElasticitySpec) -> Elasticity {
+    let coefficient = |e: &Expression| Coefficient::Function(scalar_fn(e));
+    let material = match &spec.material {
+        MaterialSpec::Lame { lambda, mu } => Material::Lame {
+            lambda: coefficient(lambda),
+            mu: coefficient(mu),
+        },
+        MaterialSpec::Young { young, poisson } => Material::Young {
+            young: coefficient(young),
+            poisson: coefficient(poisson),
+        },
+    };
+    let mut problem = Elasticity::new(material, vector_fn(&spec.body_force)).with_plane(spec.plane);
+    for b in &spec.boundary {
+        let kind = match &b.kind {
+            ElasticBoundaryKind::Displacement {
+                component: Some(a),
+                value,
+            } => ElasticBoundary::Component {
+                component: *a,
+                value: scalar_fn(&value[0]),
+            },
+            ElasticBoundaryKind::Displacement {
+                component: None,
+                value,
+            } => ElasticBoundary::Displacement(vector_fn(value)),
+            ElasticBoundaryKind::Traction(value) => ElasticBoundary::Traction(vector_fn(value)),
+        };
+        problem = problem.with_boundary(&b.tag, kind);
+    }
+    if let Some(f) = case.solver.factorization {
+        problem.factorization = f;
+    }
+    problem.ordering = case.solver.ordering;
+    problem
+}
+
+fn run_error(e: ElasticityError) -> RunError {
+    match e {
+        ElasticityError::Solve(_) | ElasticityError::Canonical(_) => RunError::Solve(e.to_string()),
+        ElasticityError::Lame { .. }
+        | ElasticityError::Young { .. }
+        | ElasticityError::Poisson { .. }
+        | ElasticityError::NonFiniteMaterial { .. } => {
+            RunError::Input(format!("problem (material): {e}"))
+        }
+        ElasticityError::RigidModes { .. } => RunError::Input(format!("boundary: {e}")),
+        other => RunError::Input(other.to_string()),
+    }
+}
+
+pub(super) fn solve(
+    case: &Case,
+    spec: &ElasticitySpec,
+    complex: &Complex,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    let d = complex.embedding_dim();
+    let elasticity = problem(case, spec);
+    phase("assembling and solving");
+    let started = Instant::now();
+    let u = elasticity.solve(complex).map_err(run_error)?;
+    let total = started.elapsed().as_secs_f64();
+    let mut warnings = Vec::new();
+    check_residual(case, u.report.relative_residual, &mut warnings)?;
+    let axes = ["x", "y", "z"];
+    let mut fields: Vec<Field> = (0..u.dim)
+        .map(|a| Field {
+            name: format!("u_{}", axes[a]),
+            dim: 0,
+            values: u.component(a).to_vec(),
+            description: format!("displacement component {}", axes[a]),
+        })
+        .collect();
+    let errors = match case.exact.as_ref().and_then(|e| e.displacement.as_ref()) {
+        Some(exact) if exact.len() < d => {
+            return Err(RunError::Input(format!(
+                "exact.displacement has {} components; the mesh lives in {d} dimensions",
+                exact.len()
+            )))
+        }
+        Some(exact) => {
+            let exact_fn = vector_fn(exact);
+            let (l2, max) = u.errors(complex, &exact_fn);
+            for (a, axis) in axes.iter().enumerate().take(u.dim) {
+                let difference: Vec<f64> = u
+                    .component(a)
+                    .iter()
+                    .enumerate()
+                    .map(|(v, value)| value - exact_fn(complex.vertices().point(v))[a])
+                    .collect();
+                fields.push(Field {
+                    name: format!("error_{axis}"),
+                    dim: 0,
+                    values: difference,
+                    description: format!("u_{axis} − exact"),
+                });
+            }
+            Some(Errors {
+                l2,
+                max,
+                gradient_l2: f64::NAN,
+            })
+        }
+        None => None,
+    };
+    let timings = vec![
+        ("assembly".to_string(), u.assembly_seconds),
+        (
+            "factorisation".to_string(),
+            u.report.symbolic_seconds + u.report.numeric_seconds,
+        ),
+        ("solve".to_string(), u.report.solve_seconds),
+        ("assembly + solve".to_string(), total),
+    ];
+    Ok(RunResult {
+        problem: "elasticity".into(),
+        method: Some("fe".into()),
+        unknowns: u.values.len(),
+        fields,
+        errors,
+        flux_error: None,
+        relative_residual: Some(u.report.relative_residual),
+        factorization: Some(u.report.factorization),
+        ordering: u.report.ordering,
+        timings,
+        warnings,
+        pure_neumann: false,
+        series: Vec::new(),
+        notes: Vec::new(),
+        report: serde_json::Map::new(),
+    })
+}

@@ -1,0 +1,7 @@
+//! Linear algebra: direct factorisations and their orderings, the
+//! row-stored matrix and conjugate gradients, eigenpairs.
+
+pub mod direct;
+pub mod eigen;
+pub mod iterative;
+pub mod ordering;

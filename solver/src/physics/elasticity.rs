@@ -1,0 +1,751 @@
+//! Linear elasticity −∇·σ(u) = f, σ = λ (∇·u) I + μ (∇u + ∇uᵀ), with the
+//! displacement u on the vertices of a 2- or 3-dimensional mesh, in
+//! canonical form.
+//!
+//! The unknowns are the d components of u on every vertex, component by
+//! component (index a·|K₀| + v). The incidence is the edge difference
+//! applied to each component,
+//!
+//! ```text
+//!     A = I_d ⊗ δ⁰        (row a·|K₁| + e: component a of u_head − u_tail)
+//! ```
+//!
+//! and every top cell c adds a dense block over the d·|edges of c| rows of
+//! its own edges. With K_c the element stiffness (P1 on triangles and
+//! tetrahedra, Q1 on quadrilaterals and hexahedra, integrated with the
+//! quadrature of the scalar FE metric) and A_c = I_d ⊗ (local δ⁰),
+//!
+//! ```text
+//!     Ω_c = (A_c⁺)ᵀ K_c A_c⁺     and     A_cᵀ Ω_c A_c = K_c   exactly,
+//! ```
+//!
+//! because the kernel of A_c (a constant per component: the translations)
+//! lies in the kernel of K_c. Rotations are not in ker A_c: A_c maps them
+//! to nonzero edge vectors, which Ω_c sends to zero.
+//!
+//! Boundary conditions act on tagged (n−1)-cells: a prescribed displacement
+//! (all components, or one component, for rollers and symmetry planes) is
+//! eliminated symmetrically, so the reduced system is symmetric positive
+//! definite; a traction σn = t adds ∫_F t φ_v, lumped as t(x_v)|F|/(vertices
+//! of F) on each face vertex (exact for constant t on segments and
+//! triangles). Unlisted boundary faces are traction-free. Before solving,
+//! the prescribed components are checked to fix every rigid-body motion
+//! (d translations, d(d−1)/2 rotations) of every connected part of the
+//! mesh; a problem that leaves one free is reported, not sent to LLᵀ.
+
+use crate::la::direct::{Factorization, Ordering, SolveError, SolveReport};
+use crate::metric::fe::{self, Topology};
+use crate::metric::MetricError;
+use crate::operator::{BlockMetric, Canonical, CanonicalError};
+use crate::physics::diffusion::{self, lumped_vertex_volumes, DiffusionError, ScalarFn, VectorFn};
+use faer::sparse::SparseColMat;
+use hasse_complex::Complex;
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+use sprs::{CsMat, TriMat};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// A material coefficient: a function of position evaluated at each top
+/// cell's centroid, or one value per top cell.
+#[derive(Clone)]
+pub enum Coefficient {
+    Function(ScalarFn),
+    PerCell(Arc<[f64]>),
+}
+
+impl Coefficient {
+    /// The same value everywhere.
+    pub fn constant(value: f64) -> Self {
+        Coefficient::Function(Arc::new(move |_| value))
+    }
+
+    fn values(&self, complex: &Complex) -> Result<Vec<f64>, ElasticityError> {
+        let n = complex.dim();
+        let cells = complex.cell_count(n);
+        match self {
+            Coefficient::Function(f) => {
+                Ok((0..cells).map(|c| f(complex.centroid_of(n, c))).collect())
+            }
+            Coefficient::PerCell(values) if values.len() == cells => Ok(values.to_vec()),
+            Coefficient::PerCell(values) => Err(ElasticityError::CoefficientCount {
+                count: values.len(),
+                cells,
+            }),
+        }
+    }
+}
+
+/// The elastic material, by Lamé parameters or by Young's modulus and
+/// Poisson's ratio (λ = Eν/((1+ν)(1−2ν)), μ = E/(2(1+ν))).
+#[derive(Clone)]
+pub enum Material {
+    Lame {
+        lambda: Coefficient,
+        mu: Coefficient,
+    },
+    Young {
+        young: Coefficient,
+        poisson: Coefficient,
+    },
+}
+
+/// The Lamé parameters of one top cell.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lame {
+    pub lambda: f64,
+    pub mu: f64,
+}
+
+/// What a 2D problem stands for.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PlaneModel {
+    /// Plane strain (ε_zz = 0): λ and μ as given.
+    #[default]
+    Strain,
+    /// Plane stress (σ_zz = 0): λ replaced by 2λμ/(λ + 2μ).
+    Stress,
+}
+
+/// A boundary condition's kind and data.
+#[derive(Clone)]
+pub enum ElasticBoundary {
+    /// u = g (every component).
+    Displacement(VectorFn),
+    /// u_a = g for one component a (a roller, a symmetry plane); the other
+    /// components are traction-free.
+    Component { component: usize, value: ScalarFn },
+    /// σ n = t, n the outward normal.
+    Traction(VectorFn),
+}
+
+/// Linear elasticity −∇·σ(u) = f with boundary conditions on tags.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::physics::elasticity::{Coefficient, ElasticBoundary, Elasticity, Material};
+/// use std::sync::Arc;
+/// // A bar clamped at x = 0 and pulled at x = 2 by a unit traction:
+/// // σ_xx = 1, so u_x(2, y) = 2/E in plane stress with ν = 0 (no lateral
+/// // contraction).
+/// let mesh = rectangle(8, 2, [0.0, 2.0], [0.0, 0.5]).unwrap();
+/// let material = Material::Young { young: Coefficient::constant(4.0), poisson: Coefficient::constant(0.0) };
+/// let problem = Elasticity::new(material, Arc::new(|_| [0.0; 3]))
+///     .with_boundary("xmin", ElasticBoundary::Displacement(Arc::new(|_| [0.0; 3])))
+///     .with_boundary("xmax", ElasticBoundary::Traction(Arc::new(|_| [1.0, 0.0, 0.0])));
+/// let u = problem.solve(&mesh).unwrap();
+/// let corner = 8; // vertex (2, 0)
+/// assert!((u.at(corner)[0] - 0.5).abs() < 1e-12);
+/// ```
+#[derive(Clone)]
+pub struct Elasticity {
+    pub material: Material,
+    /// Body force f (the first d components are used).
+    pub body_force: VectorFn,
+    /// (tag, condition), applied in order; a later condition on the same
+    /// face replaces an earlier one.
+    pub boundary: Vec<(String, ElasticBoundary)>,
+    /// Plane strain or plane stress (2D only).
+    pub plane: PlaneModel,
+    /// Direct factorisation (default LLᵀ: the reduced system is SPD).
+    pub factorization: Factorization,
+    /// Its fill-reducing ordering (default automatic).
+    pub ordering: Ordering,
+}
+
+/// Why an elasticity problem could not be solved.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ElasticityError {
+    #[error("elasticity needs a 2- or 3-dimensional mesh that fills its space; this one is {n}-dimensional in R^{d}")]
+    Dimension { n: usize, d: usize },
+    #[error("{count} material values given for {cells} top cells")]
+    CoefficientCount { count: usize, cells: usize },
+    #[error("material parameter {what} = {value} in top cell {cell} is not finite")]
+    NonFiniteMaterial {
+        what: &'static str,
+        cell: usize,
+        value: f64,
+    },
+    #[error("Lamé parameters λ = {lambda}, μ = {mu} in top cell {cell}: need μ > 0 and λ + 2μ/{d} > 0 (positive shear and bulk moduli)")]
+    Lame {
+        cell: usize,
+        lambda: f64,
+        mu: f64,
+        d: usize,
+    },
+    #[error("Young's modulus E = {young} in top cell {cell} must be positive")]
+    Young { cell: usize, young: f64 },
+    #[error("Poisson's ratio ν = {poisson} in top cell {cell} must lie in (−1, 0.5)")]
+    Poisson { cell: usize, poisson: f64 },
+    #[error("boundary condition on tag '{tag}': no such tag in the mesh (tags: {available})")]
+    UnknownTag { tag: String, available: String },
+    #[error("boundary condition on tag '{tag}': it tags {dim}-cells, but boundary conditions need (n−1)-cells (n = {n})")]
+    TagDimension { tag: String, dim: usize, n: usize },
+    #[error("boundary condition on tag '{tag}': face {face} is not on the boundary")]
+    InteriorFace { tag: String, face: usize },
+    #[error("boundary condition on tag '{tag}' fixes component {component}, but displacements have {d} components (0..{d})")]
+    Component {
+        tag: String,
+        component: usize,
+        d: usize,
+    },
+    #[error("{what} is not finite at {location:?}")]
+    NonFinite {
+        what: &'static str,
+        location: Vec<f64>,
+    },
+    #[error("the prescribed displacements leave {free} of the {modes} rigid-body modes (translations and rotations) of part {part} of the mesh free, so the solution is not unique; prescribe displacements on enough of its boundary (pure traction problems have no unique solution)")]
+    RigidModes {
+        part: usize,
+        free: usize,
+        modes: usize,
+    },
+    #[error(transparent)]
+    Metric(#[from] MetricError),
+    #[error(transparent)]
+    Canonical(#[from] CanonicalError),
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    #[error(transparent)]
+    Diffusion(DiffusionError),
+}
+
+/// The assembled system (see [`Elasticity::assemble`]).
+#[derive(Clone, Debug)]
+pub struct ElasticSystem {
+    /// Space dimension d (components per vertex).
+    pub dim: usize,
+    /// A = I_d ⊗ δ⁰ and the block metric Ω.
+    pub canonical: Canonical,
+    /// K = Aᵀ Ω A over all d·|K₀| unknowns (component-major).
+    pub matrix: SparseColMat<usize, f64>,
+    /// Body force and traction loads.
+    pub rhs: Vec<f64>,
+    /// Prescribed values of the fixed unknowns.
+    pub fixed: Vec<Option<f64>>,
+    pub assembly_seconds: f64,
+}
+
+/// The displacement and how it was obtained.
+#[derive(Clone, Debug)]
+pub struct Displacement {
+    /// Components per vertex.
+    pub dim: usize,
+    /// Component-major: u_a at vertex v is `values[a * vertices + v]`.
+    pub values: Vec<f64>,
+    pub report: SolveReport,
+    pub assembly_seconds: f64,
+}
+
+impl Displacement {
+    /// Number of vertices.
+    pub fn vertices(&self) -> usize {
+        self.values.len() / self.dim
+    }
+
+    /// Component a on every vertex.
+    pub fn component(&self, a: usize) -> &[f64] {
+        let n = self.vertices();
+        &self.values[a * n..(a + 1) * n]
+    }
+
+    /// u at vertex v (zero beyond the d components).
+    pub fn at(&self, v: usize) -> [f64; 3] {
+        let mut u = [0.0; 3];
+        for (a, ua) in u.iter_mut().enumerate().take(self.dim) {
+            *ua = self.values[a * self.vertices() + v];
+        }
+        u
+    }
+
+    /// Discrete L² error (lumped vertex volumes) and the largest pointwise
+    /// error of |u_h − u| against an exact displacement.
+    pub fn errors(&self, complex: &Complex, exact: &VectorFn) -> (f64, f64) {
+        let weights = lumped_vertex_volumes(complex);
+        let (mut l2, mut max) = (0.0, 0.0f64);
+        for (v, w) in weights.iter().enumerate() {
+            let e = exact(complex.vertices().point(v));
+            let u = self.at(v);
+            let s: f64 = (0..self.dim).map(|a| (u[a] - e[a]).powi(2)).sum();
+            l2 += w * s;
+            max = max.max(s.sqrt());
+        }
+        (l2.sqrt(), max)
+    }
+}
+
+fn evaluate(value: f64, what: &'static str, x: &[f64]) -> Result<f64, ElasticityError> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(ElasticityError::NonFinite {
+            what,
+            location: x.to_vec(),
+        })
+    }
+}
+
+impl Elasticity {
+    /// A problem without boundary conditions (add them with
+    /// [`Elasticity::with_boundary`]), plane strain in 2D, solved by LLᵀ.
+    pub fn new(material: Material, body_force: VectorFn) -> Self {
+        Self {
+            material,
+            body_force,
+            boundary: Vec::new(),
+            plane: PlaneModel::Strain,
+            factorization: Factorization::Llt,
+            ordering: Ordering::Automatic,
+        }
+    }
+
+    /// Add a boundary condition on a tag.
+    pub fn with_boundary(mut self, tag: &str, kind: ElasticBoundary) -> Self {
+        self.boundary.push((tag.to_string(), kind));
+        self
+    }
+
+    /// Plane strain or plane stress (2D).
+    pub fn with_plane(mut self, plane: PlaneModel) -> Self {
+        self.plane = plane;
+        self
+    }
+
+    /// The Lamé parameters used in each top cell (after the plane-stress
+    /// reduction in 2D), checked.
+    pub fn lame(&self, complex: &Complex) -> Result<Vec<Lame>, ElasticityError> {
+        let d = dimension(complex)?;
+        let finite = |what, cell: usize, value: f64| {
+            if value.is_finite() {
+                Ok(value)
+            } else {
+                Err(ElasticityError::NonFiniteMaterial { what, cell, value })
+            }
+        };
+        let lame: Vec<Lame> = match &self.material {
+            Material::Lame { lambda, mu } => lambda
+                .values(complex)?
+                .into_iter()
+                .zip(mu.values(complex)?)
+                .enumerate()
+                .map(|(c, (l, m))| {
+                    Ok(Lame {
+                        lambda: finite("λ", c, l)?,
+                        mu: finite("μ", c, m)?,
+                    })
+                })
+                .collect::<Result<_, ElasticityError>>()?,
+            Material::Young { young, poisson } => young
+                .values(complex)?
+                .into_iter()
+                .zip(poisson.values(complex)?)
+                .enumerate()
+                .map(|(c, (e, nu))| {
+                    let (e, nu) = (finite("E", c, e)?, finite("ν", c, nu)?);
+                    if e <= 0.0 {
+                        return Err(ElasticityError::Young { cell: c, young: e });
+                    }
+                    if !(nu > -1.0 && nu < 0.5) {
+                        return Err(ElasticityError::Poisson {
+                            cell: c,
+                            poisson: nu,
+                        });
+                    }
+                    Ok(Lame {
+                        lambda: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
+                        mu: e / (2.0 * (1.0 + nu)),
+                    })
+                })
+                .collect::<Result<_, ElasticityError>>()?,
+        };
+        lame.into_iter()
+            .enumerate()
+            .map(|(cell, Lame { lambda, mu })| {
+                // Coercivity needs a positive shear modulus and a positive
+                // bulk modulus λ + 2μ/d; a negative λ (auxetic, ν < 0) is
+                // allowed, as ν ∈ (−1, 0) is.
+                if !(mu > 0.0 && lambda + 2.0 * mu / d as f64 > 0.0) {
+                    return Err(ElasticityError::Lame {
+                        cell,
+                        lambda,
+                        mu,
+                        d,
+                    });
+                }
+                let lambda = match (d, self.plane) {
+                    (2, PlaneModel::Stress) => 2.0 * lambda * mu / (lambda + 2.0 * mu),
+                    _ => lambda,
+                };
+                Ok(Lame { lambda, mu })
+            })
+            .collect()
+    }
+
+    /// Assemble K = Aᵀ Ω A, the loads and the prescribed components.
+    pub fn assemble(&self, complex: &Complex) -> Result<ElasticSystem, ElasticityError> {
+        let started = Instant::now();
+        let d = dimension(complex)?;
+        let n = complex.dim();
+        let vertices = complex.cell_count(0);
+        let lame = self.lame(complex)?;
+        let metric = stiffness_metric(complex, &lame)?;
+        let mut canonical = Canonical::new(incidence(complex), metric)?;
+
+        let mut rhs = Vec::with_capacity(d * vertices);
+        for a in 0..d {
+            let force = &self.body_force;
+            let load = fe::load(complex, &|x| force(x)[a]).map_err(|e| match e {
+                MetricError::NonFinite { cell } => ElasticityError::NonFinite {
+                    what: "body force",
+                    location: complex.centroid_of(n, cell).to_vec(),
+                },
+                other => other.into(),
+            })?;
+            rhs.extend(load);
+        }
+
+        let mut fixed = vec![None; d * vertices];
+        let condition = self.boundary_faces(complex, d)?;
+        let area = complex.measure(n - 1);
+        for &(f, k) in &condition {
+            let face = complex.cell_vertices(n - 1, f);
+            let share = area[f] / face.len() as f64;
+            for &v in face {
+                let x = complex.vertices().point(v);
+                match &self.boundary[k].1 {
+                    ElasticBoundary::Displacement(g) => {
+                        let g = g(x);
+                        for (a, &ga) in g.iter().enumerate().take(d) {
+                            fixed[a * vertices + v] = Some(evaluate(ga, "displacement", x)?);
+                        }
+                    }
+                    ElasticBoundary::Component { component, value } => {
+                        fixed[component * vertices + v] =
+                            Some(evaluate(value(x), "displacement", x)?);
+                    }
+                    ElasticBoundary::Traction(t) => {
+                        let t = t(x);
+                        for (a, &ta) in t.iter().enumerate().take(d) {
+                            rhs[a * vertices + v] += evaluate(ta, "traction", x)? * share;
+                        }
+                    }
+                }
+            }
+        }
+        let matrix = canonical.assemble_owned();
+        Ok(ElasticSystem {
+            dim: d,
+            canonical,
+            matrix,
+            rhs,
+            fixed,
+            assembly_seconds: started.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// Assemble, check that no rigid-body mode is left free, and solve.
+    pub fn solve(&self, complex: &Complex) -> Result<Displacement, ElasticityError> {
+        let system = self.assemble(complex)?;
+        check_rigid_modes(complex, &system.fixed)?;
+        let (values, report, _) = diffusion::solve_with_fixed(
+            &system.matrix,
+            &system.rhs,
+            &system.fixed,
+            self.factorization,
+            self.ordering,
+            None,
+        )
+        .map_err(|e| match e {
+            DiffusionError::Solve(e) => ElasticityError::Solve(e),
+            other => ElasticityError::Diffusion(other),
+        })?;
+        Ok(Displacement {
+            dim: system.dim,
+            values,
+            report,
+            assembly_seconds: system.assembly_seconds,
+        })
+    }
+
+    /// (face, condition index into `boundary`) for every conditioned
+    /// (n−1)-cell, by face.
+    fn boundary_faces(
+        &self,
+        complex: &Complex,
+        d: usize,
+    ) -> Result<Vec<(usize, usize)>, ElasticityError> {
+        let condition = diffusion::tagged_boundary_faces(
+            complex,
+            self.boundary.iter().map(|(name, _)| name.as_str()),
+        )
+        .map_err(|e| match e {
+            DiffusionError::UnknownTag { tag, available } => {
+                ElasticityError::UnknownTag { tag, available }
+            }
+            DiffusionError::TagDimension { tag, dim, n } => {
+                ElasticityError::TagDimension { tag, dim, n }
+            }
+            DiffusionError::InteriorFace { tag, face } => {
+                ElasticityError::InteriorFace { tag, face }
+            }
+            other => ElasticityError::Diffusion(other),
+        })?;
+        for (name, kind) in &self.boundary {
+            if let ElasticBoundary::Component { component, .. } = kind {
+                if *component >= d {
+                    return Err(ElasticityError::Component {
+                        tag: name.clone(),
+                        component: *component,
+                        d,
+                    });
+                }
+            }
+        }
+        Ok(condition)
+    }
+}
+
+fn dimension(complex: &Complex) -> Result<usize, ElasticityError> {
+    let (n, d) = (complex.dim(), complex.embedding_dim());
+    if n != d || !(2..=3).contains(&n) {
+        return Err(ElasticityError::Dimension { n, d });
+    }
+    Ok(d)
+}
+
+/// A = I_d ⊗ δ⁰: row a·|K₁| + e holds edge e's differences of component a,
+/// column a·|K₀| + v is component a at vertex v.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let a = hasse_solver::physics::elasticity::incidence(&k);
+/// assert_eq!(a.shape(), (8, 8)); // 2 × 4 edges, 2 × 4 vertices
+/// assert_eq!(a.nnz(), 16);
+/// ```
+pub fn incidence(complex: &Complex) -> CsMat<i8> {
+    let d = complex.embedding_dim();
+    let delta = complex.shared_coboundary(0);
+    let (edges, vertices) = delta.shape();
+    let mut tri = TriMat::with_capacity((d * edges, d * vertices), d * delta.nnz());
+    for a in 0..d {
+        for (&s, (e, v)) in delta.iter() {
+            tri.add_triplet(a * edges + e, a * vertices + v, s);
+        }
+    }
+    tri.to_csr()
+}
+
+/// The elastic metric Ω over the rows of [`incidence`]: one dense block per
+/// top cell, Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the d·|edges of c| rows of its
+/// edges (see the [module documentation](self)).
+///
+/// K_c[(a, i), (b, j)] = Σ_q w_q (λ ∂_a φ_i ∂_b φ_j + μ (δ_ab ∇φ_i·∇φ_j +
+/// ∂_b φ_i ∂_a φ_j)) over the quadrature points of the scalar FE metric
+/// (one point on simplices, Gauss 2ⁿ on quadrilaterals and hexahedra).
+///
+/// ```
+/// use hasse_complex::{Complex, TopCells, Vertices};
+/// use hasse_solver::physics::elasticity::{stiffness_metric, Lame};
+/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
+/// let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
+/// let omega = stiffness_metric(&k, &[Lame { lambda: 2.0, mu: 1.0 }]).unwrap();
+/// assert_eq!((omega.size(), omega.block_count()), (6, 1));
+/// assert!(omega.is_symmetric(1e-14));
+/// ```
+pub fn stiffness_metric(complex: &Complex, lame: &[Lame]) -> Result<BlockMetric, MetricError> {
+    let top = Topology::new(complex, "elasticity")?;
+    let (n, d) = (top.n, top.d);
+    let cells = complex.cell_count(n);
+    if lame.len() != cells {
+        return Err(MetricError::CoefficientCount {
+            count: lame.len(),
+            cells,
+        });
+    }
+    let edges = complex.cell_count(1);
+    let blocks = (0..cells)
+        .into_par_iter()
+        .map(|c| {
+            let points = fe::shape_gradients(&top, c)?.ok_or(MetricError::UnsupportedCell {
+                method: "elasticity",
+                needs: "a triangle, tetrahedron, quadrilateral or hexahedron (P1 or Q1)",
+                cell: c,
+            })?;
+            let m = complex.cell_vertices(n, c).len();
+            let Lame { lambda, mu } = lame[c];
+            let mut kc = DMatrix::zeros(d * m, d * m);
+            for (w, g) in &points {
+                for a in 0..d {
+                    for b in 0..d {
+                        for i in 0..m {
+                            for j in 0..m {
+                                let mut value = lambda * g[i][a] * g[j][b] + mu * g[i][b] * g[j][a];
+                                if a == b {
+                                    value += mu * (0..d).map(|k| g[i][k] * g[j][k]).sum::<f64>();
+                                }
+                                kc[(a * m + i, b * m + j)] += w * value;
+                            }
+                        }
+                    }
+                }
+            }
+            let cell_edges = top.edges_of(c);
+            let pinv =
+                fe::edge_pseudo_inverse(&top, c, &cell_edges, &mut Vec::new(), "elasticity")?;
+            let lift = DMatrix::<f64>::identity(d, d).kronecker(&*pinv);
+            let omega = lift.transpose() * kc * &lift;
+            let size = omega.nrows();
+            let rows: Vec<usize> = (0..d)
+                .flat_map(|a| cell_edges.iter().map(move |&e| a * edges + e))
+                .collect();
+            // Symmetric up to rounding; made exactly so.
+            let values: Vec<f64> = (0..size * size)
+                .map(|k| {
+                    let (i, j) = (k / size, k % size);
+                    0.5 * (omega[(i, j)] + omega[(j, i)])
+                })
+                .collect();
+            if values.iter().any(|v| !v.is_finite()) {
+                return Err(MetricError::UnsupportedCell {
+                    method: "elasticity",
+                    needs: "a non-degenerate cell (finite local stiffness)",
+                    cell: c,
+                });
+            }
+            Ok((rows, values))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut metric = BlockMetric::new(d * edges);
+    for (rows, values) in &blocks {
+        metric.push_symmetric(rows, values);
+    }
+    Ok(metric)
+}
+
+/// The rigid-body modes of the whole mesh, component-major like the
+/// unknowns: d translations, then the rotations about the vertex average
+/// (one in 2D; about the x, y and z axes in 3D).
+pub fn rigid_modes(complex: &Complex) -> Vec<Vec<f64>> {
+    let all: Vec<usize> = (0..complex.cell_count(0)).collect();
+    modes_on(complex, &all)
+}
+
+/// Rigid modes restricted to the vertices `part` (zero elsewhere).
+fn modes_on(complex: &Complex, part: &[usize]) -> Vec<Vec<f64>> {
+    let d = complex.embedding_dim();
+    let vertices = complex.cell_count(0);
+    let mut centre = [0.0; 3];
+    for &v in part {
+        for (a, x) in complex.vertices().point(v).iter().enumerate() {
+            centre[a] += x / part.len() as f64;
+        }
+    }
+    let mut modes = Vec::new();
+    for a in 0..d {
+        let mut m = vec![0.0; d * vertices];
+        for &v in part {
+            m[a * vertices + v] = 1.0;
+        }
+        modes.push(m);
+    }
+    // Rotation in the (p, q) plane: u_p = −x_q, u_q = x_p.
+    let planes: &[(usize, usize)] = if d == 2 {
+        &[(0, 1)]
+    } else {
+        &[(1, 2), (2, 0), (0, 1)]
+    };
+    for &(p, q) in planes {
+        let mut m = vec![0.0; d * vertices];
+        for &v in part {
+            let x = complex.vertices().point(v);
+            m[p * vertices + v] = -(x[q] - centre[q]);
+            m[q * vertices + v] = x[p] - centre[p];
+        }
+        modes.push(m);
+    }
+    modes
+}
+
+/// Connected parts of the edge graph, as vertex lists.
+fn parts(complex: &Complex) -> Vec<Vec<usize>> {
+    let vertices = complex.cell_count(0);
+    let mut parent: Vec<usize> = (0..vertices).collect();
+    fn root(parent: &mut [usize], mut v: usize) -> usize {
+        while parent[v] != v {
+            parent[v] = parent[parent[v]];
+            v = parent[v];
+        }
+        v
+    }
+    for e in 0..complex.cell_count(1) {
+        let ends = complex.cell_vertices(1, e);
+        let (a, b) = (root(&mut parent, ends[0]), root(&mut parent, ends[1]));
+        parent[a] = b;
+    }
+    let mut index = vec![usize::MAX; vertices];
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    for v in 0..vertices {
+        let r = root(&mut parent, v);
+        if index[r] == usize::MAX {
+            index[r] = out.len();
+            out.push(Vec::new());
+        }
+        out[index[r]].push(v);
+    }
+    out
+}
+
+/// Below this, a generalised eigenvalue of (modes on fixed unknowns, modes
+/// on all unknowns) is a free mode. The eigenvalues lie in [0, 1]; a mode
+/// held by a single vertex of a million still has about 1e-6, while one the
+/// constraints miss is zero to rounding (≈ 1e-30).
+const RIGID_TOLERANCE: f64 = 1e-12;
+
+/// Report the first part of the mesh whose prescribed components leave a
+/// rigid-body mode free.
+fn check_rigid_modes(complex: &Complex, fixed: &[Option<f64>]) -> Result<(), ElasticityError> {
+    for (part, vertices) in parts(complex).iter().enumerate() {
+        let modes = modes_on(complex, vertices);
+        let r = modes.len();
+        let gram = |held_only: bool| {
+            DMatrix::from_fn(r, r, |i, j| {
+                modes[i]
+                    .iter()
+                    .zip(&modes[j])
+                    .zip(fixed)
+                    .filter(|(_, g)| !held_only || g.is_some())
+                    .map(|((x, y), _)| x * y)
+                    .sum::<f64>()
+            })
+        };
+        let (held, all) = (gram(true), gram(false));
+        // A single vertex has no rotation (its modes are dependent): then
+        // the held translations decide alone.
+        let free = match all.clone().cholesky() {
+            Some(chol) => {
+                let l_inv = chol
+                    .l()
+                    .try_inverse()
+                    .unwrap_or_else(|| DMatrix::zeros(r, r));
+                let scaled = &l_inv * held * l_inv.transpose();
+                scaled
+                    .symmetric_eigenvalues()
+                    .iter()
+                    .filter(|&&e| e < RIGID_TOLERANCE)
+                    .count()
+            }
+            None => (0..complex.embedding_dim())
+                .filter(|&a| held[(a, a)] == 0.0)
+                .count(),
+        };
+        if free > 0 {
+            return Err(ElasticityError::RigidModes {
+                part,
+                free,
+                modes: r,
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,419 @@
+//! Re-solving on SPLIT-refined meshes: refine, move the solution to the
+//! refined complex through the chain map, solve again, report.
+//!
+//! Each step refines the current complex (uniformly, adaptively by an
+//! error indicator with Dörfler marking, or by a cell-division rule), moves
+//! the previous solution to the refined complex (nodal values interpolate
+//! on the new vertices; cell and face averages copy to their pieces), and
+//! solves the refined problem twice by conjugate gradients, from zero and
+//! from the transferred field, to report how many iterations the warm start
+//! saves. The direct solve is not repeated: CG to a tight tolerance is the
+//! refined solution.
+//!
+//! ```
+//! use hasse_solver::frontend::case::Case;
+//! use hasse_solver::refine::{refine_and_solve, RefineSpec, Strategy};
+//! let text = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nmethod = \"fe\"\nsource = \"2*pi^2*sin(pi*x)*sin(pi*y)\"\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n[exact]\nsolution = \"sin(pi*x)*sin(pi*y)\"\n";
+//! let case = Case::from_text("demo.toml", text, &[]).unwrap();
+//! let complex = case.build_mesh().unwrap();
+//! let spec = RefineSpec { strategy: Strategy::Uniform, steps: 2, ..RefineSpec::default() };
+//! let study = refine_and_solve(&case, &complex, &spec, &mut |_| {}).unwrap();
+//! assert_eq!(study.steps.len(), 3); // the coarse solve and two refinements
+//! assert_eq!(study.complex.cell_count(2), 16 * 16);
+//! let (coarse, fine) = (study.steps[0].l2.unwrap(), study.steps[2].l2.unwrap());
+//! assert!(fine < coarse / 8.0); // two halvings of h, second order
+//! ```
+
+use crate::frontend::case::{Case, Problem};
+use crate::frontend::run::{self, RunError};
+use crate::la::iterative::CgOptions;
+use crate::physics::diffusion::{self, Diffusion, Iterative, Location, Solution};
+use hasse_complex::refine;
+use hasse_complex::split::Refinement;
+use hasse_complex::Complex;
+use std::fmt;
+
+/// How each step refines.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Strategy {
+    /// Every top cell by the axis-aligned hyperplanes through its centroid.
+    Uniform,
+    /// The cells holding the fraction θ of the squared error indicator
+    /// (Dörfler marking), each split like a uniform step.
+    Adaptive { theta: f64 },
+    /// Every top cell divided once by the plane through its centroid normal
+    /// to its longest axis (growing tissue).
+    DivideLongestAxis,
+    /// Every top cell divided once along its shortest wall through the
+    /// centroid.
+    DivideShortestWall,
+}
+
+impl Strategy {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Strategy::Uniform => "uniform",
+            Strategy::Adaptive { .. } => "adaptive",
+            Strategy::DivideLongestAxis => "divide-longest-axis",
+            Strategy::DivideShortestWall => "divide-shortest-wall",
+        }
+    }
+}
+
+/// A refinement study's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefineSpec {
+    pub strategy: Strategy,
+    /// Refinement steps after the coarse solve.
+    pub steps: usize,
+    /// Tolerance of the conjugate-gradient solves on refined meshes.
+    pub tolerance: f64,
+}
+
+impl Default for RefineSpec {
+    fn default() -> Self {
+        Self {
+            strategy: Strategy::Uniform,
+            steps: 1,
+            tolerance: 1e-10,
+        }
+    }
+}
+
+/// What one level of the study found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepReport {
+    pub step: usize,
+    pub cells: Vec<usize>,
+    pub unknowns: usize,
+    /// Cells marked for refinement at the end of this step (adaptive).
+    pub marked: Option<usize>,
+    pub l2: Option<f64>,
+    pub max: Option<f64>,
+    pub gradient_l2: Option<f64>,
+    /// CG iterations from zero and from the transferred solution (refined
+    /// steps only).
+    pub cold_iterations: Option<usize>,
+    pub warm_iterations: Option<usize>,
+    /// Relative residual of the transferred solution on the refined system.
+    pub warm_initial_residual: Option<f64>,
+    pub seconds: f64,
+}
+
+/// The study's steps, the final complex and its solution.
+pub struct RefinementStudy {
+    pub steps: Vec<StepReport>,
+    /// Every level's complex and fields (`u`, and `u_exact`, `error` when
+    /// the case has an exact solution), for a time series whose mesh changes.
+    pub levels: Vec<(Complex, Vec<run::Field>)>,
+    pub complex: Complex,
+    pub result: run::RunResult,
+}
+
+fn input(e: impl fmt::Display) -> RunError {
+    RunError::Input(e.to_string())
+}
+
+/// Move a solution's unknowns to the refined complex: nodal values
+/// interpolate; cell values (and face values of the hybrid method) copy to
+/// their pieces; a face created by the cut takes the mean of its cells.
+fn transfer(
+    coarse: &Complex,
+    fine: &Complex,
+    refinement: &Refinement,
+    solution: &Solution,
+) -> Result<Vec<f64>, RunError> {
+    let n = coarse.dim();
+    let copy = |p: usize, values: &[f64]| -> Vec<f64> {
+        (0..fine.cell_count(p))
+            .map(|i| refinement.parent(p, i).map_or(f64::NAN, |(j, _)| values[j]))
+            .collect()
+    };
+    match solution.location {
+        Location::Nodal => refinement.nodal(&solution.values).map_err(input),
+        Location::CellCentred => Ok(copy(n, &solution.values)),
+        Location::Hybrid => {
+            let cells = coarse.cell_count(n);
+            let mut values = copy(n, &solution.values[..cells]);
+            let mut faces = copy(n - 1, &solution.values[cells..]);
+            let by_face = fine.boundary(n);
+            for (f, row) in by_face.outer_iterator().enumerate() {
+                if faces[f].is_nan() {
+                    let (sum, count) = row
+                        .iter()
+                        .fold((0.0, 0), |(s, c), (k, _)| (s + values[k], c + 1));
+                    faces[f] = if count > 0 { sum / count as f64 } else { 0.0 };
+                }
+            }
+            values.extend(faces);
+            Ok(values)
+        }
+    }
+}
+
+/// Residual-type indicator per top cell: η_c² = h_c² |c| f(x_c)² +
+/// ½ Σ_F |F| h_F ((g_c − g_c')·n_F)², the jumps of the cell-wise gradient
+/// across interior faces F (shared with c') plus the source residual.
+pub fn indicators(
+    complex: &Complex,
+    solution: &Solution,
+    source: &dyn Fn(&[f64]) -> f64,
+) -> Vec<f64> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let gradient = diffusion::reconstruct_gradient(complex, solution);
+    let volume = complex.measure(n);
+    let area = complex.measure(n - 1);
+    let centre = complex.centroid(n);
+    let normal = complex.normal();
+    let cells_by_face = complex.boundary(n);
+    let mut eta2: Vec<f64> = (0..complex.cell_count(n))
+        .map(|c| {
+            let h = volume[c].powf(1.0 / n as f64);
+            let f = source(&centre[c * d..(c + 1) * d]);
+            h * h * volume[c] * f * f
+        })
+        .collect();
+    for (face, row) in cells_by_face.outer_iterator().enumerate() {
+        if let [a, b] = row.indices() {
+            let jump: f64 = (0..d)
+                .map(|k| (gradient[*a][k] - gradient[*b][k]) * normal[face * d + k])
+                .sum();
+            let h_face = area[face].powf(1.0 / (n - 1).max(1) as f64);
+            let share = 0.5 * area[face] * h_face * jump * jump;
+            eta2[*a] += share;
+            eta2[*b] += share;
+        }
+    }
+    eta2.into_iter().map(f64::sqrt).collect()
+}
+
+/// Directions searched for the shortest wall: every 5° in 2D.
+const SHORTEST_WALL_DIRECTIONS: usize = 36;
+
+fn refine_once(
+    complex: &Complex,
+    strategy: Strategy,
+    eta: &[f64],
+) -> Result<(Complex, Refinement, Option<usize>), RunError> {
+    let all: Vec<usize> = (0..complex.cell_count(complex.dim())).collect();
+    match strategy {
+        Strategy::Uniform => refine::uniform(complex).map(|(k, r)| (k, r, None)),
+        Strategy::Adaptive { theta } => {
+            let marked = refine::dorfler_mark(eta, theta).map_err(input)?;
+            let count = marked.len();
+            refine::refine_marked(complex, &marked).map(|(k, r)| (k, r, Some(count)))
+        }
+        Strategy::DivideLongestAxis => {
+            refine::divide_longest_axis(complex, &all).map(|(k, r)| (k, r, None))
+        }
+        Strategy::DivideShortestWall => {
+            refine::divide_shortest_wall(complex, &all, SHORTEST_WALL_DIRECTIONS)
+                .map(|(k, r)| (k, r, None))
+        }
+    }
+    .map_err(input)
+}
+
+fn diffusion_of(case: &Case) -> Result<Diffusion, RunError> {
+    match &case.problem {
+        Problem::Diffusion(spec) => Ok(run::diffusion_problem(case, spec)),
+        other => Err(RunError::Input(format!(
+            "refinement re-solves diffusion problems; this case is kind = \"{}\"",
+            other.kind()
+        ))),
+    }
+}
+
+/// The primary field of a level and, with an exact solution, its error.
+fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<run::Field> {
+    let dim = match solution.location {
+        Location::Nodal => 0,
+        _ => complex.dim(),
+    };
+    let u = solution.field(complex).to_vec();
+    let mut fields = Vec::new();
+    if let Some(solution_fn) = case.exact.as_ref().and_then(|e| e.solution.as_ref()) {
+        let points: Vec<Vec<f64>> = match &solution.cell_points {
+            Some(given) => given
+                .chunks(complex.embedding_dim())
+                .map(<[f64]>::to_vec)
+                .collect(),
+            None => run::field_points(complex, dim),
+        };
+        let exact_values: Vec<f64> = points.iter().map(|x| solution_fn.eval(x, 0.0)).collect();
+        let error = u.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
+        fields.push(run::Field {
+            name: "u_exact".into(),
+            dim,
+            values: exact_values,
+            description: "the exact solution".into(),
+        });
+        fields.push(run::Field {
+            name: "error".into(),
+            dim,
+            values: error,
+            description: "u − u_exact".into(),
+        });
+    }
+    fields.insert(
+        0,
+        run::Field {
+            name: "u".into(),
+            dim,
+            values: u,
+            description: "the solution on this level".into(),
+        },
+    );
+    fields
+}
+
+fn report(
+    step: usize,
+    complex: &Complex,
+    case: &Case,
+    solution: &Solution,
+    seconds: f64,
+) -> StepReport {
+    let errors = case.exact.as_ref().and_then(|exact| {
+        let u = run::scalar_fn(exact.solution.as_ref()?);
+        let grad = exact.gradient.as_ref().map(|g| run::vector_fn(g));
+        Some(diffusion::errors(complex, solution, &u, grad.as_ref()))
+    });
+    StepReport {
+        step,
+        cells: complex.cell_counts(),
+        unknowns: solution.unknowns(),
+        marked: None,
+        l2: errors.map(|e| e.l2),
+        max: errors.map(|e| e.max),
+        gradient_l2: errors.map(|e| e.gradient_l2).filter(|g| g.is_finite()),
+        cold_iterations: None,
+        warm_iterations: None,
+        warm_initial_residual: None,
+        seconds,
+    }
+}
+
+/// Solve the case on `complex`, then refine `spec.steps` times, re-solving
+/// after each step; `phase` hears about each step.
+pub fn refine_and_solve(
+    case: &Case,
+    complex: &Complex,
+    spec: &RefineSpec,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RefinementStudy, RunError> {
+    let problem = diffusion_of(case)?;
+    let source = problem.source.clone();
+    let solve_error = |e: diffusion::DiffusionError| RunError::Solve(e.to_string());
+    phase("step 0: solving on the initial mesh");
+    let started = std::time::Instant::now();
+    let mut current = complex.clone();
+    let mut solution = problem.solve(&current).map_err(solve_error)?;
+    let mut steps = vec![report(
+        0,
+        &current,
+        case,
+        &solution,
+        started.elapsed().as_secs_f64(),
+    )];
+    let mut levels = vec![(current.clone(), level_fields(case, &current, &solution))];
+    for step in 1..=spec.steps {
+        phase(&format!("step {step}: refining ({})", spec.strategy.name()));
+        let started = std::time::Instant::now();
+        let eta = match spec.strategy {
+            Strategy::Adaptive { .. } => indicators(&current, &solution, &*source),
+            _ => Vec::new(),
+        };
+        let (fine, refinement, marked) = refine_once(&current, spec.strategy, &eta)?;
+        if let Some(last) = steps.last_mut() {
+            last.marked = marked;
+        }
+        let guess = transfer(&current, &fine, &refinement, &solution)?;
+        phase(&format!(
+            "step {step}: solving on {} cells",
+            fine.cell_count(fine.dim())
+        ));
+        let options = CgOptions {
+            tolerance: spec.tolerance,
+            max_iterations: 100_000,
+        };
+        let mut cold_problem = problem.clone();
+        cold_problem.iterative = Some(Iterative {
+            options,
+            initial: None,
+            ..Iterative::default()
+        });
+        let cold = cold_problem.solve(&fine).map_err(solve_error)?;
+        let mut warm_problem = problem.clone();
+        warm_problem.iterative = Some(Iterative {
+            options,
+            initial: Some(guess),
+            ..Iterative::default()
+        });
+        let warm = warm_problem.solve(&fine).map_err(solve_error)?;
+        let mut r = report(step, &fine, case, &warm, started.elapsed().as_secs_f64());
+        r.cold_iterations = cold.iterations.map(|c| c.iterations);
+        r.warm_iterations = warm.iterations.map(|c| c.iterations);
+        r.warm_initial_residual = warm.iterations.map(|c| c.initial_residual);
+        steps.push(r);
+        levels.push((fine.clone(), level_fields(case, &fine, &warm)));
+        current = fine;
+        solution = warm;
+    }
+    phase("post-processing the final mesh");
+    let result = run::solve(case, &current, &mut |_| {})?;
+    Ok(RefinementStudy {
+        steps,
+        levels,
+        complex: current,
+        result,
+    })
+}
+
+impl fmt::Display for StepReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let top = self.cells.last().copied().unwrap_or(0);
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.4e}"));
+        let count = |v: Option<usize>| v.map_or("-".to_string(), |x| x.to_string());
+        write!(
+            f,
+            "{:>4} {:>9} {:>9} {:>11} {:>11} {:>11} {:>6} {:>6} {:>9}",
+            self.step,
+            top,
+            self.unknowns,
+            opt(self.l2),
+            opt(self.max),
+            opt(self.gradient_l2),
+            count(self.cold_iterations),
+            count(self.warm_iterations),
+            count(self.marked),
+        )
+    }
+}
+
+/// The header matching [`StepReport`]'s `Display`.
+pub const TABLE_HEADER: &str =
+    "step     cells  unknowns    L2 error   max error  grad error   cold   warm    marked";
+
+/// The steps as JSON (stored in the output's provenance report).
+pub fn steps_json(steps: &[StepReport]) -> serde_json::Value {
+    steps
+        .iter()
+        .map(|s| {
+            serde_json::json!({
+                "step": s.step,
+                "cells": s.cells,
+                "unknowns": s.unknowns,
+                "marked": s.marked,
+                "l2": s.l2,
+                "max": s.max,
+                "gradient_l2": s.gradient_l2,
+                "cold_iterations": s.cold_iterations,
+                "warm_iterations": s.warm_iterations,
+                "warm_initial_residual": s.warm_initial_residual,
+                "seconds": s.seconds,
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,153 @@
+//! The study as one plain-text table: a row per method and level, a
+//! least-squares row per method, the orders next to their errors.
+
+use super::{Norm, StudyResult};
+use std::fmt;
+
+fn resolution(r: &[usize]) -> String {
+    r.iter().map(usize::to_string).collect::<Vec<_>>().join("×")
+}
+
+fn order(p: Option<f64>) -> String {
+    // A slope that rounds to zero prints as 0.00, not -0.00.
+    match p.map(|p| format!("{p:.2}")) {
+        None => "-".to_string(),
+        Some(s) if s == "-0.00" => "0.00".to_string(),
+        Some(s) => s,
+    }
+}
+
+impl fmt::Display for StudyResult {
+    /// ```
+    /// use hasse_solver::study::{Refinement, StudyResult, StudyRow};
+    /// let row = |level: usize, h: f64, l2: f64| StudyRow {
+    ///     method: "fd".into(), level, resolution: vec![8 << level, 8 << level], h, cells: 64 << (2 * level),
+    ///     unknowns: 64 << (2 * level), l2, max: 2.0 * l2, gradient_l2: None, flux: Some(10.0 * l2.sqrt()),
+    ///     mesh_seconds: 0.001, solve_seconds: 0.01,
+    /// };
+    /// let result = StudyResult {
+    ///     case: "demo.toml".into(), title: None, refinement: Refinement::Uniform, levels: 2,
+    ///     methods: vec!["fd".into()], rows: vec![row(0, 0.2, 4e-2), row(1, 0.1, 1e-2)],
+    /// };
+    /// let table = result.to_string();
+    /// assert!(table.contains("fd         1  16×16"));
+    /// assert!(table.contains("least squares"));
+    /// assert!(table.contains("2.00")); // L² order
+    /// assert!(table.contains("1.00")); // flux order
+    /// ```
+    fn fmt(&self, out: &mut fmt::Formatter<'_>) -> fmt::Result {
+        // Built whole, then written line by line without trailing blanks
+        // (columns a method lacks would otherwise leave them).
+        let mut text = String::new();
+        self.write_table(&mut text)?;
+        for line in text.lines() {
+            writeln!(out, "{}", line.trim_end())?;
+        }
+        Ok(())
+    }
+}
+
+impl StudyResult {
+    fn write_table(&self, f: &mut String) -> fmt::Result {
+        use std::fmt::Write;
+        match &self.title {
+            Some(t) => writeln!(f, "case     {} ({t})", self.case)?,
+            None => writeln!(f, "case     {}", self.case)?,
+        }
+        writeln!(
+            f,
+            "study    {} level{}, {} refinement; h = largest top-cell diameter; p = observed order (from the previous level; least squares over all levels)",
+            self.levels,
+            if self.levels == 1 { "" } else { "s" },
+            self.refinement.name()
+        )?;
+        let norms: Vec<Norm> = Norm::ALL
+            .into_iter()
+            .filter(|&n| self.rows.iter().any(|r| r.error(n).is_some()))
+            .collect();
+        let method_width = self
+            .methods
+            .iter()
+            .map(|m| m.len())
+            .chain([6])
+            .max()
+            .unwrap_or(6);
+        let resolution_width = self
+            .rows
+            .iter()
+            .map(|r| resolution(&r.resolution).chars().count())
+            .chain([10])
+            .max()
+            .unwrap_or(10);
+        let norm_title = |n: Norm| match n {
+            Norm::L2 => "L² error",
+            Norm::Max => "max error",
+            Norm::GradientL2 => "gradient L²",
+            Norm::Flux => "flux error",
+        };
+        write!(
+            f,
+            "\n{:<mw$} {:>5}  {:<rw$} {:>10} {:>9}",
+            "method",
+            "level",
+            "resolution",
+            "h",
+            "unknowns",
+            mw = method_width,
+            rw = resolution_width
+        )?;
+        for &n in &norms {
+            write!(f, "  {:>11} {:>5}", norm_title(n), "p")?;
+        }
+        writeln!(f, "  {:>9}", "seconds")?;
+        for method in &self.methods {
+            let orders: Vec<_> = norms.iter().map(|&n| self.orders(method, n)).collect();
+            for row in self.method_rows(method) {
+                write!(
+                    f,
+                    "{:<mw$} {:>5}  {:<rw$} {:>10.4e} {:>9}",
+                    method,
+                    row.level,
+                    resolution(&row.resolution),
+                    row.h,
+                    row.unknowns,
+                    mw = method_width,
+                    rw = resolution_width
+                )?;
+                for (&n, o) in norms.iter().zip(&orders) {
+                    match row.error(n) {
+                        Some(e) => {
+                            let p = if row.level == 0 {
+                                "-".to_string()
+                            } else {
+                                order(o.pairwise.get(row.level - 1).copied().flatten())
+                            };
+                            write!(f, "  {e:>11.4e} {p:>5}")?;
+                        }
+                        None => write!(f, "  {:>11} {:>5}", "", "")?,
+                    }
+                }
+                writeln!(f, "  {:>9.3}", row.solve_seconds)?;
+            }
+            if self.levels >= 2 {
+                let label = format!("{method} least squares");
+                write!(
+                    f,
+                    "{:<w$}",
+                    label,
+                    w = method_width + 6 + 2 + resolution_width + 11 + 10
+                )?;
+                for o in &orders {
+                    let p = if self.method_rows(method).all(|r| r.error(o.norm).is_some()) {
+                        order(o.least_squares)
+                    } else {
+                        String::new()
+                    };
+                    write!(f, "  {:>11} {p:>5}", "")?;
+                }
+                writeln!(f)?;
+            }
+        }
+        Ok(())
+    }
+}
