@@ -73,8 +73,9 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::{Mat, Side};
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
-use hasse_solver::la::direct::{relative_residual, DirectSolver, Factorization, Ordering};
+use hasse_solver::la::direct::{relative_residual, DirectSolver, Factorization};
 use hasse_solver::la::iterative::CgOptions;
+use hasse_solver::la::ordering::Ordering;
 use hasse_solver::multigrid::{CellProlongation, Hierarchy, MultigridOptions};
 use hasse_solver::physics::diffusion::{
     solve_with_fixed, Assembled, BoundaryKind, Conductivity, Diffusion, Iterative, Method,

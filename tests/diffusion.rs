@@ -676,7 +676,8 @@ fn analysis_beside_the_assembly_gives_the_plain_solution() {
         Location::Nodal => lumped_vertex_volumes(mesh),
         _ => mesh.measure(mesh.dim()).to_vec(),
     };
-    use hasse_solver::la::direct::{Factorization, Ordering};
+    use hasse_solver::la::direct::Factorization;
+    use hasse_solver::la::ordering::Ordering;
     use hasse_solver::physics::diffusion::solve_with_fixed;
     let u = scalar(|x| x[0] * x[0] + 3.0 * x[1] + x[0] * x[1]);
     let mixed = |method: Method| {

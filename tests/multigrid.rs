@@ -12,8 +12,9 @@ use hasse_complex::generate::{box3, delaunay, kuhn, rectangle, uniform_axis};
 use hasse_complex::refine::uniform;
 use hasse_complex::split::Refinement;
 use hasse_complex::Complex;
-use hasse_solver::la::direct::{Factorization, Ordering};
+use hasse_solver::la::direct::Factorization;
 use hasse_solver::la::iterative::{CgError, CgOptions, Preconditioner, RowMatrix};
+use hasse_solver::la::ordering::Ordering;
 use hasse_solver::multigrid::{Hierarchy, Multigrid, MultigridError, MultigridOptions};
 use hasse_solver::physics::diffusion::{
     solve_with_fixed, BoundaryKind, Conductivity, Diffusion, DiffusionError, Iterative, Method,

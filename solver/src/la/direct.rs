@@ -26,7 +26,7 @@ use faer::{Conj, Mat, Par, Side};
 use std::sync::Arc;
 use std::time::Instant;
 
-use crate::la::ordering::{self, OrderingError};
+use crate::la::ordering::{self, Ordering, OrderingError, UnknownPoints, ND_MIN_FILL_PER_UNKNOWN};
 
 /// Which factorisation to use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,134 +56,6 @@ impl std::fmt::Display for Factorization {
         })
     }
 }
-
-/// The fill-reducing ordering of a symmetric (LLᵀ, LDLᵀ, LBLᵀ) analysis.
-/// LU ignores it: faer orders LU's columns by COLAMD.
-///
-/// ```
-/// use faer::sparse::{SparseColMat, Triplet};
-/// use hasse_solver::la::direct::{DirectSolver, Factorization, Ordering};
-/// // The seven-point Laplacian on a 12³ grid.
-/// let m = 12;
-/// let id = |i: usize, j: usize, k: usize| i + m * (j + m * k);
-/// let mut t = Vec::new();
-/// for k in 0..m { for j in 0..m { for i in 0..m {
-///     t.push(Triplet::new(id(i, j, k), id(i, j, k), 6.0));
-///     for (a, b) in [(i + 1, j), (i, j + 1)].into_iter().filter(|&(a, b)| a < m && b < m) {
-///         t.push(Triplet::new(id(a, b, k), id(i, j, k), -1.0));
-///         t.push(Triplet::new(id(i, j, k), id(a, b, k), -1.0));
-///     }
-///     if k + 1 < m {
-///         t.push(Triplet::new(id(i, j, k + 1), id(i, j, k), -1.0));
-///         t.push(Triplet::new(id(i, j, k), id(i, j, k + 1), -1.0));
-///     }
-/// }}}
-/// let n = m * m * m;
-/// let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
-/// let nd = DirectSolver::analyse_with(a.as_ref(), Factorization::Llt, Ordering::NestedDissection).unwrap();
-/// let x = nd.factorize(a.as_ref()).unwrap().solve(&vec![1.0; n]).unwrap();
-/// assert_eq!(nd.ordering(), Some(Ordering::NestedDissection));
-/// assert!(x.iter().all(|v| v.is_finite() && *v > 0.0));
-/// ```
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Ordering {
-    /// For LLᵀ with the unknowns' positions ([`UnknownPoints`], which
-    /// [`crate::physics::diffusion`] gives): geometric nested dissection. Without
-    /// them: AMD, or METIS nested dissection for LLᵀ systems on which AMD
-    /// fills at least [`ND_MIN_FILL_PER_UNKNOWN`] entries per unknown (3D
-    /// meshes from a few 10⁴ unknowns; see there). LDLᵀ and LBLᵀ: AMD.
-    ///
-    /// Why the positions win, measured on whole `Diffusion::solve` runs
-    /// (`HASSE_BENCH_ORDERING=amd|nd|geometric cargo bench --bench
-    /// multigrid -- CASE PHASE`, release, 2 cores; seconds for the
-    /// analysis (ordering included) and the numeric factorisation):
-    ///
-    /// | case | AMD | METIS ND | geometric |
-    /// |---|---|---|---|
-    /// | 2D 1000² five-point FV (`2d-1000 solve`) | 0.58 + 1.00 | — | 0.42 + 1.19 |
-    /// | 2D 1000² nine-point Q1 (`2d-1000 q1-solve`) | 0.66 + 2.03 | — | 0.52 + 1.09 |
-    /// | Delaunay P1, 5·10⁵ (`delaunay-1m solve`) | 0.77 + 0.57 | — | 0.27 + 0.63 |
-    /// | 3D 60³ seven-point FV (`3d-60 solve`) | — | 1.44 + 2.42 | 0.23 + 2.89 |
-    /// | 3D 60³ Q1 (`3d-60 q1-solve`) | — | 2.22 + 4.54 | 0.36 + 4.86 |
-    ///
-    /// The table predates the diagonal cuts of
-    /// [`crate::la::ordering::coordinate_dissection`]. With them, two runs on
-    /// a slower day gave 0.87 + 1.14 and 0.88 + 1.29 s on the five-point
-    /// grid (factor 44.4 M entries instead of 68.4 M), against plain
-    /// faer's AMD analysis and factorisation of 2.68 and 3.08 s in
-    /// between, and 0.39 + 2.37 and 0.37 + 1.84 s on the seven-point one.
-    ///
-    /// Factorisation work Σ c_j² ([`DirectSolver::factor_flops`]) against
-    /// AMD: 0.53× on the five-point grid, 0.35× on the nine-point one; on
-    /// 3D grids 0.51× METIS's (seven-point) and 1.0× (Q1). The analysis
-    /// costs a third to a tenth of AMD's or METIS's, which is what the
-    /// whole solve saves where the factor is no smaller.
-    #[default]
-    Automatic,
-    /// faer's approximate minimum degree.
-    Amd,
-    /// METIS nested dissection ([`crate::la::ordering::nested_dissection`]).
-    NestedDissection,
-    /// Nested dissection from the unknowns' positions
-    /// ([`crate::la::ordering::coordinate_dissection`]); needs
-    /// [`UnknownPoints`] ([`DirectSolver::analyse_pattern_at`]).
-    Geometric,
-}
-
-/// Where a system's unknowns sit, for the geometric ordering: `dimension`
-/// coordinates per unknown, unknown after unknown (vertices for nodal
-/// unknowns, a point inside each cell for cell-centred ones).
-#[derive(Clone, Copy, Debug)]
-pub struct UnknownPoints<'a> {
-    pub coordinates: &'a [f64],
-    pub dimension: usize,
-}
-
-impl std::fmt::Display for Ordering {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            Ordering::Automatic => "automatic",
-            Ordering::Amd => "AMD",
-            Ordering::NestedDissection => "nested dissection (METIS)",
-            Ordering::Geometric => "geometric nested dissection",
-        })
-    }
-}
-
-/// AMD fill, in factor entries per unknown, from which
-/// [`Ordering::Automatic`] tries nested dissection for an LLᵀ analysis.
-///
-/// The rule, by measurement rather than by size: analyse with AMD (cheap);
-/// if the factor stores at least this many entries per unknown, analyse
-/// again with METIS nested dissection and keep whichever factor is smaller.
-/// LDLᵀ and LBLᵀ keep AMD unless asked: unpivoted LDLᵀ and LBLᵀ pivoting
-/// within supernodes are only as stable as their pivot order allows, and
-/// [`crate::physics::darcy`] relies on the order it gets.
-///
-/// Measured with `cargo bench --bench multigrid -- CASE amd|nd` (release,
-/// the 5-/7-point Laplacian and P1 on a jittered Delaunay mesh, 2 cores
-/// shared with other work; analysis + numeric factorisation in seconds,
-/// two runs each; entries = values stored for L):
-///
-/// | case | n | AMD s | ND s | AMD entries/n | ND entries/n |
-/// |---|---|---|---|---|---|
-/// | 2D 100² | 10⁴ | 0.011 | 0.033 | 21 | 20 |
-/// | 2D 300² | 9·10⁴ | 0.14–0.17 | 0.45 | 42 | 33 |
-/// | 2D 1000² | 10⁶ | 2.4–2.8 | 6.8–7.4 | 55 | 42 |
-/// | Delaunay P1 | 5·10⁵ | 1.7–2.4 | 3.4–4.3 | 68 | 47 |
-/// | 3D 20³ | 8·10³ | 0.04 | 0.06–0.07 | 143 | 91 |
-/// | 3D 40³ | 6.4·10⁴ | 0.87–1.38 | 0.86–0.96 | 414 | 281 |
-/// | 3D 60³ | 2.2·10⁵ | 10.9–18.8 | 5.5–9.2 | 912 | 498 |
-///
-/// (The spread is other work on the machine; the entries are exact.) The
-/// automatic rule adds AMD's analysis (0.7 s at 60³) to nested
-/// dissection's. In 2D the factorisation is cheap and METIS's own time
-/// (4 s of the 6.8 s at 1000²) outweighs the smaller factor, so size alone
-/// would be the wrong rule; AMD's fill per unknown separates the 2D-like
-/// graphs (≤ 68) from the 3D ones that gain (≥ 414), and the threshold
-/// sits between 143 (3D 20³, where ND's analysis costs more than it
-/// saves) and 414.
-pub const ND_MIN_FILL_PER_UNKNOWN: usize = 300;
 
 /// Why a solve failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -376,7 +248,8 @@ impl DirectSolver {
     ///
     /// ```
     /// use faer::sparse::{SparseColMat, Triplet};
-    /// use hasse_solver::la::direct::{DirectSolver, Factorization, Ordering};
+    /// use hasse_solver::la::direct::{DirectSolver, Factorization};
+    /// use hasse_solver::la::ordering::Ordering;
     /// // tridiag(−1, 2, −1), n = 5, stored whole.
     /// let mut t = Vec::new();
     /// for i in 0..5 {
@@ -407,7 +280,8 @@ impl DirectSolver {
     ///
     /// ```
     /// use faer::sparse::{SparseColMat, Triplet};
-    /// use hasse_solver::la::direct::{DirectSolver, Factorization, Ordering};
+    /// use hasse_solver::la::direct::{DirectSolver, Factorization};
+    /// use hasse_solver::la::ordering::Ordering;
     ///
     /// let a = SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &[
     ///     Triplet::new(0, 0, 2.0), Triplet::new(1, 0, -1.0),
@@ -432,7 +306,9 @@ impl DirectSolver {
     ///
     /// ```
     /// use faer::sparse::{SparseColMat, Triplet};
-    /// use hasse_solver::la::direct::{DirectSolver, Factorization, Ordering, UnknownPoints};
+    /// use hasse_solver::la::direct::{DirectSolver, Factorization};
+    /// use hasse_solver::la::ordering::Ordering;
+    /// use hasse_solver::la::ordering::UnknownPoints;
     /// // tridiag(−1, 2, −1) on 100 unknowns at x = 0, 1, …, 99.
     /// let n = 100;
     /// let mut t = Vec::new();

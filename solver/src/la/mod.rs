@@ -5,3 +5,4 @@ pub mod direct;
 pub mod eigen;
 pub mod iterative;
 pub mod ordering;
+pub(crate) mod parallel;

@@ -528,7 +528,7 @@ impl DarcySystem {
         }
         let report = SolveReport {
             factorization: Factorization::Ldlt,
-            // The constrained ordering above, not one of direct::Ordering.
+            // The constrained ordering above, not one of ordering::Ordering.
             ordering: None,
             unknowns: size,
             nonzeros: a.compute_nnz(),

@@ -33,7 +33,8 @@
 //! (d translations, d(d−1)/2 rotations) of every connected part of the
 //! mesh; a problem that leaves one free is reported, not sent to LLᵀ.
 
-use crate::la::direct::{Factorization, Ordering, SolveError, SolveReport};
+use crate::la::direct::{Factorization, SolveError, SolveReport};
+use crate::la::ordering::Ordering;
 use crate::metric::fe::{self, Topology};
 use crate::metric::MetricError;
 use crate::operator::{BlockMetric, Canonical, CanonicalError};

@@ -17,7 +17,8 @@
 //! order, L-stable), θ = ½ Crank–Nicolson (second order, A-stable).
 
 use crate::frontend::output::{Cochain, Step};
-use crate::la::direct::{DirectSolver, Factorization, Ordering, SolveError};
+use crate::la::direct::{DirectSolver, Factorization, SolveError};
+use crate::la::ordering::Ordering;
 use crate::physics::diffusion::{
     lumped_vertex_volumes, BoundaryKind, Conductivity, Diffusion, DiffusionError, Location, Method,
     ScalarFn,

@@ -39,7 +39,8 @@ mod reader;
 pub use diagnostic::{Diagnostic, Diagnostics};
 
 use crate::frontend::mesh_spec::{MeshError, MeshSpec};
-use crate::la::direct::{Factorization, Ordering};
+use crate::la::direct::Factorization;
+use crate::la::ordering::Ordering;
 use crate::multigrid::CellProlongation;
 use crate::physics::diffusion::Method;
 use diagnostic::Collector;

@@ -26,7 +26,8 @@
 use crate::frontend::case::{
     BoundaryKindSpec, Case, Coefficient, DiffusionSpec, GradientMetric, GradientSpec, Problem,
 };
-use crate::la::direct::{Factorization, Ordering};
+use crate::la::direct::Factorization;
+use crate::la::ordering::Ordering;
 use crate::metric::Tensor;
 use crate::physics::diffusion::{
     self, BoundaryKind, Conductivity, Diffusion, DiffusionError, Errors, Location, ScalarFn,

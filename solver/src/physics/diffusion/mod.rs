@@ -22,10 +22,10 @@
 //! the data are checked for compatibility (Σ sources + Σ boundary fluxes
 //! = 0 up to quadrature error), and the solution with zero mean is returned.
 
-use crate::la::direct::{
-    self, DirectSolver, Factorization, Ordering, SolveError, SolveReport, UnknownPoints,
-};
+use crate::la::direct::{self, DirectSolver, Factorization, SolveError, SolveReport};
 use crate::la::iterative::{conjugate_gradient, CgError, CgOptions, CgReport, RowMatrix};
+use crate::la::ordering::Ordering;
+use crate::la::ordering::UnknownPoints;
 use crate::metric::{self, dec, fd, fe, fv, CellTensors, MetricError, Tensor};
 use crate::multigrid::{
     self, CellProlongation, Hierarchy, Multigrid, MultigridError, MultigridOptions, SolverChoice,
@@ -888,7 +888,7 @@ impl Diffusion {
         let n = complex.dim();
         let d = complex.embedding_dim();
         let cells = complex.cell_count(n);
-        let mut rhs = crate::operator::zeroed(unknowns);
+        let mut rhs = crate::la::parallel::zeroed(unknowns);
         match self.method {
             Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x))?,
             Method::Dec(kind) => rhs = dec::load(complex, kind, &|x| (self.source)(x))?,
@@ -1459,7 +1459,7 @@ fn apply_at_unknown(
 pub fn lumped_vertex_volumes(complex: &Complex) -> Vec<f64> {
     let n = complex.dim();
     let volume = complex.measure(n);
-    let mut w = crate::operator::zeroed(complex.cell_count(0));
+    let mut w = crate::la::parallel::zeroed(complex.cell_count(0));
     for (c, &vol) in volume.iter().enumerate() {
         let verts = complex.cell_vertices(n, c);
         for &v in verts {
@@ -1715,9 +1715,9 @@ fn free_block(
             .map(|(&i, &v)| (free_index[i], v))
     };
     let size = free.len();
-    let parts = crate::operator::ranges(size);
+    let parts = crate::la::parallel::ranges(size);
     let mut col_ptr = vec![0usize; size + 1];
-    let counts = crate::operator::split_at_ranges(&mut col_ptr[1..], &parts, |k| k);
+    let counts = crate::la::parallel::split_at_ranges(&mut col_ptr[1..], &parts, |k| k);
     parts.par_iter().zip(counts).for_each(|(range, counts)| {
         for (k, count) in range.clone().zip(counts) {
             *count = kept_rows(free[k]).count();
@@ -1728,8 +1728,8 @@ fn free_block(
     }
     let mut row_idx = vec![0usize; col_ptr[size]];
     let mut val = vec![0.0; col_ptr[size]];
-    let row_pieces = crate::operator::split_at_ranges(&mut row_idx, &parts, |k| col_ptr[k]);
-    let val_pieces = crate::operator::split_at_ranges(&mut val, &parts, |k| col_ptr[k]);
+    let row_pieces = crate::la::parallel::split_at_ranges(&mut row_idx, &parts, |k| col_ptr[k]);
+    let val_pieces = crate::la::parallel::split_at_ranges(&mut val, &parts, |k| col_ptr[k]);
     parts
         .par_iter()
         .zip(row_pieces.into_par_iter().zip(val_pieces))

@@ -9,7 +9,8 @@ use super::{
     GradientSpec, OutputSpec, Problem, SolverKind, SolverSpec,
 };
 use crate::frontend::mesh_spec::MeshSpec;
-use crate::la::direct::{Factorization, Ordering};
+use crate::la::direct::Factorization;
+use crate::la::ordering::Ordering;
 use crate::multigrid::CellProlongation;
 use crate::physics::diffusion::Method;
 use crate::refine::{RefineSpec, Strategy};

@@ -1,0 +1,166 @@
+//! Lowest-order virtual elements on polygons and polyhedra: moments of
+//! the cell and the projected stiffness.
+
+use super::*;
+
+pub(super) fn sub(a: &Point, b: &Point) -> Point {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(super) fn dot(a: &Point, b: &Point) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(super) fn cross(a: &Point, b: &Point) -> Point {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(super) fn average(points: impl ExactSizeIterator<Item = Point>) -> Point {
+    let count = points.len() as f64;
+    let mut sum = [0.0; 3];
+    for p in points {
+        for i in 0..3 {
+            sum[i] += p[i];
+        }
+    }
+    sum.map(|s| s / count)
+}
+
+/// ∫_∂c φ_i n for every vertex of a polygon (exact: φ_i is linear on each
+/// edge) and the polygon's area, both from the outward edge normals.
+pub(super) fn polygon_moments(
+    top: &Topology,
+    c: usize,
+    x: &[Point],
+    centre: &Point,
+) -> Result<(Vec<Point>, f64), MetricError> {
+    let vertices = top.complex.cell_vertices(2, c);
+    let mut moments = vec![[0.0; 3]; x.len()];
+    let mut area = 0.0;
+    for e in top.edges_of(c) {
+        let (a, b) = top.local_ends(e, vertices, c)?;
+        let t = sub(&x[b], &x[a]);
+        let mid = [0.5 * (x[a][0] + x[b][0]), 0.5 * (x[a][1] + x[b][1]), 0.0];
+        let mut normal = [t[1], -t[0], 0.0];
+        if dot(&normal, &sub(&mid, centre)) < 0.0 {
+            normal = normal.map(|v| -v);
+        }
+        for i in [a, b] {
+            for (mi, ni) in moments[i].iter_mut().zip(&normal) {
+                *mi += 0.5 * ni;
+            }
+        }
+        area += 0.5 * dot(&sub(&mid, centre), &normal);
+    }
+    Ok((moments, area))
+}
+
+/// ∫_∂c φ_i n for every vertex of a polyhedron and its volume, over the
+/// faces split into fans of triangles about their vertex averages, with the
+/// vertex rule on each triangle (exact for functions linear on it).
+pub(super) fn polyhedron_moments(
+    top: &Topology,
+    c: usize,
+    x: &[Point],
+    centre: &Point,
+) -> Result<(Vec<Point>, f64), MetricError> {
+    let vertices = top.complex.cell_vertices(3, c);
+    let mut moments = vec![[0.0; 3]; x.len()];
+    let mut volume = 0.0;
+    for &f in top.facets_of(3, c).0 {
+        let face: Vec<usize> = top
+            .complex
+            .cell_vertices(2, f)
+            .iter()
+            .map(|v| {
+                vertices
+                    .binary_search(v)
+                    .map_err(|_| MetricError::UnsupportedMesh {
+                        method: "VEM",
+                        needs: "cells whose faces use their own vertices",
+                        detail: format!("face {f} of top cell {c} has a vertex outside the cell"),
+                    })
+            })
+            .collect::<Result<_, _>>()?;
+        let apex = average(face.iter().map(|&i| x[i]));
+        // Fan triangles (apex, tail, head), all turning the face's way.
+        let (edges, signs) = top.facets_of(2, f);
+        let mut fan = Vec::with_capacity(edges.len());
+        let mut total = [0.0; 3];
+        for (&e, &s) in edges.iter().zip(signs) {
+            let (a, b) = top.local_ends(e, vertices, c)?;
+            let (t, h) = if s > 0 { (a, b) } else { (b, a) };
+            let area = cross(&sub(&x[t], &apex), &sub(&x[h], &apex)).map(|v| 0.5 * v);
+            for i in 0..3 {
+                total[i] += area[i];
+            }
+            fan.push((t, h, area));
+        }
+        let outward = match dot(&total, &sub(&apex, centre)) {
+            s if s > 0.0 => 1.0,
+            s if s < 0.0 => -1.0,
+            _ => {
+                return Err(MetricError::UnsupportedCell {
+                    method: "VEM",
+                    needs: "a convex polyhedron (a face is edge-on to the cell centre)",
+                    cell: c,
+                })
+            }
+        };
+        let share = 1.0 / (3 * face.len()) as f64;
+        for (t, h, area) in fan {
+            let area = area.map(|v| outward * v);
+            for i in 0..3 {
+                moments[t][i] += area[i] / 3.0;
+                moments[h][i] += area[i] / 3.0;
+                for &j in &face {
+                    moments[j][i] += area[i] * share;
+                }
+            }
+            let centroid = average([apex, x[t], x[h]].into_iter());
+            volume += dot(&sub(&centroid, centre), &area) / 3.0;
+        }
+    }
+    Ok((moments, volume))
+}
+
+pub(super) fn vem_stiffness(
+    top: &Topology,
+    c: usize,
+    k: &Tensor,
+) -> Result<DMatrix<f64>, MetricError> {
+    let n = top.n;
+    let x = top.points(c);
+    let m = x.len();
+    let centre = average(x.iter().copied());
+    let (moments, measure) = if n == 2 {
+        polygon_moments(top, c, &x, &centre)?
+    } else {
+        polyhedron_moments(top, c, &x, &centre)?
+    };
+    if measure.is_nan() || measure <= 0.0 {
+        return Err(MetricError::UnsupportedCell {
+            method: "VEM",
+            needs: "a convex cell of positive measure",
+            cell: c,
+        });
+    }
+    // Π̃ (n × m): gradient of the projection, column i = ∫_∂c φ_i n / |c|.
+    let pit = DMatrix::from_fn(n, m, |a, i| moments[i][a] / measure);
+    let kn = DMatrix::from_fn(n, n, |a, b| k[a][b]);
+    let consistency = pit.transpose() * &kn * &pit * measure;
+    let offsets = DMatrix::from_fn(m, n, |i, a| x[i][a] - centre[a]);
+    let projection = DMatrix::from_element(m, m, 1.0 / m as f64) + &offsets * &pit;
+    let residual = DMatrix::identity(m, m) - projection;
+    let diameter = x
+        .iter()
+        .flat_map(|a| x.iter().map(move |b| dot(&sub(a, b), &sub(a, b))))
+        .fold(0.0f64, f64::max)
+        .sqrt();
+    let alpha = kn.trace() / n as f64 * diameter.powi(n as i32 - 2);
+    Ok(consistency + residual.transpose() * residual * alpha)
+}

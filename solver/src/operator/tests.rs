@@ -1,0 +1,708 @@
+//! Tests of the canonical operator and its metric storage.
+
+use super::*;
+use faer::sparse::SparseColMat;
+use nalgebra::DMatrix;
+use sprs::CsMat;
+use std::sync::Arc;
+
+#[test]
+fn square_blocks_read_like_records_and_turn_into_them_on_a_push() {
+    // Two square blocks, over rows {0, 2} and {1, 2, 3}, back to back.
+    let first = [2.0, -1.0, -1.0, 2.0];
+    let second = [3.0, 0.5, 0.0, 0.5, 4.0, 1.0, 0.0, 1.0, 5.0];
+    let values: Vec<f64> = first.iter().chain(&second).copied().collect();
+    let square = BlockMetric::from_symmetric_blocks(
+        5,
+        vec![0, 2, 5],
+        vec![0, 4, 13],
+        vec![0, 2, 1, 2, 3],
+        values,
+        false,
+    );
+    let mut pushed = BlockMetric::new(5);
+    pushed.push_symmetric(&[0, 2], &first);
+    pushed.push_symmetric(&[1, 2, 3], &second);
+    assert_eq!(square.block_count(), 2);
+    assert_eq!(square.diagonal_weights(), None);
+    for b in 0..2 {
+        assert_eq!(square.block(b), pushed.block(b));
+    }
+    assert_eq!(square.to_dense(), pushed.to_dense());
+    assert!(square.is_symmetric(0.0));
+    // A push turns the square layout into records of the same blocks.
+    let mut more = square.clone();
+    more.push_block(&[4], &[4], &[7.0]);
+    pushed.push_block(&[4], &[4], &[7.0]);
+    assert_eq!(more, pushed);
+    assert_eq!(more.apply(&[1.0; 5]), vec![1.0, 3.5, 6.5, 6.0, 7.0]);
+}
+
+/// The error of a five-row Ω whose block 1 lists row 7.
+fn assert_row_7_of_block_1(built: Result<Canonical, CanonicalError>) {
+    let error = built.unwrap_err();
+    assert!(
+        matches!(
+            error,
+            CanonicalError::RowOutOfRange {
+                block: 1,
+                row: 7,
+                size: 5
+            }
+        ),
+        "{error:?}"
+    );
+}
+
+#[test]
+fn square_blocks_skip_the_value_scans_until_their_values_are_changed() {
+    let square = |indices: Vec<usize>| {
+        let values = [
+            2.0, -1.0, -1.0, 2.0, 3.0, 0.5, 0.0, 0.5, 4.0, 1.0, 0.0, 1.0, 5.0,
+        ];
+        BlockMetric::from_symmetric_blocks(
+            5,
+            vec![0, 2, 5],
+            vec![0, 4, 13],
+            indices,
+            values.to_vec(),
+            false,
+        )
+    };
+    let identity = || CsMat::<i8>::eye(5);
+    assert!(Canonical::new(identity(), square(vec![0, 2, 1, 2, 3])).is_ok());
+    // A row past Ω's size is still found, in the block that holds it.
+    assert_row_7_of_block_1(Canonical::new(identity(), square(vec![0, 2, 1, 2, 7])));
+    // Changed values are scanned again.
+    let mut changed = square(vec![0, 2, 1, 2, 3]);
+    assert!(changed.is_symmetric(0.0));
+    changed.block_values_mut(1)[1] = 9.0;
+    assert!(!changed.is_symmetric(1e-12));
+    changed.block_values_mut(0)[3] = f64::NAN;
+    let error = Canonical::new(identity(), changed).unwrap_err();
+    assert!(
+        matches!(error, CanonicalError::NonFinite { block: 0 }),
+        "{error:?}"
+    );
+}
+
+#[test]
+fn blocks_over_shared_columns_read_like_listed_rows() {
+    // The two blocks of the test above, their rows {0, 2} and
+    // {1, 2, 3} as the columns of a 5 × 2 CSC matrix.
+    let values = vec![
+        2.0, -1.0, -1.0, 2.0, 3.0, 0.5, 0.0, 0.5, 4.0, 1.0, 0.0, 1.0, 5.0,
+    ];
+    let columns = |rows: usize, last: usize| {
+        Arc::new(CsMat::new_csc(
+            (rows, 2),
+            vec![0, 2, 5],
+            vec![0, 2, 1, 2, last],
+            vec![1i8; 5],
+        ))
+    };
+    let listed = |last: usize| {
+        BlockMetric::from_symmetric_blocks(
+            5,
+            vec![0, 2, 5],
+            vec![0, 4, 13],
+            vec![0, 2, 1, 2, last],
+            values.clone(),
+            true,
+        )
+    };
+    let shared = |rows: usize, last: usize| {
+        BlockMetric::from_symmetric_column_blocks(
+            5,
+            columns(rows, last),
+            vec![0, 4, 13],
+            values.clone(),
+            true,
+        )
+    };
+    let metric = shared(5, 3);
+    assert_eq!(metric.block_count(), 2);
+    for b in 0..2 {
+        assert_eq!(metric.block(b), listed(3).block(b));
+    }
+    assert_eq!(metric.to_dense(), listed(3).to_dense());
+    let identity = || CsMat::<i8>::eye(5);
+    assert!(Canonical::new(identity(), metric.clone()).is_ok());
+    // A row past Ω's size, in a matrix with more rows than Ω: named
+    // with its block, as for listed rows.
+    assert_row_7_of_block_1(Canonical::new(identity(), shared(8, 7)));
+    // A push copies the rows out and continues as records.
+    let mut pushed = metric;
+    pushed.push_block(&[4], &[4], &[7.0]);
+    let mut expected = listed(3);
+    expected.push_block(&[4], &[4], &[7.0]);
+    assert_eq!(pushed, expected);
+    assert_eq!(pushed.apply(&[1.0; 5]), vec![1.0, 3.5, 6.5, 6.0, 7.0]);
+}
+
+/// M of `omega` on the nodal operator of `k`, through the blocks'
+/// own pattern and through the complex's cell lists.
+fn both_ways(
+    k: &hasse_complex::Complex,
+    omega: BlockMetric,
+) -> (SparseColMat<usize, f64>, SparseColMat<usize, f64>) {
+    let gathered = Canonical::new(k.shared_coboundary(0), omega.clone()).unwrap();
+    let from_cells = Canonical::with_cell_blocks(k.shared_coboundary(0), omega, k).unwrap();
+    (gathered.assemble(), from_cells.assemble())
+}
+
+#[test]
+fn cell_blocks_give_the_nine_point_stencil_of_the_unit_grid() {
+    // Q1 on a 3 × 3 grid of unit squares (h = 1): from the element
+    // matrix (4, −1, −2 over 6 on the diagonal, along an edge, across
+    // a diagonal), vertex (i, j) gets 4/6 from each of its cells, and
+    // a neighbour −1/6 from each shared cell along an edge (two inside,
+    // one on the boundary) or −2/6 across a diagonal (one cell).
+    let k = hasse_complex::generate::rectangle(3, 3, [0.0, 3.0], [0.0, 3.0]).unwrap();
+    let omega = crate::metric::fe::stiffness_metric(&k, &[1.0; 9]).unwrap();
+    let (gathered, from_cells) = both_ways(&k, omega);
+    assert_eq!(
+        gathered.symbolic().col_ptr(),
+        from_cells.symbolic().col_ptr()
+    );
+    assert_eq!(
+        gathered.symbolic().row_idx(),
+        from_cells.symbolic().row_idx()
+    );
+    assert_eq!(gathered.val(), from_cells.val());
+    let dense = from_cells.to_dense();
+    let at = |v: usize| {
+        let p = k.vertices().point(v);
+        (p[0].round() as i64, p[1].round() as i64)
+    };
+    let cells_of = |(x, y): (i64, i64)| {
+        let side = |t: i64| if t == 0 || t == 3 { 1 } else { 2 };
+        side(x) * side(y)
+    };
+    for u in 0..16 {
+        for v in 0..16 {
+            let ((xu, yu), (xv, yv)) = (at(u), at(v));
+            let (dx, dy) = ((xu - xv).abs(), (yu - yv).abs());
+            let expected = match (dx, dy) {
+                (0, 0) => 4.0 / 6.0 * f64::from(cells_of((xu, yu))),
+                (1, 0) | (0, 1) => {
+                    // Cells on the edge: 2, or 1 when it is on the boundary.
+                    let boundary = if dx == 1 {
+                        yu == 0 || yu == 3
+                    } else {
+                        xu == 0 || xu == 3
+                    };
+                    -1.0 / 6.0 * if boundary { 1.0 } else { 2.0 }
+                }
+                (1, 1) => -2.0 / 6.0,
+                _ => 0.0,
+            };
+            assert!(
+                (dense[(u, v)] - expected).abs() < 1e-14,
+                "({u}, {v}): {} against {expected}",
+                dense[(u, v)]
+            );
+        }
+    }
+}
+
+#[test]
+fn cell_blocks_assemble_like_the_gathered_pattern_on_hexahedra_and_polygons() {
+    // Moved vertices: no two blocks are alike.
+    let hexes = hasse_complex::generate::box3(3, 2, 2, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let moved: Vec<[f64; 3]> = (0..hexes.cell_count(0))
+        .map(|v| {
+            let p = hexes.vertices().point(v);
+            let t = v as f64;
+            [
+                p[0] + 0.02 * (1.3 * t).sin(),
+                p[1] + 0.02 * (0.7 * t).cos(),
+                p[2],
+            ]
+        })
+        .collect();
+    let hexes = hexes
+        .with_vertices(hasse_complex::Vertices::from_points(&moved).unwrap())
+        .unwrap();
+    let tensors = vec![1.5; hexes.cell_count(3)];
+    let omega = crate::metric::fe::stiffness_metric(&hexes, &tensors).unwrap();
+    let (gathered, from_cells) = both_ways(&hexes, omega);
+    assert_eq!(
+        gathered.symbolic().row_idx(),
+        from_cells.symbolic().row_idx()
+    );
+    assert_eq!(gathered.val(), from_cells.val());
+    // Virtual elements on quadrilaterals.
+    let quads = hasse_complex::generate::rectangle(4, 3, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let omega = crate::metric::fe::vem_stiffness_metric(&quads, &[1.0; 12]).unwrap();
+    let (gathered, from_cells) = both_ways(&quads, omega);
+    assert_eq!(gathered.val(), from_cells.val());
+    // Constants are the kernel: every row of M sums to zero.
+    let dense = from_cells.to_dense();
+    for i in 0..dense.nrows() {
+        let sum: f64 = (0..dense.ncols()).map(|j| dense[(i, j)]).sum();
+        assert!(sum.abs() < 1e-13, "row {i} sums to {sum}");
+    }
+}
+
+#[test]
+fn a_metric_pushed_to_after_it_was_built_per_cell_uses_its_own_pattern() {
+    let k = hasse_complex::generate::rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let mut omega = crate::metric::fe::stiffness_metric(&k, &[1.0; 4]).unwrap();
+    assert!(omega.per_cell);
+    // One block more than cells: not one block per cell any longer.
+    omega.push_symmetric(&[0], &[7.0]);
+    assert!(!omega.per_cell);
+    let (gathered, from_cells) = both_ways(&k, omega);
+    assert_eq!(gathered.val(), from_cells.val());
+    // Edge 0's extra weight 7 lands on its two ends a, b: +7 on (a, a),
+    // −7 on (a, b).
+    let (tail, head) = (k.cell_vertices(1, 0)[0], k.cell_vertices(1, 0)[1]);
+    let plain = Canonical::new(
+        k.shared_coboundary(0),
+        crate::metric::fe::stiffness_metric(&k, &[1.0; 4]).unwrap(),
+    )
+    .unwrap()
+    .assemble()
+    .to_dense();
+    let dense = from_cells.to_dense();
+    assert!((dense[(tail, tail)] - plain[(tail, tail)] - 7.0).abs() < 1e-14);
+    assert!((dense[(tail, head)] - plain[(tail, head)] + 7.0).abs() < 1e-14);
+}
+
+#[test]
+fn the_diagonal_pattern_is_the_cells_coupled_through_faces() {
+    // Three cells in a row, four faces: ∂ by faces has rows (1), (−1, 1),
+    // (−1, 1), (−1); ∂ᵀ∂ is tridiagonal whatever the face weights.
+    let rows = CsMat::new(
+        (4, 3),
+        vec![0, 1, 3, 5, 6],
+        vec![0, 0, 1, 1, 2, 2],
+        vec![1i8, -1, 1, -1, 1, -1],
+    );
+    let by_columns = Arc::new(rows.to_csc());
+    let pattern = diagonal_pattern(&rows, &by_columns);
+    assert_eq!(pattern.col_ptr(), &[0, 2, 5, 7]);
+    assert_eq!(pattern.row_idx(), &[0, 1, 0, 1, 2, 1, 2]);
+    // The operator with real weights has that pattern too.
+    let metric = BlockMetric::diagonal(&[2.0, 0.5, 3.0, 1.0]);
+    let m = Canonical::new(rows, metric).unwrap().assemble();
+    assert_eq!(m.symbolic().col_ptr(), pattern.col_ptr());
+    assert_eq!(m.symbolic().row_idx(), pattern.row_idx());
+}
+
+#[test]
+fn theorem_one_reproduces_any_matrix_when_the_kernel_is_trivial() {
+    // A = ∂_1 of a path of 6 edges with all 7 vertices kept (7 × 6, full
+    // column rank); M = tridiag(−1, 3, −1), the thesis's implicit heat matrix.
+    let mut a = DMatrix::zeros(7, 6);
+    for e in 0..6 {
+        a[(e, e)] = -1.0;
+        a[(e + 1, e)] = 1.0;
+    }
+    let m = DMatrix::from_fn(6, 6, |i, j| match i.abs_diff(j) {
+        0 => 3.0,
+        1 => -1.0,
+        _ => 0.0,
+    });
+    let omega = metric_from_matrix(&a, &m).unwrap();
+    let back = a.transpose() * &omega * &a;
+    assert!((back - &m).abs().max() < 1e-12);
+    // A with a kernel (the closed cycle of 3 edges) has no left inverse.
+    let mut cycle = DMatrix::zeros(3, 3);
+    for e in 0..3 {
+        cycle[(e, e)] = -1.0;
+        cycle[((e + 1) % 3, e)] = 1.0;
+    }
+    assert!(metric_from_matrix(&cycle, &DMatrix::identity(3, 3)).is_none());
+}
+
+#[test]
+fn one_dimensional_identity_metric_gives_the_fe_stiffness() {
+    // A = ∂_1ᵀ... thesis: A = ∂_1 ((n+1) × n, boundary vertices kept), Ω = I:
+    // AᵀA = tridiag(−1, 2, −1).
+    let n = 5;
+    let mut tri = sprs::TriMat::new((n + 1, n));
+    for e in 0..n {
+        tri.add_triplet(e, e, -1i8);
+        tri.add_triplet(e + 1, e, 1i8);
+    }
+    let op = Canonical::new(tri.to_csr(), BlockMetric::diagonal(&vec![1.0; n + 1])).unwrap();
+    let m = op.assemble().to_dense();
+    for i in 0..n {
+        for j in 0..n {
+            let expected = match i.abs_diff(j) {
+                0 => 2.0,
+                1 => -1.0,
+                _ => 0.0,
+            };
+            assert_eq!(m[(i, j)], expected);
+        }
+    }
+}
+
+#[test]
+fn dense_blocks_assemble_like_the_dense_triple_product() {
+    // A: 4 rows × 3 unknowns; Ω: one 2×2 symmetric block + a diagonal entry
+    // + an off-diagonal triplet pair (symmetric).
+    let a = CsMat::new(
+        (4, 3),
+        vec![0, 2, 4, 5, 7],
+        vec![0, 1, 1, 2, 0, 0, 2],
+        vec![1i8, -1, 1, -1, 1, -1, 1],
+    );
+    let mut omega = BlockMetric::new(4);
+    omega.push_symmetric(&[0, 1], &[2.0, 0.5, 0.5, 3.0]);
+    omega.push_block(&[2], &[2], &[1.5]);
+    omega.push_block(&[3], &[0], &[0.25]);
+    omega.push_block(&[0], &[3], &[0.25]);
+    let op = Canonical::new(a.clone(), omega.clone()).unwrap();
+    let m = op.assemble().to_dense();
+    let ad = DMatrix::from_fn(4, 3, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
+    let od = DMatrix::from_fn(4, 4, |i, j| omega.to_dense()[i][j]);
+    let expected = ad.transpose() * od * ad;
+    for i in 0..3 {
+        for j in 0..3 {
+            assert!((m[(i, j)] - expected[(i, j)]).abs() < 1e-15, "({i},{j})");
+        }
+    }
+    // Matrix-free application agrees with the assembled matrix.
+    let u = [0.3, -1.0, 2.0];
+    let mu = op.apply(&u);
+    for i in 0..3 {
+        let row: f64 = (0..3).map(|j| expected[(i, j)] * u[j]).sum();
+        assert!((mu[i] - row).abs() < 1e-14);
+    }
+    assert!(!omega.is_symmetric(0.0));
+}
+
+#[test]
+fn coupling_blocks_assemble_like_the_dense_product_with_two_incidences() {
+    // A: 4 rows × 3 unknowns, B: the same 4 rows × 2 other unknowns; Ω
+    // with a dense 2×2 block, a diagonal entry and an unsymmetric pair,
+    // and then diagonal. Expected: the dense Aᵀ Ω B by nalgebra.
+    let a = CsMat::new(
+        (4, 3),
+        vec![0, 2, 4, 5, 7],
+        vec![0, 1, 1, 2, 0, 0, 2],
+        vec![1i8, -1, 1, -1, 1, -1, 1],
+    );
+    let b = CsMat::new(
+        (4, 2),
+        vec![0, 1, 3, 4, 4],
+        vec![1, 0, 1, 0],
+        vec![-1i8, 1, 1, 1],
+    );
+    let mut blocks = BlockMetric::new(4);
+    blocks.push_symmetric(&[0, 1], &[2.0, 0.5, 0.5, 3.0]);
+    blocks.push_block(&[2], &[2], &[1.5]);
+    blocks.push_block(&[3], &[0], &[0.25]);
+    let diagonal = BlockMetric::diagonal(&[2.0, -1.0, 0.5, 4.0]);
+    let dense = |m: &CsMat<i8>, cols| {
+        DMatrix::from_fn(4, cols, |i, j| f64::from(*m.get(i, j).unwrap_or(&0)))
+    };
+    let (ad, bd) = (dense(&a, 3), dense(&b, 2));
+    for omega in [blocks, diagonal] {
+        let op = Canonical::coupling(a.clone(), omega.clone(), b.clone()).unwrap();
+        assert_eq!((op.shape(), op.unknowns()), ((3, 2), 2));
+        let m = op.assemble().to_dense();
+        let od = DMatrix::from_fn(4, 4, |i, j| omega.to_dense()[i][j]);
+        let expected = ad.transpose() * od * &bd;
+        assert_eq!((m.nrows(), m.ncols()), (3, 2));
+        for i in 0..3 {
+            for j in 0..2 {
+                assert!((m[(i, j)] - expected[(i, j)]).abs() < 1e-15, "({i},{j})");
+            }
+        }
+        let u = [0.7, -2.0];
+        let mu = op.apply(&u);
+        assert_eq!(mu.len(), 3);
+        for i in 0..3 {
+            let row: f64 = (0..2).map(|j| expected[(i, j)] * u[j]).sum();
+            assert!((mu[i] - row).abs() < 1e-14);
+        }
+    }
+    // B must have Ω's rows.
+    let short = CsMat::new((3, 2), vec![0, 1, 2, 3], vec![0, 1, 0], vec![1i8, 1, 1]);
+    assert_eq!(
+        Canonical::coupling(a, BlockMetric::diagonal(&[1.0; 4]), short).unwrap_err(),
+        CanonicalError::SizeMismatch { metric: 4, rows: 3 }
+    );
+}
+
+#[test]
+fn a_sum_of_operators_is_the_stacked_operator() {
+    // 2·(Aᵀ Ω₁ A) + ½·(Iᵀ diag(m) I) against the dense sum, with a block
+    // Ω₁ (the general path) and with a diagonal one.
+    let a = CsMat::new(
+        (4, 3),
+        vec![0, 2, 4, 5, 7],
+        vec![0, 1, 1, 2, 0, 0, 2],
+        vec![1i8, -1, 1, -1, 1, -1, 1],
+    );
+    let mut blocks = BlockMetric::new(4);
+    blocks.push_symmetric(&[0, 1], &[2.0, 0.5, 0.5, 3.0]);
+    blocks.push_block(&[2], &[2], &[1.5]);
+    blocks.push_block(&[3], &[3], &[0.75]);
+    let mass =
+        Canonical::new(CsMat::<i8>::eye(3), BlockMetric::diagonal(&[1.0, 2.0, 4.0])).unwrap();
+    let ad = DMatrix::from_fn(4, 3, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
+    for omega in [blocks, BlockMetric::diagonal(&[2.0, 3.0, 1.5, 0.75])] {
+        let od = DMatrix::from_fn(4, 4, |i, j| omega.to_dense()[i][j]);
+        let stiffness = Canonical::new(a.clone(), omega).unwrap();
+        let sum = Canonical::sum(&[(2.0, &stiffness), (0.5, &mass)]).unwrap();
+        let m = sum.assemble().to_dense();
+        let expected = ad.transpose() * od * &ad * 2.0
+            + DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![0.5, 1.0, 2.0]));
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((m[(i, j)] - expected[(i, j)]).abs() < 1e-14, "({i},{j})");
+            }
+        }
+    }
+    let other = Canonical::new(CsMat::<i8>::eye(2), BlockMetric::diagonal(&[1.0, 1.0])).unwrap();
+    assert_eq!(
+        Canonical::sum(&[(1.0, &mass), (1.0, &other)]).unwrap_err(),
+        CanonicalError::SumMismatch {
+            unknowns: 3,
+            found: 2
+        }
+    );
+}
+
+#[test]
+fn the_clique_pattern_couples_the_kept_vertices_of_each_cell() {
+    // Two quadrilaterals side by side: bottom vertices 0 1 2, top 3 4
+    // 5; cell 0 = {0, 1, 3, 4}, cell 1 = {1, 2, 4, 5}. Vertex 0 is
+    // dropped, so vertices 1..5 become 0..4.
+    let cells = [vec![0, 1, 3, 4], vec![1, 2, 4, 5]];
+    let star = CsMat::new(
+        (6, 2),
+        vec![0, 1, 3, 4, 5, 7, 8],
+        vec![0, 0, 1, 1, 0, 0, 1, 1],
+        vec![1u8; 8],
+    );
+    let keep = [false, true, true, true, true, true];
+    let pattern = clique_pattern(&star, |c| &cells[c][..], &keep);
+    assert_eq!((pattern.nrows(), pattern.ncols()), (5, 5));
+    assert_eq!(pattern.col_ptr(), &[0, 5, 9, 12, 17, 21]);
+    assert_eq!(
+        pattern.row_idx(),
+        &[0, 1, 2, 3, 4, 0, 1, 3, 4, 0, 2, 3, 0, 1, 2, 3, 4, 0, 1, 3, 4]
+    );
+}
+
+#[test]
+fn blocks_numbered_apart_from_their_unknowns_assemble_like_the_dense_product() {
+    // A cycle of 240 unknowns numbered by a stride permutation, one row
+    // (edge) per consecutive pair; blocks of three rows picked by
+    // another stride, some symmetric, some with different row and
+    // column sets, then a 1×1 block per row. A column range's blocks
+    // are spread over the whole block range, so each range sorts them
+    // (the nodal tests on generated grids take the run path).
+    let n = 240;
+    let label = |k: usize| (k * 7) % n;
+    let (mut indptr, mut indices, mut data) = (vec![0], Vec::new(), Vec::new());
+    for r in 0..n {
+        let (a, b) = (label(r), label((r + 1) % n));
+        let (lo, hi, sign) = if a < b { (a, b, -1i8) } else { (b, a, 1i8) };
+        indices.extend([lo, hi]);
+        data.extend([sign, -sign]);
+        indptr.push(indices.len());
+    }
+    let a = CsMat::new((n, n), indptr, indices, data);
+    let mut omega = BlockMetric::new(n);
+    let value = |b: usize, k: usize| 0.1 + ((b * 31 + k * 17) % 23) as f64 / 7.0;
+    for b in 0..60 {
+        let rows = [(b * 11) % n, (b * 11 + 97) % n, (b * 11 + 181) % n];
+        let mut w = [0.0; 9];
+        for i in 0..3 {
+            for j in 0..=i {
+                let v = value(b, i * 3 + j) + if i == j { 5.0 } else { 0.0 };
+                w[i * 3 + j] = v;
+                w[j * 3 + i] = v;
+            }
+        }
+        if b % 4 == 0 {
+            let cols = [(b * 13 + 5) % n, (b * 13 + 50) % n, (b * 13 + 120) % n];
+            omega.push_block(&rows, &cols, &w);
+        } else {
+            omega.push_symmetric(&rows, &w);
+        }
+    }
+    for r in 0..n {
+        omega.push_block(&[r], &[r], &[1.0 + r as f64 / n as f64]);
+    }
+    let m = Canonical::new(a.clone(), omega.clone())
+        .unwrap()
+        .assemble()
+        .to_dense();
+    let ad = DMatrix::from_fn(n, n, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
+    let omega_dense = omega.to_dense();
+    let od = DMatrix::from_fn(n, n, |i, j| omega_dense[i][j]);
+    let expected = ad.transpose() * od * ad;
+    // Entries are sums of a few products of values below 10: the two
+    // orders of summation agree to a few ulps of 100.
+    for i in 0..n {
+        for j in 0..n {
+            assert!((m[(i, j)] - expected[(i, j)]).abs() < 1e-12, "({i},{j})");
+        }
+    }
+}
+
+#[test]
+fn a_diagonal_metric_stays_compact_until_a_block_breaks_the_pattern() {
+    let mut omega = BlockMetric::new(3);
+    omega.push_block(&[0], &[0], &[2.0]);
+    omega.push_block(&[1], &[1], &[3.0]);
+    assert_eq!(omega.diagonal_weights(), Some(&[2.0, 3.0][..]));
+    assert_eq!(omega.block_count(), 2);
+    assert_eq!(omega.block(1), (&[1][..], &[1][..], &[3.0][..]));
+    // An off-diagonal block: the earlier blocks get records and keep
+    // their rows, columns and values.
+    omega.push_block(&[2], &[0], &[5.0]);
+    assert_eq!(omega.diagonal_weights(), None);
+    assert_eq!(omega.block_count(), 3);
+    assert_eq!(omega.block(0), (&[0][..], &[0][..], &[2.0][..]));
+    assert_eq!(omega.block(2), (&[2][..], &[0][..], &[5.0][..]));
+    let dense = omega.to_dense();
+    assert_eq!(dense[0], vec![2.0, 0.0, 0.0]);
+    assert_eq!(dense[1], vec![0.0, 3.0, 0.0]);
+    assert_eq!(dense[2], vec![5.0, 0.0, 0.0]);
+    // A block out of row order also ends the compact layout.
+    let mut skipped = BlockMetric::new(3);
+    skipped.push_block(&[1], &[1], &[1.0]);
+    assert_eq!(skipped.diagonal_weights(), None);
+    assert_eq!(skipped.apply(&[1.0, 4.0, 9.0]), vec![0.0, 4.0, 0.0]);
+    // Out-of-range and non-finite diagonal entries are refused by number.
+    let a = CsMat::new((2, 2), vec![0, 1, 3], vec![0, 0, 1], vec![1i8, -1, 1]);
+    let mut long = BlockMetric::diagonal(&[1.0, 1.0]);
+    long.push_block(&[2], &[2], &[1.0]);
+    assert_eq!(
+        Canonical::new(a.clone(), long).err(),
+        Some(CanonicalError::RowOutOfRange {
+            block: 2,
+            row: 2,
+            size: 2
+        })
+    );
+    let mut beyond = BlockMetric::diagonal(&[1.0]);
+    beyond.push_block(&[1], &[1], &[1.0]);
+    beyond.push_block(&[2], &[2], &[1.0]);
+    assert_eq!(beyond.diagonal_weights().map(<[f64]>::len), Some(3));
+    assert_eq!(beyond.size(), 1);
+    assert!(matches!(
+        beyond.validate(),
+        Err(CanonicalError::RowOutOfRange {
+            block: 1,
+            row: 1,
+            size: 1
+        })
+    ));
+    assert_eq!(
+        Canonical::new(a, BlockMetric::diagonal(&[1.0, f64::NAN])).err(),
+        Some(CanonicalError::NonFinite { block: 1 })
+    );
+}
+
+#[test]
+fn diagonal_metrics_assemble_like_the_dense_triple_product_and_the_block_path() {
+    // A = ∂_2 of a 3×2 grid of squares (17 edges × 6 cells): the
+    // two-point flux operator. Dyadic weights make every sum exact, so
+    // the column-wise diagonal assembly, the block-wise assembly and
+    // the dense product must agree to the last bit.
+    let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+    let a = grid.boundary(2).clone();
+    let rows = a.rows();
+    let weights: Vec<f64> = (0..rows).map(|r| 0.25 * (r % 5 + 1) as f64).collect();
+    let dense_a = DMatrix::from_fn(rows, 6, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
+    for blocks in [rows, rows - 4] {
+        // Only the first `blocks` rows carry a weight; the rest have no
+        // block at all and must not enter the pattern.
+        let mut diagonal = BlockMetric::diagonal(&weights[..blocks]);
+        diagonal.add_rows(rows - blocks);
+        assert!(diagonal.diagonal_weights().is_some());
+        let mut by_blocks = BlockMetric::new(rows);
+        for r in (0..blocks).rev() {
+            by_blocks.push_block(&[r], &[r], &[weights[r]]);
+        }
+        assert!(by_blocks.diagonal_weights().is_none());
+        // With A's CSC form from the complex (used only when every
+        // row has its weight) the result is the same.
+        let shared = Canonical::with_columns(
+            grid.shared_boundary(2),
+            grid.shared_boundary_csc(2),
+            diagonal.clone(),
+        )
+        .unwrap()
+        .assemble();
+        let fast = Canonical::new(a.clone(), diagonal).unwrap().assemble();
+        let general = Canonical::new(a.clone(), by_blocks).unwrap().assemble();
+        for other in [&general, &shared] {
+            assert_eq!(fast.symbolic().col_ptr(), other.symbolic().col_ptr());
+            assert_eq!(fast.symbolic().row_idx(), other.symbolic().row_idx());
+            assert_eq!(fast.val(), other.val());
+        }
+        let w = DMatrix::from_fn(rows, rows, |i, j| {
+            if i == j && i < blocks {
+                weights[i]
+            } else {
+                0.0
+            }
+        });
+        let expected = dense_a.transpose() * w * &dense_a;
+        let m = fast.to_dense();
+        for i in 0..6 {
+            for j in 0..6 {
+                assert_eq!(
+                    m[(i, j)],
+                    expected[(i, j)],
+                    "({i},{j}) with {blocks} blocks"
+                );
+            }
+        }
+    }
+    // Cells 0 and 5 (opposite corners) share no edge: no stored entry.
+    let op = Canonical::new(a, BlockMetric::diagonal(&weights)).unwrap();
+    let m = op.assemble();
+    let column = &m.symbolic().row_idx()[m.symbolic().col_ptr()[0]..m.symbolic().col_ptr()[1]];
+    assert!(!column.contains(&5));
+}
+
+#[test]
+fn the_last_assembly_takes_the_pattern_and_a_later_one_rebuilds_it() {
+    // Q1 blocks on a 3×2 grid (block path) and two-point weights
+    // (diagonal path): the owned assembly and the assemblies before and
+    // after it, which rebuild the pattern, agree to the last bit.
+    let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+    let q1 = crate::metric::fe::stiffness_metric(&grid, &[1.0; 6]).unwrap();
+    let tpfa = crate::metric::fv::two_point(&grid, &[1.0; 6]).unwrap();
+    for (a, metric) in [
+        (Arc::new(grid.coboundary(0)), q1),
+        (grid.shared_boundary(2), tpfa),
+    ] {
+        let mut op = Canonical::new(a, metric).unwrap();
+        let before = op.assemble();
+        let owned = op.assemble_owned();
+        let after = op.assemble();
+        for m in [&owned, &after] {
+            assert_eq!(m.symbolic().col_ptr(), before.symbolic().col_ptr());
+            assert_eq!(m.symbolic().row_idx(), before.symbolic().row_idx());
+            assert_eq!(m.val(), before.val());
+        }
+        assert_eq!(op.nonzeros(), before.val().len());
+    }
+}
+
+#[test]
+fn metric_values_can_change_without_a_new_pattern() {
+    let a = CsMat::new((2, 2), vec![0, 1, 3], vec![0, 0, 1], vec![1i8, -1, 1]);
+    let mut op = Canonical::new(a, BlockMetric::diagonal(&[1.0, 1.0])).unwrap();
+    op.set_metric(BlockMetric::diagonal(&[2.0, 3.0])).unwrap();
+    let m = op.assemble().to_dense();
+    assert_eq!((m[(0, 0)], m[(0, 1)], m[(1, 1)]), (5.0, -3.0, 3.0));
+    assert_eq!(
+        op.set_metric(BlockMetric::from_triplets(2, &[(0, 1, 1.0)])),
+        Err(CanonicalError::PatternChanged)
+    );
+}
