@@ -21,10 +21,13 @@
 //! checks the hand-built matrix against hasse's.
 
 use hasse_complex::{generate, Complex};
+use hasse_solver::metric::Method;
 use hasse_solver::metric::{fe, fv, isotropic};
 use hasse_solver::operator::Canonical;
-use hasse_solver::physics::diffusion::{BoundaryKind, Conductivity, Diffusion, Method};
+use hasse_solver::physics::diffusion::Diffusion;
 use hasse_solver::physics::elasticity::{Coefficient, ElasticBoundary, Elasticity, Material};
+use hasse_solver::physics::BoundaryKind;
+use hasse_solver::physics::Conductivity;
 use std::sync::Arc;
 use std::time::Instant;
 

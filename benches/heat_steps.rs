@@ -11,8 +11,9 @@
 //! (target: under 5 ms per step).
 
 use hasse_complex::generate::rectangle;
-use hasse_solver::physics::diffusion::{Conductivity, Method};
+use hasse_solver::metric::Method;
 use hasse_solver::physics::heat::{Heat, HeatBoundary, TimeFn};
+use hasse_solver::physics::Conductivity;
 use std::f64::consts::PI;
 use std::sync::Arc;
 use std::time::Instant;

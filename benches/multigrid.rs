@@ -76,11 +76,13 @@ use hasse_complex::{generate, Complex};
 use hasse_solver::la::direct::{relative_residual, DirectSolver, Factorization};
 use hasse_solver::la::iterative::CgOptions;
 use hasse_solver::la::ordering::Ordering;
+use hasse_solver::metric::Method;
 use hasse_solver::multigrid::{CellProlongation, Hierarchy, MultigridOptions};
 use hasse_solver::physics::diffusion::{
-    solve_with_fixed, Assembled, BoundaryKind, Conductivity, Diffusion, Iterative, Method,
-    Preconditioning,
+    solve_with_fixed, Assembled, Diffusion, Iterative, Preconditioning,
 };
+use hasse_solver::physics::BoundaryKind;
+use hasse_solver::physics::Conductivity;
 use std::io::Write;
 use std::sync::Arc;
 use std::time::Instant;

@@ -2,7 +2,7 @@
 //! `hasse converge` end to end (tables, CSV, JSON, PNG, SVG, `--expect`
 //! exit codes), and uniform refinement of the generators.
 
-use hasse_solver::physics::diffusion::Method;
+use hasse_solver::metric::Method;
 use hasse_solver::study::{
     least_squares_order, pairwise_orders, Norm, OrderError, PlotFormat, PlotOptions, Refinement,
     Study, StudyError,

@@ -23,12 +23,13 @@
 use hasse_complex::generate::{kuhn, rectangle, uniform_axis};
 use hasse_complex::Complex;
 use hasse_solver::la::direct::Factorization;
+use hasse_solver::metric::Method;
 use hasse_solver::physics::coupled::{
     Coupled, CoupledError, CoupledField, CoupledSolution, Reaction,
 };
-use hasse_solver::physics::diffusion::{
-    BoundaryKind, Conductivity, Diffusion, DiffusionError, Method,
-};
+use hasse_solver::physics::diffusion::{Diffusion, DiffusionError};
+use hasse_solver::physics::BoundaryKind;
+use hasse_solver::physics::Conductivity;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -311,7 +312,7 @@ fn bad_input_is_a_typed_error() {
     match untagged.solve(&mesh) {
         Err(CoupledError::Field {
             name,
-            source: DiffusionError::UnknownTag { tag, .. },
+            source: DiffusionError::Tag(hasse_solver::physics::TagError::UnknownTag { tag, .. }),
         }) => assert_eq!((name.as_str(), tag.as_str()), ("v", "inlet")),
         other => panic!("expected an unknown tag, got {:?}", other.map(|s| s.names)),
     }

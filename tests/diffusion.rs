@@ -8,10 +8,14 @@
 
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
+use hasse_solver::metric::Method;
 use hasse_solver::physics::diffusion::{
-    conservation_residual, errors, flux_error, BoundaryKind, CellPoints, Conductivity, Diffusion,
-    DiffusionError, Method, ScalarFn, VectorFn,
+    conservation_residual, errors, flux_error, CellPoints, Diffusion, DiffusionError,
 };
+use hasse_solver::physics::BoundaryKind;
+use hasse_solver::physics::Conductivity;
+use hasse_solver::physics::ScalarFn;
+use hasse_solver::physics::VectorFn;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -390,7 +394,10 @@ fn bad_input_is_named() {
     )
     .with_boundary("left", BoundaryKind::Dirichlet(scalar(|_| 0.0)));
     let err = problem.solve(&mesh).unwrap_err();
-    assert!(matches!(err, DiffusionError::UnknownTag { .. }));
+    assert!(matches!(
+        err,
+        DiffusionError::Tag(hasse_solver::physics::TagError::UnknownTag { .. })
+    ));
     assert!(err.to_string().contains("xmin"), "{err}");
     let problem = Diffusion::new(
         Method::Fe,
@@ -670,7 +677,9 @@ fn cell_points_are_checked() {
 /// analysis is then not used.
 #[test]
 fn analysis_beside_the_assembly_gives_the_plain_solution() {
-    use hasse_solver::physics::diffusion::{lumped_vertex_volumes, Assembled, Location};
+    use hasse_solver::metric::mass::lumped_vertex_volumes;
+    use hasse_solver::metric::Location;
+    use hasse_solver::physics::diffusion::Assembled;
     // The weights of the zero mean of a pure-Neumann solution.
     let mean_weights = |system: &Assembled, mesh: &Complex| match system.location {
         Location::Nodal => lumped_vertex_volumes(mesh),

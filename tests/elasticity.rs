@@ -18,10 +18,10 @@
 
 use hasse_complex::generate::{box3, kuhn, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
-use hasse_solver::physics::diffusion::VectorFn;
 use hasse_solver::physics::elasticity::{
     Coefficient, ElasticBoundary, Elasticity, ElasticityError, Material, PlaneModel,
 };
+use hasse_solver::physics::VectorFn;
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -638,7 +638,9 @@ fn bad_input_is_a_typed_error() {
         base()
             .with_boundary("left", ElasticBoundary::Displacement(no_force()))
             .solve(&mesh),
-        Err(ElasticityError::UnknownTag { .. })
+        Err(ElasticityError::Tag(
+            hasse_solver::physics::TagError::UnknownTag { .. }
+        ))
     ));
     assert!(matches!(
         base()

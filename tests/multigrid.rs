@@ -15,11 +15,13 @@ use hasse_complex::Complex;
 use hasse_solver::la::direct::Factorization;
 use hasse_solver::la::iterative::{CgError, CgOptions, Preconditioner, RowMatrix};
 use hasse_solver::la::ordering::Ordering;
+use hasse_solver::metric::Method;
 use hasse_solver::multigrid::{Hierarchy, Multigrid, MultigridError, MultigridOptions};
 use hasse_solver::physics::diffusion::{
-    solve_with_fixed, BoundaryKind, Conductivity, Diffusion, DiffusionError, Iterative, Method,
-    Preconditioning,
+    solve_with_fixed, Diffusion, DiffusionError, Iterative, Preconditioning,
 };
+use hasse_solver::physics::BoundaryKind;
+use hasse_solver::physics::Conductivity;
 use std::sync::Arc;
 
 /// −Δu = f on the unit square/cube with u = 0 on the boundary; f is smooth

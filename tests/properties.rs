@@ -20,9 +20,11 @@
 use hasse_complex::generate::{delaunay, grid, kuhn, perturb, rectangle, uniform_axis, voronoi};
 use hasse_complex::split::{split, Hyperplane, Refinement, SplitOptions};
 use hasse_complex::{Complex, DualKind, Vertices};
-use hasse_solver::physics::diffusion::{
-    errors, BoundaryKind, Conductivity, Diffusion, Method, ScalarFn,
-};
+use hasse_solver::metric::Method;
+use hasse_solver::physics::diffusion::{errors, Diffusion};
+use hasse_solver::physics::BoundaryKind;
+use hasse_solver::physics::Conductivity;
+use hasse_solver::physics::ScalarFn;
 use nalgebra::DMatrix;
 use proptest::prelude::*;
 use sprs::CsMat;

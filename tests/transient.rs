@@ -21,8 +21,10 @@
 
 use hasse_complex::generate::{kuhn, rectangle, uniform_axis};
 use hasse_complex::Complex;
-use hasse_solver::physics::diffusion::{Conductivity, Method, ScalarFn};
+use hasse_solver::metric::Method;
 use hasse_solver::physics::heat::{Heat, HeatBoundary, HeatError, TimeFn};
+use hasse_solver::physics::Conductivity;
+use hasse_solver::physics::ScalarFn;
 use std::f64::consts::PI;
 use std::sync::Arc;
 

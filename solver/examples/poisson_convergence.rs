@@ -12,9 +12,10 @@
 
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
-use hasse_solver::physics::diffusion::{
-    errors, flux_error, BoundaryKind, CellPoints, Conductivity, Diffusion, Method,
-};
+use hasse_solver::metric::Method;
+use hasse_solver::physics::diffusion::{errors, flux_error, CellPoints, Diffusion};
+use hasse_solver::physics::BoundaryKind;
+use hasse_solver::physics::Conductivity;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -38,9 +39,9 @@ fn table(title: &str, method: Method, meshes: &[Complex]) {
 
 /// One table row per (mesh, cell points of FV, h).
 fn table_at(title: &str, method: Method, levels: &[(Complex, CellPoints, f64)]) {
-    let exact: hasse_solver::physics::diffusion::ScalarFn =
+    let exact: hasse_solver::physics::ScalarFn =
         Arc::new(|x: &[f64]| (PI * x[0]).sin() * (PI * x[1]).sin() + x[0] * x[1]);
-    let gradient: hasse_solver::physics::diffusion::VectorFn = Arc::new(|x: &[f64]| {
+    let gradient: hasse_solver::physics::VectorFn = Arc::new(|x: &[f64]| {
         [
             PI * (PI * x[0]).cos() * (PI * x[1]).sin() + x[1],
             PI * (PI * x[0]).sin() * (PI * x[1]).cos() + x[0],

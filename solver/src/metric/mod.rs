@@ -20,6 +20,10 @@ pub mod dec;
 pub mod fd;
 pub mod fe;
 pub mod fv;
+pub mod mass;
+mod method;
+
+pub use method::{Location, Method, UnknownMethod};
 
 use hasse_complex::ComplexError;
 use rayon::prelude::*;

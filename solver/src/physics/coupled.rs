@@ -33,11 +33,12 @@
 //! pattern, and the symbolic factorisation is reused.
 
 use crate::la::direct::{Factorization, SolveError};
+use crate::metric::mass::lumped_vertex_volumes;
+use crate::metric::Location;
 use crate::operator::block::{Block, BlockError, BlockSystem, Symmetry};
 use crate::operator::{Canonical, CanonicalError};
-use crate::physics::diffusion::{
-    lumped_vertex_volumes, Diffusion, DiffusionError, Location, ScalarFn,
-};
+use crate::physics::diffusion::{Diffusion, DiffusionError};
+use crate::physics::ScalarFn;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use hasse_complex::Complex;
 use sprs::TriMat;
@@ -88,7 +89,10 @@ pub struct Reaction {
 /// ```
 /// use hasse_complex::generate::rectangle;
 /// use hasse_solver::physics::coupled::{Coupled, CoupledField, Reaction};
-/// use hasse_solver::physics::diffusion::{BoundaryKind, Conductivity, Diffusion, Method};
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::BoundaryKind;
+/// use hasse_solver::physics::Conductivity;
+/// use hasse_solver::metric::Method;
 /// use std::sync::Arc;
 /// // Constant fields solve the reaction part alone: with u = 1, v = 2,
 /// // f = a − 2b and g = −b + 2c.

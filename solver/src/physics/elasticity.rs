@@ -36,9 +36,12 @@
 use crate::la::direct::{Factorization, SolveError, SolveReport};
 use crate::la::ordering::Ordering;
 use crate::metric::fe::{self, Topology};
+use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::MetricError;
 use crate::operator::{BlockMetric, Canonical, CanonicalError};
-use crate::physics::diffusion::{self, lumped_vertex_volumes, DiffusionError, ScalarFn, VectorFn};
+use crate::physics::diffusion::{self, DiffusionError};
+use crate::physics::VectorFn;
+use crate::physics::{tagged_boundary_faces, ScalarFn, TagError};
 use faer::sparse::SparseColMat;
 use hasse_complex::Complex;
 use nalgebra::DMatrix;
@@ -178,12 +181,8 @@ pub enum ElasticityError {
     Young { cell: usize, young: f64 },
     #[error("Poisson's ratio ν = {poisson} in top cell {cell} must lie in (−1, 0.5)")]
     Poisson { cell: usize, poisson: f64 },
-    #[error("boundary condition on tag '{tag}': no such tag in the mesh (tags: {available})")]
-    UnknownTag { tag: String, available: String },
-    #[error("boundary condition on tag '{tag}': it tags {dim}-cells, but boundary conditions need (n−1)-cells (n = {n})")]
-    TagDimension { tag: String, dim: usize, n: usize },
-    #[error("boundary condition on tag '{tag}': face {face} is not on the boundary")]
-    InteriorFace { tag: String, face: usize },
+    #[error(transparent)]
+    Tag(#[from] TagError),
     #[error("boundary condition on tag '{tag}' fixes component {component}, but displacements have {d} components (0..{d})")]
     Component {
         tag: String,
@@ -475,22 +474,8 @@ impl Elasticity {
         complex: &Complex,
         d: usize,
     ) -> Result<Vec<(usize, usize)>, ElasticityError> {
-        let condition = diffusion::tagged_boundary_faces(
-            complex,
-            self.boundary.iter().map(|(name, _)| name.as_str()),
-        )
-        .map_err(|e| match e {
-            DiffusionError::UnknownTag { tag, available } => {
-                ElasticityError::UnknownTag { tag, available }
-            }
-            DiffusionError::TagDimension { tag, dim, n } => {
-                ElasticityError::TagDimension { tag, dim, n }
-            }
-            DiffusionError::InteriorFace { tag, face } => {
-                ElasticityError::InteriorFace { tag, face }
-            }
-            other => ElasticityError::Diffusion(other),
-        })?;
+        let condition =
+            tagged_boundary_faces(complex, self.boundary.iter().map(|(name, _)| name.as_str()))?;
         for (name, kind) in &self.boundary {
             if let ElasticBoundary::Component { component, .. } = kind {
                 if *component >= d {

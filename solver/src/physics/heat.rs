@@ -19,10 +19,13 @@
 use crate::frontend::output::{Cochain, Step};
 use crate::la::direct::{DirectSolver, Factorization, SolveError};
 use crate::la::ordering::Ordering;
-use crate::physics::diffusion::{
-    lumped_vertex_volumes, BoundaryKind, Conductivity, Diffusion, DiffusionError, Location, Method,
-    ScalarFn,
-};
+use crate::metric::mass::lumped_vertex_volumes;
+use crate::metric::Location;
+use crate::metric::Method;
+use crate::physics::diffusion::{Diffusion, DiffusionError};
+use crate::physics::BoundaryKind;
+use crate::physics::Conductivity;
+use crate::physics::ScalarFn;
 use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::Complex;
 use std::sync::Arc;
@@ -93,7 +96,8 @@ pub enum HeatError {
 ///
 /// ```
 /// use hasse_complex::generate::rectangle;
-/// use hasse_solver::physics::diffusion::{Conductivity, Method};
+/// use hasse_solver::physics::Conductivity;
+/// use hasse_solver::metric::Method;
 /// use hasse_solver::physics::heat::{Heat, HeatBoundary, TimeFn};
 /// use std::sync::Arc;
 /// // Cooling from u = 1 towards the boundary value 0.
@@ -306,7 +310,8 @@ impl Heat {
     ///
     /// ```
     /// use hasse_complex::generate::rectangle;
-    /// use hasse_solver::physics::diffusion::{Conductivity, Method};
+    /// use hasse_solver::physics::Conductivity;
+    /// use hasse_solver::metric::Method;
     /// use hasse_solver::physics::heat::{Heat, HeatEvent};
     /// use std::sync::Arc;
     /// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();

@@ -27,7 +27,8 @@
 use crate::frontend::case::{Case, Problem};
 use crate::frontend::run::{self, RunError};
 use crate::la::iterative::CgOptions;
-use crate::physics::diffusion::{self, Diffusion, Iterative, Location, Solution};
+use crate::metric::Location;
+use crate::physics::diffusion::{self, Diffusion, Iterative, Solution};
 use hasse_complex::refine;
 use hasse_complex::split::Refinement;
 use hasse_complex::Complex;

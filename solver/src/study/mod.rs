@@ -12,7 +12,7 @@
 //!
 //! ```
 //! use hasse_solver::study::{Refinement, Study};
-//! use hasse_solver::physics::diffusion::Method;
+//! use hasse_solver::metric::Method;
 //! let text = r#"
 //! [mesh]
 //! generator = "rectangle"
@@ -50,7 +50,7 @@ pub use write::WriteError;
 use crate::frontend::case::{Case, CaseError, Diagnostics, Problem};
 use crate::frontend::mesh_spec::MeshSpec;
 use crate::frontend::run::{self, RunError};
-use crate::physics::diffusion::Method;
+use crate::metric::Method;
 use hasse_complex::dual::DualKind;
 use serde::Serialize;
 use std::path::Path;
@@ -72,7 +72,7 @@ pub const METHODS: [Method; 6] = [
 ///
 /// ```
 /// use hasse_solver::study::parse_method;
-/// use hasse_solver::physics::diffusion::Method;
+/// use hasse_solver::metric::Method;
 /// assert_eq!(parse_method("fv-mimetic").unwrap(), Method::FvMimetic);
 /// assert!(parse_method("fvm").unwrap_err().to_string().contains("fv-mimetic"));
 /// ```
@@ -386,7 +386,7 @@ impl Study {
     ///
     /// ```
     /// use hasse_solver::study::{Norm, Refinement, Study};
-    /// use hasse_solver::physics::diffusion::Method;
+    /// use hasse_solver::metric::Method;
     /// let case = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../cases/box-3d.toml"));
     /// let study = Study { levels: 2, refinement: Refinement::Uniform, methods: vec![Method::Fv] };
     /// let mut lines = Vec::new();

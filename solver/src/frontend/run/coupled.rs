@@ -4,8 +4,9 @@
 
 use super::{diffusion_problem, field_points, scalar_fn, Field, RunError, RunResult};
 use crate::frontend::case::{Case, CoupledSpec};
+use crate::metric::mass::lumped_vertex_volumes;
+use crate::metric::Location;
 use crate::physics::coupled::{Coupled, CoupledError, CoupledField, Reaction};
-use crate::physics::diffusion::{lumped_vertex_volumes, Location};
 use hasse_complex::Complex;
 use std::time::Instant;
 

@@ -5,10 +5,11 @@
 use super::{check_residual, scalar_fn, Field, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{Case, ElasticBoundaryKind, ElasticitySpec, MaterialSpec};
-use crate::physics::diffusion::{Errors, VectorFn};
+use crate::physics::diffusion::Errors;
 use crate::physics::elasticity::{
     Coefficient, ElasticBoundary, Elasticity, ElasticityError, Material,
 };
+use crate::physics::VectorFn;
 use hasse_complex::Complex;
 use std::time::Instant;
 

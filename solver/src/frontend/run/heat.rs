@@ -5,7 +5,8 @@
 use super::{conductivity, scalar_fn, Field, LevelStream, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{BoundaryKindSpec, Case, HeatSpec};
-use crate::physics::diffusion::{lumped_vertex_volumes, Errors};
+use crate::metric::mass::lumped_vertex_volumes;
+use crate::physics::diffusion::Errors;
 use crate::physics::heat::{Heat, HeatBoundary, HeatError, HeatEvent, History, TimeFn};
 use hasse_complex::Complex;
 use std::sync::Arc;
@@ -101,7 +102,7 @@ pub(super) fn solve_streaming<'a>(
     phase("assembling and factorising");
     let started = Instant::now();
     let initial = |x: &[f64]| spec.initial.eval(x, time.start);
-    let dim = if heat.at(time.start).location() == crate::physics::diffusion::Location::Nodal {
+    let dim = if heat.at(time.start).location() == crate::metric::Location::Nodal {
         0
     } else {
         complex.dim()

@@ -28,11 +28,14 @@ use crate::frontend::case::{
 };
 use crate::la::direct::Factorization;
 use crate::la::ordering::Ordering;
+use crate::metric::Location;
 use crate::metric::Tensor;
-use crate::physics::diffusion::{
-    self, BoundaryKind, Conductivity, Diffusion, DiffusionError, Errors, Location, ScalarFn,
-    TensorFn, VectorFn,
-};
+use crate::physics::diffusion::{self, Diffusion, DiffusionError, Errors};
+use crate::physics::BoundaryKind;
+use crate::physics::Conductivity;
+use crate::physics::ScalarFn;
+use crate::physics::TensorFn;
+use crate::physics::VectorFn;
 use hasse_complex::Complex;
 use std::fmt;
 use std::path::PathBuf;
@@ -229,7 +232,7 @@ fn solve_diffusion(
 ) -> Result<RunResult, RunError> {
     let problem = with_solver(case, diffusion_problem(case, spec), complex)?;
     let mut warnings = Vec::new();
-    if let (crate::physics::diffusion::Method::Fv, Coefficient::Tensor(rows)) =
+    if let (crate::metric::Method::Fv, Coefficient::Tensor(rows)) =
         (spec.method, &spec.conductivity)
     {
         let off_diagonal_zero = rows.iter().enumerate().all(|(i, row)| {

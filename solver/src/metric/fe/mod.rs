@@ -37,29 +37,21 @@ mod tests;
 mod topology;
 mod vem;
 
+use super::{check_tensors, CellTensors, MetricError, Tensor};
+use crate::la::parallel::{ranges, split_at_ranges};
+use crate::operator::BlockMetric;
+use hasse_complex::Complex;
 use load::{cell_load, element_load, evaluate, LoadFn};
+use nalgebra::DMatrix;
 use p1::p1_weights;
 pub(crate) use p1::{k_dot, simplex_gradients};
 use q1::{q1_cell, q1_gradients, q1_load, Q1Memo};
+use rayon::prelude::*;
+use sprs::CsMat;
+use std::rc::Rc;
 use topology::{edge_block, pseudo_inverse_of_key, tensor_order_of};
 pub(crate) use topology::{edge_pseudo_inverse, Topology};
 use vem::vem_stiffness;
-
-use super::{check_tensors, CellTensors, MetricError, Tensor};
-
-use crate::la::parallel::{ranges, split_at_ranges};
-
-use crate::operator::BlockMetric;
-
-use hasse_complex::Complex;
-
-use nalgebra::DMatrix;
-
-use rayon::prelude::*;
-
-use sprs::CsMat;
-
-use std::rc::Rc;
 
 /// A point padded to three coordinates.
 pub(crate) type Point = [f64; 3];

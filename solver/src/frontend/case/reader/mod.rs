@@ -11,8 +11,8 @@ use super::{
 use crate::frontend::mesh_spec::MeshSpec;
 use crate::la::direct::Factorization;
 use crate::la::ordering::Ordering;
+use crate::metric::Method;
 use crate::multigrid::CellProlongation;
-use crate::physics::diffusion::Method;
 use crate::refine::{RefineSpec, Strategy};
 use hasse_complex::DualKind;
 use std::collections::BTreeMap;

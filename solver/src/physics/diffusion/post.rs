@@ -1,0 +1,275 @@
+//! What a solution yields besides its values: cell-wise gradients, error
+//! norms against an exact solution, face-flux errors and per-cell
+//! conservation residuals.
+
+use super::*;
+
+/// Cell-wise gradient of a discrete field, by least squares over the
+/// points that carry values: the cell's vertices (nodal), the centroids of
+/// the neighbouring cells (cell-centred) or of the cell's faces (hybrid).
+/// Exact for linear fields (for cell-centred values wherever a cell has at
+/// least d neighbours in general position).
+pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64; 3]> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let cells = complex.cell_count(n);
+    // Cell values stand for the exact field at their cell points.
+    let centre = match solution.location {
+        Location::CellCentred => solution
+            .cell_points
+            .as_deref()
+            .unwrap_or(complex.centroid(n)),
+        _ => complex.centroid(n),
+    };
+    let face_centre = complex.centroid(n - 1);
+    let by_cell = complex.boundary_csc(n);
+    let top = complex.boundary(n);
+    (0..cells)
+        .map(|c| {
+            let mut points: Vec<(Vec<f64>, f64)> = Vec::new();
+            let xc = &centre[c * d..(c + 1) * d];
+            match solution.location {
+                Location::Nodal => {
+                    for &v in complex.cell_vertices(n, c) {
+                        points.push((complex.vertices().point(v).to_vec(), solution.values[v]));
+                    }
+                }
+                Location::Hybrid => {
+                    if let Some(col) = by_cell.outer_view(c) {
+                        for (f, _) in col.iter() {
+                            points.push((
+                                face_centre[f * d..(f + 1) * d].to_vec(),
+                                solution.values[cells + f],
+                            ));
+                        }
+                    }
+                }
+                Location::CellCentred => {
+                    points.push((xc.to_vec(), solution.values[c]));
+                    if let Some(col) = by_cell.outer_view(c) {
+                        for (f, _) in col.iter() {
+                            if let Some(row) = top.outer_view(f) {
+                                for (other, _) in row.iter() {
+                                    if other != c {
+                                        points.push((
+                                            centre[other * d..(other + 1) * d].to_vec(),
+                                            solution.values[other],
+                                        ));
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            least_squares_gradient(&points, d)
+        })
+        .collect()
+}
+
+pub(super) fn least_squares_gradient(points: &[(Vec<f64>, f64)], d: usize) -> [f64; 3] {
+    let m = points.len() as f64;
+    let mut mean_x = vec![0.0; d];
+    let mut mean_u = 0.0;
+    for (x, u) in points {
+        for a in 0..d {
+            mean_x[a] += x[a] / m;
+        }
+        mean_u += u / m;
+    }
+    let mut normal = nalgebra::DMatrix::<f64>::zeros(d, d);
+    let mut right = nalgebra::DVector::<f64>::zeros(d);
+    for (x, u) in points {
+        for a in 0..d {
+            for b in 0..d {
+                normal[(a, b)] += (x[a] - mean_x[a]) * (x[b] - mean_x[b]);
+            }
+            right[a] += (x[a] - mean_x[a]) * (u - mean_u);
+        }
+    }
+    let mut g = [0.0; 3];
+    // A rank-deficient fit (too few points, e.g. on an embedded surface)
+    // falls back to the minimum-norm solution.
+    let solution = normal
+        .clone()
+        .pseudo_inverse(1e-14 * normal.norm().max(f64::MIN_POSITIVE))
+        .map(|p| p * right)
+        .unwrap_or_else(|_| nalgebra::DVector::zeros(d));
+    for a in 0..d {
+        g[a] = solution[a];
+    }
+    g
+}
+
+/// Errors of `solution` against the exact field `u` (and its gradient, if
+/// given). For pure-Neumann problems the mean of the difference is removed
+/// first (the solution is only defined up to a constant).
+pub fn errors(
+    complex: &Complex,
+    solution: &Solution,
+    exact: &ScalarFn,
+    exact_gradient: Option<&VectorFn>,
+) -> Errors {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let (points, weights): (Vec<Vec<f64>>, Vec<f64>) = match solution.location {
+        Location::Nodal => (
+            (0..complex.cell_count(0))
+                .map(|v| complex.vertices().point(v).to_vec())
+                .collect(),
+            lumped_vertex_volumes(complex),
+        ),
+        _ => (
+            solution
+                .cell_points
+                .as_deref()
+                .unwrap_or(complex.centroid(n))
+                .chunks(d)
+                .map(<[f64]>::to_vec)
+                .collect(),
+            complex.measure(n).to_vec(),
+        ),
+    };
+    let field = solution.field(complex);
+    let mut diff: Vec<f64> = points
+        .iter()
+        .zip(field)
+        .map(|(x, u)| u - exact(x))
+        .collect();
+    if solution.pure_neumann {
+        let wsum: f64 = weights.iter().sum();
+        let mean: f64 = diff.iter().zip(&weights).map(|(e, w)| e * w).sum::<f64>() / wsum;
+        for e in &mut diff {
+            *e -= mean;
+        }
+    }
+    let l2 = diff
+        .iter()
+        .zip(&weights)
+        .map(|(e, w)| e * e * w)
+        .sum::<f64>()
+        .sqrt();
+    let max = diff.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    let gradient_l2 = exact_gradient.map_or(f64::NAN, |grad| {
+        let g = reconstruct_gradient(complex, solution);
+        let volume = complex.measure(n);
+        let centre = complex.centroid(n);
+        (0..complex.cell_count(n))
+            .map(|c| {
+                let e = grad(&centre[c * d..(c + 1) * d]);
+                let s: f64 = (0..d).map(|a| (g[c][a] - e[a]).powi(2)).sum();
+                s * volume[c]
+            })
+            .sum::<f64>()
+            .sqrt()
+    });
+    Errors {
+        l2,
+        max,
+        gradient_l2,
+    }
+}
+
+/// Discrete L² error of the face fluxes of a cell-centred or hybrid
+/// solution against the exact flux −∫_F K∇u·n ≈ −|F| K(x_F)∇u(x_F)·n_F:
+/// sqrt(Σ_F w_F ((q_F − q_F^exact)/|F|)²) with w_F = |F| d_F, d_F the
+/// distance between the centroids on either side of F (cell to face on the
+/// boundary, and for the half-faces of the hybrid method). Boundary faces
+/// without flux (Neumann) are included: their exact flux is the data's.
+/// `None` for nodal methods, whose edge cochain is not a face flux.
+pub fn flux_error(
+    complex: &Complex,
+    solution: &Solution,
+    problem: &Diffusion,
+    exact_gradient: &VectorFn,
+) -> Option<f64> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let area = complex.measure(n - 1);
+    let face_centre = complex.centroid(n - 1);
+    let cell_centre = complex.centroid(n);
+    let normal = complex.normal();
+    let exact_density = |f: usize| -> f64 {
+        let x = &face_centre[f * d..(f + 1) * d];
+        let g = exact_gradient(x);
+        let k = match &problem.conductivity {
+            Conductivity::Scalar(l) => metric::isotropic(l(x)),
+            Conductivity::Tensor(t) => t(x),
+        };
+        let mut kg = [0.0; 3];
+        for a in 0..d {
+            for b in 0..d {
+                kg[a] += k[a][b] * g[b];
+            }
+        }
+        -(0..d).map(|a| kg[a] * normal[f * d + a]).sum::<f64>()
+    };
+    let distance = |x: &[f64], y: &[f64]| -> f64 {
+        x.iter()
+            .zip(y)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let top = complex.boundary(n);
+    let mut sum = 0.0;
+    match solution.location {
+        Location::Nodal => return None,
+        Location::CellCentred => {
+            for (f, row) in top.outer_iterator().enumerate() {
+                let xf = &face_centre[f * d..(f + 1) * d];
+                let cells: Vec<usize> = row.indices().to_vec();
+                let d_f = match cells.as_slice() {
+                    [k, l] => distance(
+                        &cell_centre[k * d..(k + 1) * d],
+                        &cell_centre[l * d..(l + 1) * d],
+                    ),
+                    [k] => distance(&cell_centre[k * d..(k + 1) * d], xf),
+                    _ => continue,
+                };
+                let e = solution.flux[f] / area[f] - exact_density(f);
+                sum += area[f] * d_f * e * e;
+            }
+        }
+        Location::Hybrid => {
+            // Half-face rows follow boundary_csc(n): cell by cell, its faces;
+            // the sign turns the face normal into the cell's outward normal.
+            let by_cell = complex.boundary_csc(n);
+            let mut row = 0;
+            for (k, col) in by_cell.outer_iterator().enumerate() {
+                for (f, &s) in col.iter() {
+                    let xf = &face_centre[f * d..(f + 1) * d];
+                    let d_f = distance(&cell_centre[k * d..(k + 1) * d], xf);
+                    let e = solution.flux[row] / area[f] - f64::from(s) * exact_density(f);
+                    sum += area[f] * d_f * e * e;
+                    row += 1;
+                }
+            }
+        }
+    }
+    Some(sum.sqrt())
+}
+
+/// Per-cell conservation residual of cell-centred fluxes: for every top
+/// cell, Σ_F ∂(F,c) q_F − ∫_c f (zero to rounding for FV/FD).
+pub fn conservation_residual(
+    complex: &Complex,
+    solution: &Solution,
+    source: &ScalarFn,
+) -> Vec<f64> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let volume = complex.measure(n);
+    let centre = complex.centroid(n);
+    let by_cell = complex.boundary_csc(n);
+    (0..complex.cell_count(n))
+        .map(|c| {
+            let out: f64 = by_cell.outer_view(c).map_or(0.0, |col| {
+                col.iter()
+                    .map(|(f, &s)| f64::from(s) * solution.flux[f])
+                    .sum()
+            });
+            out - source(&centre[c * d..(c + 1) * d]) * volume[c]
+        })
+        .collect()
+}
