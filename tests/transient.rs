@@ -282,21 +282,19 @@ fn a_quadratic_in_time_part_gives_backward_euler_exactly_t_dt_and_crank_nicolson
 }
 
 #[test]
-fn time_series_feed_the_output_writer() {
+fn saved_levels_are_cochains_of_the_unknowns_degree() {
     let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
     let heat = zero_boundary(Heat::new(Method::Fe, unit(), 0.01));
     let history = heat.run(&mesh, &*sine(), 7, 3).unwrap();
     // t₀, steps 3 and 6, and the last one (7).
     assert_eq!(history.times.len(), 4);
     assert!((history.times[3] - 0.07).abs() < 1e-15);
-    let steps = history.steps("u");
-    assert_eq!(steps[2].cochains[0].dim, 0);
-    assert_eq!(steps[2].cochains[0].values.len(), 25);
+    // Nodal: 0-cochains on the 25 vertices; cell-centred: 2-cochains on
+    // the 16 squares.
+    assert_eq!((history.degree, history.fields[2].len()), (0, 25));
     let fv = zero_boundary(Heat::new(Method::Fv, unit(), 0.01));
-    assert_eq!(
-        fv.run(&mesh, &*sine(), 1, 1).unwrap().steps("u")[1].cochains[0].dim,
-        2
-    );
+    let cells = fv.run(&mesh, &*sine(), 1, 1).unwrap();
+    assert_eq!((cells.degree, cells.fields[1].len()), (2, 16));
     // Errors are typed.
     assert!(matches!(
         Heat::new(Method::Fe, unit(), 0.0).run(&mesh, &*sine(), 1, 1),

@@ -3,6 +3,7 @@
 
 pub mod direct;
 pub mod eigen;
+pub mod fixed;
 pub mod iterative;
 pub mod ordering;
 pub(crate) mod parallel;

@@ -3,6 +3,7 @@
 use super::cycle::spectral_bound;
 use super::transfer::grid_prolongation;
 use super::*;
+use crate::la::fixed::FixedSplit;
 use crate::la::iterative::RowMatrix;
 
 fn apply(p: &RowMatrix, x: &[f64]) -> Vec<f64> {
@@ -51,14 +52,15 @@ fn grid_prolongation_interpolates_affine_nodal_fields_and_copies_cell_values() {
 fn dirichlet_vertices_remove_their_coarse_twins() {
     // 1D, 4 cells: vertices 0..4, coarse 0..2; both ends fixed.
     let p = grid_prolongations(&[4], Transfer::Nodal).unwrap();
-    let fixed = [true, false, false, false, true];
+    let fixed = FixedSplit::from_mask([true, false, false, false, true]);
     let free = restrict_to_free(&p, &fixed).unwrap();
     // Fine free 1, 2, 3; coarse free: only the middle vertex (fine 2).
     assert_eq!((free[0].matrix.nrows(), free[0].matrix.ncols()), (3, 1));
     assert_eq!(apply(&free[0].matrix, &[1.0]), vec![0.5, 1.0, 0.5]);
     // Cells: a coarse cell goes only with all its children.
     let p = grid_prolongations(&[4], Transfer::Cells).unwrap();
-    let free = restrict_to_free(&p, &[true, true, false, false]).unwrap();
+    let fixed = FixedSplit::from_mask([true, true, false, false]);
+    let free = restrict_to_free(&p, &fixed).unwrap();
     assert_eq!((free[0].matrix.nrows(), free[0].matrix.ncols()), (2, 1));
 }
 

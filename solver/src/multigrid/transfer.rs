@@ -3,6 +3,7 @@
 //! that knows the complex), and their restriction to free unknowns.
 
 use super::MultigridError;
+use crate::la::fixed::FixedSplit;
 use crate::la::iterative::RowMatrix;
 use hasse_complex::split::Refinement;
 use std::sync::Arc;
@@ -231,15 +232,15 @@ pub fn refinement_prolongations(
     Ok(out)
 }
 
-/// The prolongations restricted to the unknowns that are not `fixed` (on
-/// the finest level; the coarse levels' fixed unknowns follow from the
+/// The prolongations restricted to the free unknowns of `split` (on the
+/// finest level; the coarse levels' fixed unknowns follow from the
 /// [`Transfer`] rule). Dropping a coarse unknown whose support is all
 /// fixed keeps the coarse operators nonsingular.
 pub fn restrict_to_free(
     prolongations: &[Prolongation],
-    fixed: &[bool],
+    split: &FixedSplit,
 ) -> Result<Vec<Prolongation>, MultigridError> {
-    let mut fixed = fixed.to_vec();
+    let mut fixed: Vec<bool> = (0..split.unknowns()).map(|i| split.is_fixed(i)).collect();
     let mut out = Vec::with_capacity(prolongations.len());
     for (level, p) in prolongations.iter().enumerate() {
         let m = &p.matrix;

@@ -706,3 +706,35 @@ fn metric_values_can_change_without_a_new_pattern() {
         Err(CanonicalError::PatternChanged)
     );
 }
+
+#[test]
+fn restricted_columns_give_the_free_block_of_the_canonical_operator() {
+    use crate::la::fixed::FixedSplit;
+    // A path of 4 vertices (3 edges), Ω = diag(1, 2, 3): the vertex
+    // Laplacian; dropping vertices 0 and 3 leaves [[3, −2], [−2, 5]].
+    let a = CsMat::new(
+        (3, 4),
+        vec![0, 2, 4, 6],
+        vec![0, 1, 1, 2, 2, 3],
+        vec![-1i8, 1, -1, 1, -1, 1],
+    );
+    let omega = BlockMetric::diagonal(&[1.0, 2.0, 3.0]);
+    let split = FixedSplit::from_mask([true, false, false, true]);
+    let reduced = Canonical::new(split.restrict_columns(&a), omega.clone())
+        .unwrap()
+        .assemble()
+        .to_dense();
+    assert_eq!(
+        (reduced[(0, 0)], reduced[(0, 1)], reduced[(1, 1)]),
+        (3.0, -2.0, 5.0)
+    );
+    let full = Canonical::new(a, omega).unwrap().assemble();
+    assert_eq!(split.free_block(&full).to_dense(), reduced);
+    // Eᵀ diag(w) E keeps the free weights.
+    let e = split.selection();
+    let w = Canonical::new(e, BlockMetric::diagonal(&[1.0, 2.0, 3.0, 4.0]))
+        .unwrap()
+        .assemble()
+        .to_dense();
+    assert_eq!((w[(0, 0)], w[(1, 1)], w[(0, 1)]), (2.0, 3.0, 0.0));
+}

@@ -25,23 +25,25 @@
 //! failure and LBLᵀ or LU solve it. Both fields must live on the same cells
 //! (both nodal or both cell-centred) for the pointwise coupling.
 //!
-//! Dirichlet values of nodal fields are eliminated before the blocks are
-//! placed: the canonical operator of a field keeps Ω and drops the fixed
-//! columns of A (A_free), the known values move to the right-hand side,
-//! so the blocks keep their canonical form and the system stays SPD.
+//! Every block is a canonical operator. Dirichlet values of nodal fields
+//! are eliminated before the blocks are placed ([`FixedSplit`]): the
+//! operator of a field keeps Ω and drops the fixed columns of A (A E, E the
+//! selection of the free unknowns), the known values move to the
+//! right-hand side, so the system stays SPD. The reaction blocks are
+//! Eᵀ (aW) E and the coupling block E₁ᵀ (−bW) E₂, lumped masses over the
+//! unknowns restricted to each field's free ones.
 //! [`CoupledSystem::update`] puts new coefficient values into the same
 //! pattern, and the symbolic factorisation is reused.
 
 use crate::la::direct::{Factorization, SolveError};
+use crate::la::fixed::FixedSplit;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::Location;
 use crate::operator::block::{Block, BlockError, BlockSystem, Symmetry};
-use crate::operator::{Canonical, CanonicalError};
+use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use crate::physics::diffusion::{Diffusion, DiffusionError};
 use crate::physics::ScalarFn;
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use hasse_complex::Complex;
-use sprs::TriMat;
 
 /// One of the two fields: a name and its diffusion problem (method, D,
 /// source, boundary conditions).
@@ -158,8 +160,8 @@ pub enum CoupledError {
 /// One field's share of the system.
 #[derive(Clone, Debug)]
 struct Part {
-    /// Free unknowns, in order (their position is the block's index).
-    free: Vec<usize>,
+    /// Free and fixed unknowns (the free ones' positions index the block).
+    split: FixedSplit,
     /// Every unknown's prescribed value, if any.
     fixed: Vec<Option<f64>>,
     /// K restricted to the free unknowns, in canonical form.
@@ -172,10 +174,10 @@ struct Part {
 /// The values of one assembly: both parts and the lumped reaction blocks.
 struct Values {
     parts: [Part; 2],
-    /// Diagonal of aW on field 0's free unknowns, of cW on field 1's.
-    reaction: [Vec<f64>; 2],
-    /// −bW at (free index in field 0, free index in field 1).
-    coupling: Vec<(usize, usize, f64)>,
+    /// Eᵀ (aW) E on field 0's free unknowns, Eᵀ (cW) E on field 1's.
+    reaction: [Canonical; 2],
+    /// E₀ᵀ (−bW) E₁.
+    coupling: Canonical,
     /// Both fields' right-hand sides, coupling lifts included, stacked.
     rhs: Vec<f64>,
     location: Location,
@@ -212,33 +214,6 @@ impl CoupledSolution {
     }
 }
 
-/// A diagonal matrix with every entry stored, zeros included, so the
-/// pattern does not depend on the values.
-fn diagonal(values: &[f64]) -> SparseColMat<usize, f64> {
-    let n = values.len();
-    let symbolic =
-        SymbolicSparseColMat::new_checked(n, n, (0..=n).collect(), None, (0..n).collect());
-    SparseColMat::new(symbolic, values.to_vec())
-}
-
-/// A rows × cols matrix with one entry per column at most, from (row, col,
-/// value) sorted by column, explicit zeros kept.
-fn sparse(rows: usize, cols: usize, entries: &[(usize, usize, f64)]) -> SparseColMat<usize, f64> {
-    let mut col_ptr = vec![0usize; cols + 1];
-    for &(_, c, _) in entries {
-        col_ptr[c + 1] += 1;
-    }
-    for c in 0..cols {
-        col_ptr[c + 1] += col_ptr[c];
-    }
-    let row_idx = entries.iter().map(|e| e.0).collect();
-    let values = entries.iter().map(|e| e.2).collect();
-    SparseColMat::new(
-        SymbolicSparseColMat::new_checked(rows, cols, col_ptr, None, row_idx),
-        values,
-    )
-}
-
 impl Coupled {
     /// The problem, solved by LLᵀ unless told otherwise.
     pub fn new(first: CoupledField, second: CoupledField, reaction: Reaction) -> Self {
@@ -263,13 +238,14 @@ impl Coupled {
             rhs,
             location,
         } = self.values(complex)?;
-        let sizes = [parts[0].free.len(), parts[1].free.len()];
+        let sizes = [parts[0].split.free().len(), parts[1].split.free().len()];
+        let [first_reaction, second_reaction] = reaction;
         let blocks: Vec<(usize, usize, Block)> = vec![
             (0, 0, parts[0].operator.clone().into()),
             (1, 1, parts[1].operator.clone().into()),
-            (0, 0, diagonal(&reaction[0]).into()),
-            (1, 1, diagonal(&reaction[1]).into()),
-            (0, 1, sparse(sizes[0], sizes[1], &coupling).into()),
+            (0, 0, first_reaction.into()),
+            (1, 1, second_reaction.into()),
+            (0, 1, coupling.into()),
         ];
         let system = BlockSystem::new(&sizes, Symmetry::Symmetric, blocks)?;
         Ok(CoupledSystem {
@@ -340,32 +316,28 @@ impl Coupled {
         let cw = coefficient(&self.reaction.c, "c")?;
         let parts = [part(first, complex)?, part(second, complex)?];
 
-        let mut index = [
-            vec![usize::MAX; weights.len()],
-            vec![usize::MAX; weights.len()],
-        ];
-        for (p, idx) in parts.iter().zip(&mut index) {
-            for (k, &u) in p.free.iter().enumerate() {
-                idx[u] = k;
-            }
-        }
+        let [first_selection, second_selection] = [0, 1].map(|i| parts[i].split.selection());
         let reaction = [
-            parts[0].free.iter().map(|&u| aw[u]).collect(),
-            parts[1].free.iter().map(|&u| cw[u]).collect(),
+            Canonical::new(first_selection.clone(), BlockMetric::from_weights(aw))?,
+            Canonical::new(second_selection.clone(), BlockMetric::from_weights(cw))?,
         ];
+        let minus_bw: Vec<f64> = bw.iter().map(|v| -v).collect();
+        let coupling = Canonical::coupling(
+            first_selection,
+            BlockMetric::from_weights(minus_bw),
+            second_selection,
+        )?;
         let mut rhs0 = parts[0].rhs.clone();
         let mut rhs1 = parts[1].rhs.clone();
-        let mut coupling = Vec::new();
         // The coupling −bW joins the same unknown of both fields; where one
         // side is fixed, its known value moves to the other's right-hand
-        // side. Visiting the unknowns in order leaves the entries sorted by
-        // column of the (0, 1) block, one per column, as `sparse` needs.
+        // side.
+        let index = |p: usize, u: usize| parts[p].split.free_index(u);
         for u in 0..weights.len() {
             match (parts[0].fixed[u], parts[1].fixed[u]) {
-                (None, None) => coupling.push((index[0][u], index[1][u], -bw[u])),
-                (None, Some(g)) => rhs0[index[0][u]] += bw[u] * g,
-                (Some(g), None) => rhs1[index[1][u]] += bw[u] * g,
-                (Some(_), Some(_)) => {}
+                (None, Some(g)) => rhs0[index(0, u).unwrap_or(0)] += bw[u] * g,
+                (Some(g), None) => rhs1[index(1, u).unwrap_or(0)] += bw[u] * g,
+                _ => {}
             }
         }
         rhs0.extend(rhs1);
@@ -390,30 +362,22 @@ fn part(field: &CoupledField, complex: &Complex) -> Result<Part, CoupledError> {
             source,
         })?;
     let fixed = assembled.fixed;
-    let unknowns = fixed.len();
-    let mut free_index = vec![usize::MAX; unknowns];
-    let mut free = Vec::new();
-    for (u, g) in fixed.iter().enumerate() {
-        if g.is_none() {
-            free_index[u] = free.len();
-            free.push(u);
-        }
-    }
+    let split = FixedSplit::new(&fixed);
     let canonical = assembled.canonical;
     // b_free −= (Aᵀ Ω A g)_free with g the prescribed values (0 elsewhere).
-    let known: Vec<f64> = fixed.iter().map(|g| g.unwrap_or(0.0)).collect();
+    let known = split.lift(&[], &fixed);
     let lifted = canonical.apply(&known);
-    let rhs = free.iter().map(|&u| assembled.rhs[u] - lifted[u]).collect();
-    let a = canonical.incidence();
-    let mut tri = TriMat::with_capacity((a.rows(), free.len()), a.nnz());
-    for (&s, (r, u)) in a.iter() {
-        if free_index[u] != usize::MAX {
-            tri.add_triplet(r, free_index[u], s);
-        }
-    }
-    let operator = Canonical::new(tri.to_csr(), canonical.metric().clone())?;
+    let rhs = split
+        .free()
+        .iter()
+        .map(|&u| assembled.rhs[u] - lifted[u])
+        .collect();
+    let operator = Canonical::new(
+        split.restrict_columns(canonical.incidence()),
+        canonical.metric().clone(),
+    )?;
     Ok(Part {
-        free,
+        split,
         fixed,
         operator,
         rhs,
@@ -442,20 +406,19 @@ impl CoupledSystem {
             rhs,
             location,
         } = problem.values(complex)?;
-        let sizes = self.system.fields().to_vec();
         if location != self.location
-            || parts[0].free != self.parts[0].free
-            || parts[1].free != self.parts[1].free
+            || parts[0].split != self.parts[0].split
+            || parts[1].split != self.parts[1].split
         {
             // Other fixed unknowns or another location are another pattern.
             return Err(CoupledError::Block(BlockError::PatternChanged { block: 0 }));
         }
         self.system.set_block(0, parts[0].operator.clone())?;
         self.system.set_block(1, parts[1].operator.clone())?;
-        self.system.set_block(2, diagonal(&reaction[0]))?;
-        self.system.set_block(3, diagonal(&reaction[1]))?;
-        self.system
-            .set_block(4, sparse(sizes[0], sizes[1], &coupling))?;
+        let [first_reaction, second_reaction] = reaction;
+        self.system.set_block(2, first_reaction)?;
+        self.system.set_block(3, second_reaction)?;
+        self.system.set_block(4, coupling)?;
         self.names = [
             problem.fields[0].name.clone(),
             problem.fields[1].name.clone(),
@@ -475,16 +438,10 @@ impl CoupledSystem {
             other => CoupledError::Block(other),
         })?;
         let x = factor.solve(&self.rhs)?;
-        let offset = self.parts[0].free.len();
-        let fields = [0, 1].map(|i| {
-            let part = &self.parts[i];
-            let mut values: Vec<f64> = part.fixed.iter().map(|g| g.unwrap_or(0.0)).collect();
-            let start = if i == 0 { 0 } else { offset };
-            for (k, &u) in part.free.iter().enumerate() {
-                values[u] = x[start + k];
-            }
-            values
-        });
+        let offset = self.parts[0].split.free().len();
+        let (first, second) = x.split_at(offset);
+        let fields = [first, second].map(|x| x.to_vec());
+        let fields = [0, 1].map(|i| self.parts[i].split.lift(&fields[i], &self.parts[i].fixed));
         Ok(CoupledSolution {
             names: self.names.clone(),
             fields,

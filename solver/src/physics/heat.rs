@@ -16,18 +16,19 @@
 //! every step and is factorised once. θ = 1 is backward Euler (first
 //! order, L-stable), θ = ½ Crank–Nicolson (second order, A-stable).
 
-use crate::frontend::output::{Cochain, Step};
 use crate::la::direct::{DirectSolver, Factorization, SolveError};
+use crate::la::fixed::FixedSplit;
 use crate::la::ordering::Ordering;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::Location;
 use crate::metric::Method;
+use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use crate::physics::diffusion::{Diffusion, DiffusionError};
 use crate::physics::BoundaryKind;
 use crate::physics::Conductivity;
 use crate::physics::ScalarFn;
-use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::Complex;
+use sprs::CsMat;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -90,6 +91,8 @@ pub enum HeatError {
     Diffusion(#[from] DiffusionError),
     #[error(transparent)]
     Solve(#[from] SolveError),
+    #[error(transparent)]
+    Canonical(#[from] CanonicalError),
 }
 
 /// The transient heat problem: method, conductivity, data and θ-scheme.
@@ -109,8 +112,8 @@ pub enum HeatError {
 /// assert!((history.times[2] - 0.1).abs() < 1e-15);
 /// // The maximum principle: values decay and stay in [0, 1].
 /// assert!(history.fields[2].iter().all(|&u| u > 0.0 && u < 1.0));
-/// let steps = history.steps("temperature");
-/// assert_eq!(steps[1].cochains[0].dim, 2);
+/// // Cell-centred unknowns: the fields are 2-cochains, one value a square.
+/// assert_eq!((history.degree, history.fields[1].len()), (2, 64));
 /// ```
 #[derive(Clone)]
 pub struct Heat {
@@ -168,20 +171,6 @@ pub enum HeatEvent<'a> {
     },
     /// Step number `n` (1-based) has been taken.
     Step(usize),
-}
-
-impl History {
-    /// The saved levels as output steps, one cochain `name` each.
-    pub fn steps(&self, name: &str) -> Vec<Step> {
-        self.times
-            .iter()
-            .zip(&self.fields)
-            .map(|(&time, field)| Step {
-                time,
-                cochains: vec![Cochain::new(name, self.degree, field.clone())],
-            })
-            .collect()
-    }
 }
 
 impl Heat {
@@ -366,43 +355,24 @@ impl Heat {
             u.push(v);
         }
 
-        // Free unknowns and the matrix L = M/Δt + θK on them; the entries of
-        // L in free rows and fixed columns lift the Dirichlet values.
+        // The step matrix L = M/Δt + θK in canonical form: the lumped mass
+        // (A = I, Ω = diag(m)) and the stiffness (A, Ω of the diffusion
+        // assembly) stacked, [I; A]ᵀ diag(m/Δt, θΩ) [I; A]. Its free block
+        // is factorised once; its free-row, fixed-column entries lift the
+        // Dirichlet values of every step.
         let stiffness = &first.matrix;
-        let mut free_index = vec![usize::MAX; unknowns];
-        let mut free = Vec::new();
-        for (i, g) in first.fixed.iter().enumerate() {
-            if g.is_none() {
-                free_index[i] = free.len();
-                free.push(i);
-            }
-        }
-        let mut triplets = Vec::with_capacity(stiffness.compute_nnz());
-        let mut lift: Vec<(usize, usize, f64)> = Vec::new();
-        for (i, &fi) in free_index.iter().enumerate() {
-            if fi != usize::MAX {
-                triplets.push(Triplet::new(fi, fi, mass[i] / dt));
-            }
-        }
-        for j in 0..unknowns {
-            let range = stiffness.col_range(j);
-            let rows = &stiffness.row_idx()[range.clone()];
-            let vals = &stiffness.val()[range];
-            for (&i, &v) in rows.iter().zip(vals) {
-                let fi = free_index[i];
-                if fi == usize::MAX {
-                    continue;
-                }
-                if free_index[j] != usize::MAX {
-                    triplets.push(Triplet::new(fi, free_index[j], theta * v));
-                } else {
-                    lift.push((fi, j, theta * v));
-                }
-            }
-        }
+        let lumped = Canonical::new(
+            CsMat::<i8>::eye(unknowns),
+            BlockMetric::from_weights(mass.clone()),
+        )?;
         let started = Instant::now();
-        let reduced = SparseColMat::try_new_from_triplets(free.len(), free.len(), &triplets)
-            .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
+        let step_matrix =
+            Canonical::sum(&[(1.0 / dt, &lumped), (theta, &first.canonical)])?.assemble_owned();
+        let split = FixedSplit::new(&first.fixed);
+        let free = split.free().to_vec();
+        let reduced = split.free_block(&step_matrix);
+        let lift = split.coupling(&step_matrix);
+        drop(step_matrix);
         // Analysed once: every step reuses this factor.
         let (factor, ordering) = if free.is_empty() {
             (None, None)
@@ -455,10 +425,8 @@ impl Heat {
                     + theta * b_new[i]
                     + (1.0 - theta) * b_old[i];
             }
-            for &(fi, j, v) in &lift {
-                // The fixed pattern is the tags', the same at every time.
-                rhs[fi] -= v * fixed_new[j].unwrap_or(0.0);
-            }
+            // The fixed pattern is the tags', the same at every time.
+            FixedSplit::lift_into(&lift, &fixed_new, &mut rhs);
             // An unstable θ < ½ overflows, in the right-hand side or in the
             // solve. The matrix was factorised, so a non-finite solution
             // (which the solve reports as a singular matrix) is overflow too.

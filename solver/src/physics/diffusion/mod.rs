@@ -25,8 +25,6 @@
 mod assemble;
 mod post;
 mod solve;
-#[cfg(test)]
-mod tests;
 
 use crate::la::direct::{self, DirectSolver, Factorization, SolveError, SolveReport};
 use crate::la::iterative::{conjugate_gradient, CgError, CgOptions, CgReport, RowMatrix};

@@ -4,6 +4,7 @@
 //! the free unknowns.
 
 use super::*;
+use crate::la::fixed::FixedSplit;
 
 /// Every connected part of the free unknowns must be tied to a Dirichlet
 /// value or a Robin/ghost row, or M is singular there. On a part C of the
@@ -160,29 +161,11 @@ pub(super) fn solve_fixed(
     points: Option<UnknownPoints<'_>>,
 ) -> Result<(Vec<f64>, SolveReport, Option<CgReport>, bool), DiffusionError> {
     let n = rhs.len();
-    let mut free_index = vec![usize::MAX; n];
-    let mut free = Vec::new();
-    for i in 0..n {
-        if fixed[i].is_none() {
-            free_index[i] = free.len();
-            free.push(i);
-        }
-    }
-    let mut reduced_rhs: Vec<f64> = free.iter().map(|&i| rhs[i]).collect();
-    // b_f −= M_fd g, column after column of the fixed unknowns.
-    for (j, g) in fixed.iter().enumerate().take(n) {
-        if let Some(g) = *g {
-            let range = matrix.col_range(j);
-            let rows = &matrix.row_idx()[range.clone()];
-            for (&i, &v) in rows.iter().zip(&matrix.val()[range]) {
-                if free_index[i] != usize::MAX {
-                    reduced_rhs[free_index[i]] -= v * g;
-                }
-            }
-        }
-    }
-    let mut values: Vec<f64> = fixed.iter().map(|g| g.unwrap_or(0.0)).collect();
+    let split = FixedSplit::new(fixed);
+    let free = split.free();
+    let reduced_rhs = split.reduced_rhs(matrix, rhs, fixed);
     if free.is_empty() {
+        let values = split.lift(&[], fixed);
         let report = SolveReport {
             factorization,
             ordering: None,
@@ -198,10 +181,10 @@ pub(super) fn solve_fixed(
         return Ok((values, report, None, false));
     }
     // Without fixed unknowns the matrix is used as it is.
-    let reduced: std::borrow::Cow<'_, SparseColMat<usize, f64>> = if free.len() == n {
+    let reduced: std::borrow::Cow<'_, SparseColMat<usize, f64>> = if split.all_free() {
         std::borrow::Cow::Borrowed(matrix)
     } else {
-        std::borrow::Cow::Owned(free_block(matrix, &free, &free_index))
+        std::borrow::Cow::Owned(split.free_block(matrix))
     };
     let analysis = analysis.filter(|a| a.fits(&reduced)).map(|a| a.solver);
     let analysed = analysis.is_some();
@@ -251,9 +234,8 @@ pub(super) fn solve_fixed(
                     let rows = RowMatrix::from_symmetric(&reduced)?;
                     // The row copy replaces the faer matrix for the solve.
                     drop(reduced);
-                    let fixed_mask: Vec<bool> = fixed.iter().map(Option::is_some).collect();
                     let prolongations =
-                        multigrid::restrict_to_free(&hierarchy.prolongations(n)?, &fixed_mask)?;
+                        multigrid::restrict_to_free(&hierarchy.prolongations(n)?, &split)?;
                     let mg = Multigrid::new(rows, prolongations, options)?;
                     let (x, cg) = mg.solve(&reduced_rhs, guess.as_deref(), &settings.options)?;
                     (x, cg, mg.setup_seconds)
@@ -274,10 +256,7 @@ pub(super) fn solve_fixed(
             (x, report, Some(cg))
         }
     };
-    for (k, &i) in free.iter().enumerate() {
-        values[i] = x[k];
-    }
-    Ok((values, report, iterations, analysed))
+    Ok((split.lift(&x, fixed), report, iterations, analysed))
 }
 
 /// A point of each unknown of `location`, for the geometric ordering: the
@@ -323,55 +302,6 @@ pub(super) fn points_of(points: UnknownPoints<'_>, kept: impl Iterator<Item = us
     kept.flat_map(|i| &points.coordinates[i * d..(i + 1) * d])
         .copied()
         .collect()
-}
-
-/// The block of `matrix` on the unknowns `free` (increasing), whose new
-/// indices are `free_index` (`usize::MAX` for the others). Renumbering keeps
-/// the order of the rows, so the CSC invariants of `matrix` carry over and
-/// nothing is sorted; the columns are copied in parallel ranges, each
-/// counted and then written in place (see `canonical::compressed_lists`).
-pub(super) fn free_block(
-    matrix: &SparseColMat<usize, f64>,
-    free: &[usize],
-    free_index: &[usize],
-) -> SparseColMat<usize, f64> {
-    let kept_rows = |j: usize| {
-        let range = matrix.col_range(j);
-        matrix.row_idx()[range.clone()]
-            .iter()
-            .zip(&matrix.val()[range])
-            .filter(|(&i, _)| free_index[i] != usize::MAX)
-            .map(|(&i, &v)| (free_index[i], v))
-    };
-    let size = free.len();
-    let parts = crate::la::parallel::ranges(size);
-    let mut col_ptr = vec![0usize; size + 1];
-    let counts = crate::la::parallel::split_at_ranges(&mut col_ptr[1..], &parts, |k| k);
-    parts.par_iter().zip(counts).for_each(|(range, counts)| {
-        for (k, count) in range.clone().zip(counts) {
-            *count = kept_rows(free[k]).count();
-        }
-    });
-    for k in 0..size {
-        col_ptr[k + 1] += col_ptr[k];
-    }
-    let mut row_idx = vec![0usize; col_ptr[size]];
-    let mut val = vec![0.0; col_ptr[size]];
-    let row_pieces = crate::la::parallel::split_at_ranges(&mut row_idx, &parts, |k| col_ptr[k]);
-    let val_pieces = crate::la::parallel::split_at_ranges(&mut val, &parts, |k| col_ptr[k]);
-    parts
-        .par_iter()
-        .zip(row_pieces.into_par_iter().zip(val_pieces))
-        .for_each(|(range, (rows_out, vals_out))| {
-            let slots = rows_out.iter_mut().zip(vals_out.iter_mut());
-            let entries = range.clone().flat_map(|k| kept_rows(free[k]));
-            for ((row, value), (i, v)) in slots.zip(entries) {
-                *row = i;
-                *value = v;
-            }
-        });
-    let symbolic = SymbolicSparseColMat::new_checked(size, size, col_ptr, None, row_idx);
-    SparseColMat::new(symbolic, val)
 }
 
 impl Diffusion {
