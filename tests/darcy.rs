@@ -10,9 +10,10 @@
 use hasse_complex::generate::{delaunay, grid, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, DualKind};
 use hasse_solver::la::direct::Factorization;
+use hasse_solver::metric::fv::FluxMass;
 use hasse_solver::metric::{isotropic, MetricError, Tensor};
 use hasse_solver::physics::darcy::{
-    self, BoundaryConditions, DarcyError, DarcySolution, FaceCondition, FluxMass,
+    self, BoundaryConditions, DarcyError, DarcySolution, FaceCondition,
 };
 use std::f64::consts::PI;
 
@@ -305,10 +306,11 @@ fn dec_mass_is_dual_edge_over_face() {
         &vec![isotropic(2.5); k.cell_count(2)],
         FluxMass::Dec(DualKind::Circumcentric),
     )
-    .unwrap();
+    .unwrap()
+    .assemble();
     let dual = k.dual_measure(DualKind::Circumcentric, 1).unwrap();
-    assert_eq!(mass.len(), k.cell_count(1));
-    for &(i, j, v) in &mass {
+    assert_eq!(mass.compute_nnz(), k.cell_count(1));
+    for (i, j, v) in mass.triplet_iter().map(|t| (t.row, t.col, *t.val)) {
         assert_eq!(i, j);
         let expected = dual[i] / (2.5 * k.measure(1)[i]);
         assert!(

@@ -7,8 +7,9 @@
 use hasse_complex::generate::{perturb, rectangle};
 use hasse_complex::DualKind;
 use hasse_solver::la::direct::Factorization;
+use hasse_solver::metric::fv::FluxMass;
 use hasse_solver::metric::isotropic;
-use hasse_solver::physics::darcy::{self, BoundaryConditions, FaceCondition, FluxMass};
+use hasse_solver::physics::darcy::{self, BoundaryConditions, FaceCondition};
 
 fn main() {
     let n: usize = std::env::args()

@@ -242,6 +242,24 @@ impl FixedSplit {
         CsMat::new((a.rows(), self.free.len()), indptr, indices, data)
     }
 
+    /// Eᵀ A: the rows of a matrix (unknowns × anything) at the free
+    /// unknowns, renumbered.
+    pub fn restrict_rows(&self, a: &CsMat<i8>) -> CsMat<i8> {
+        let a = if a.is_csr() { a } else { &a.to_csr() };
+        let mut indptr = Vec::with_capacity(self.free.len() + 1);
+        let mut indices = Vec::new();
+        let mut data = Vec::new();
+        indptr.push(0);
+        for &i in &self.free {
+            if let Some(row) = a.outer_view(i) {
+                indices.extend_from_slice(row.indices());
+                data.extend_from_slice(row.data());
+            }
+            indptr.push(indices.len());
+        }
+        CsMat::new((self.free.len(), a.cols()), indptr, indices, data)
+    }
+
     /// E as an incidence matrix (unknowns × free): column k is the k-th
     /// free unknown. Eᵀ W E is W on the free unknowns; E₁ᵀ W E₂ couples
     /// the free unknowns of two splits through the same rows.

@@ -85,7 +85,8 @@
 //!
 //! ```
 //! use hasse_complex::generate::rectangle;
-//! use hasse_solver::physics::darcy::{self, BoundaryConditions, FluxMass};
+//! use hasse_solver::physics::darcy::{self, BoundaryConditions};
+//! use hasse_solver::metric::fv::FluxMass;
 //! use hasse_solver::metric::isotropic;
 //! // p = 1 − x on the unit square: pressure 1 on the left, 0 on the
 //! // right, no flow through top and bottom. u = (1, 0).
@@ -107,39 +108,22 @@
 //! [`fv::two_point_at`]: crate::metric::fv::two_point_at
 
 use crate::la::direct::{self, Factorization, SolveError, SolveReport};
-use crate::metric::{check_tensors, fv, MetricError, Tensor};
+use crate::la::fixed::FixedSplit;
+use crate::metric::fv::{self, FluxMass};
+use crate::metric::{MetricError, Tensor};
+use crate::operator::block::{Block, BlockError, BlockSystem, Symmetry};
+use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymmetricOrdering,
 };
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::SparseColMat;
 use faer::{Conj, Mat, Par, Side};
-use hasse_complex::{Complex, DualKind};
-use nalgebra::DMatrix;
-use rayon::prelude::*;
+use hasse_complex::Complex;
+use sprs::CsMat;
 use std::time::Instant;
-
-/// Which flux mass matrix M_u to use. See the [module documentation](self)
-/// for the formulas.
-///
-/// ```
-/// use hasse_complex::DualKind;
-/// use hasse_solver::physics::darcy::FluxMass;
-/// // Delaunay triangulations: circumcentric dual; uniform boxes: barycentric.
-/// let dec = FluxMass::Dec(DualKind::Circumcentric);
-/// assert_ne!(dec, FluxMass::Mimetic);
-/// ```
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FluxMass {
-    /// Diagonal DEC / two-point mass with pressures at the dual vertices
-    /// of the given kind.
-    Dec(DualKind),
-    /// Mimetic (RT0-type) mass, one dense block per cell, pressures at the
-    /// centroids.
-    Mimetic,
-}
 
 /// A condition on one boundary (n−1)-cell.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -203,6 +187,10 @@ pub enum DarcyError {
     /// Permeability (non-positive, non-finite, wrong count) or geometry.
     #[error(transparent)]
     Metric(#[from] MetricError),
+    #[error(transparent)]
+    Canonical(#[from] CanonicalError),
+    #[error(transparent)]
+    Block(#[from] BlockError),
     #[error(transparent)]
     Solve(#[from] SolveError),
     #[error("mixed Darcy needs a complex that fills its space (n = d ≥ 1); this one is {n}-dimensional in R^{d}")]
@@ -288,128 +276,34 @@ pub fn cell_integrals(complex: &Complex, f: impl Fn(&[f64]) -> f64) -> Vec<f64> 
         .collect()
 }
 
-/// The global flux mass M_u as (row, column, value) triplets over the
-/// (n−1)-cells, both triangles, repeated positions to be summed.
+/// The flux mass M_u = Aᵀ Ω A over the (n−1)-cells as a canonical
+/// operator: the metric of [`fv::flux_mass`] (the diagonal DEC mass on A =
+/// I, or the mimetic cell blocks on the half-face incidence).
 ///
 /// ```
 /// use hasse_complex::{generate::rectangle, DualKind};
-/// use hasse_solver::physics::darcy::{flux_mass, FluxMass};
+/// use hasse_solver::metric::fv::FluxMass;
 /// use hasse_solver::metric::isotropic;
+/// use hasse_solver::physics::darcy::flux_mass;
 /// // Two unit squares, K = 2: the shared face has dual edge 1, so
 /// // M = 1 / (2 · 1); a boundary face has half a dual edge: 1/4.
 /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
-/// let m = flux_mass(&k, &[isotropic(2.0); 2], FluxMass::Dec(DualKind::Barycentric)).unwrap();
+/// let m = flux_mass(&k, &[isotropic(2.0); 2], FluxMass::Dec(DualKind::Barycentric)).unwrap().assemble();
 /// let shared = k.boundary(2).outer_iterator().position(|r| r.nnz() == 2).unwrap();
-/// assert!(m.iter().all(|&(i, j, v)| i == j && (v - if i == shared { 0.5 } else { 0.25 }).abs() < 1e-15));
+/// let dense = m.to_dense();
+/// assert!((0..7).all(|f| (dense[(f, f)] - if f == shared { 0.5 } else { 0.25 }).abs() < 1e-15));
 /// ```
 pub fn flux_mass(
     complex: &Complex,
     tensors: &[Tensor],
     mass: FluxMass,
-) -> Result<Vec<(usize, usize, f64)>, DarcyError> {
+) -> Result<Canonical, DarcyError> {
     let (n, d) = (complex.dim(), complex.embedding_dim());
     if n == 0 || n != d {
         return Err(DarcyError::NotVolume { n, d });
     }
-    check_tensors(tensors, complex.cell_count(n), d)?;
-    match mass {
-        FluxMass::Dec(kind) => {
-            let points = complex.dual_vertices(kind).map_err(MetricError::from)?;
-            let sigma = fv::two_point_at(complex, tensors, points)?;
-            // The two-point metric is diagonal, one 1×1 block per face in
-            // order; its inverse is the series resistance Σ s/(κ|F|).
-            Ok((0..sigma.block_count())
-                .map(|b| {
-                    let (rows, _, v) = sigma.block(b);
-                    (rows[0], rows[0], 1.0 / v[0])
-                })
-                .collect())
-        }
-        FluxMass::Mimetic => mimetic_mass(complex, tensors),
-    }
-}
-
-/// Per-cell mimetic blocks, assembled with the orientation signs.
-fn mimetic_mass(
-    complex: &Complex,
-    tensors: &[Tensor],
-) -> Result<Vec<(usize, usize, f64)>, DarcyError> {
-    const METHOD: &str = "mimetic Darcy flux mass";
-    let (n, d) = (complex.dim(), complex.embedding_dim());
-    let by_cell = complex.boundary_csc(n);
-    let _ = (complex.measure(n), complex.measure(n - 1), complex.normal());
-    let _ = (complex.centroid(n), complex.centroid(n - 1));
-    let blocks = (0..complex.cell_count(n))
-        .into_par_iter()
-        .map(|cell| {
-            let col = by_cell.outer_view(cell).expect("cell column");
-            let faces: Vec<(usize, i8)> = col.iter().map(|(f, &s)| (f, s)).collect();
-            let m = faces.len();
-            let t = &tensors[cell];
-            let k = DMatrix::from_fn(d, d, |i, j| 0.5 * (t[i][j] + t[j][i]));
-            let k_inv = k.clone().try_inverse().ok_or(MetricError::NotPositive {
-                cell,
-                value: 0.0,
-            })?;
-            let (mut x, mut normals) = (DMatrix::zeros(m, d), DMatrix::zeros(m, d));
-            let mut s = DMatrix::zeros(m, m);
-            let x_cell = complex.centroid_of(n, cell);
-            for (i, &(face, sign)) in faces.iter().enumerate() {
-                let area = complex.measure(n - 1)[face];
-                let normal = &complex.normal()[face * d..(face + 1) * d];
-                let x_face = complex.centroid_of(n - 1, face);
-                let mut distance = 0.0;
-                for a in 0..d {
-                    x[(i, a)] = x_face[a] - x_cell[a];
-                    normals[(i, a)] = f64::from(sign) * area * normal[a];
-                    distance += x[(i, a)] * normal[a];
-                }
-                let kappa = (0..d)
-                    .map(|a| (0..d).map(|b| normal[a] * k[(a, b)] * normal[b]).sum::<f64>())
-                    .sum::<f64>();
-                // Half resistance of the two-point scheme: sets the scale of
-                // the stabilisation and makes M_c = S on K-orthogonal boxes.
-                let half = distance.abs() / (kappa * area);
-                if !(half > 0.0 && half.is_finite()) {
-                    return Err(MetricError::UnsupportedCell {
-                        method: METHOD,
-                        needs: "a convex cell whose centroid lies strictly inside (off every face plane)",
-                        cell,
-                    });
-                }
-                s[(i, i)] = half;
-            }
-            let volume = complex.measure(n)[cell];
-            let consistency = &x * &k_inv * x.transpose() / volume;
-            let qr = normals.clone().qr();
-            let r = qr.r();
-            let scale = (0..d).fold(0.0f64, |a, i| a.max(r[(i, i)].abs()));
-            // A zero or NaN diagonal of R: the outward normals lost rank.
-            if (0..d).any(|i| {
-                let v = r[(i, i)].abs();
-                v.is_nan() || v <= 1e-12 * scale
-            }) {
-                return Err(MetricError::UnsupportedCell {
-                    method: METHOD,
-                    needs: "a non-degenerate cell (face normals spanning the space)",
-                    cell,
-                });
-            }
-            let q = qr.q();
-            let projector = DMatrix::<f64>::identity(m, m) - &q * q.transpose();
-            let block = consistency + &projector * s * &projector;
-            let block = (&block + block.transpose()) * 0.5;
-            let mut out = Vec::with_capacity(m * m);
-            for (i, &(fi, si)) in faces.iter().enumerate() {
-                for (j, &(fj, sj)) in faces.iter().enumerate() {
-                    // Local fluxes are outward: u_out = ∂ₙ(F, c) u_F.
-                    out.push((fi, fj, f64::from(si * sj) * block[(i, j)]));
-                }
-            }
-            Ok(out)
-        })
-        .collect::<Result<Vec<_>, MetricError>>()?;
-    Ok(blocks.into_iter().flatten().collect())
+    let (incidence, metric) = fv::flux_mass(complex, tensors, mass)?;
+    Ok(Canonical::new(incidence, metric)?)
 }
 
 /// Validate the face lists; returns per face its condition.
@@ -460,9 +354,11 @@ pub struct DarcySystem {
     pub free_faces: usize,
     /// Number of pressure unknowns (rows `free_faces..free_faces + cells`).
     pub cells: usize,
-    /// Per face: the prescribed flux u_F along n_F, or `None` when free.
-    known: Vec<Option<f64>>,
-    column: Vec<usize>,
+    /// Per unknown of the whole system (faces, cells, multiplier): the
+    /// prescribed flux u_F along n_F, or `None` when free.
+    fixed: Vec<Option<f64>>,
+    split: FixedSplit,
+    faces: usize,
     points: Vec<f64>,
 }
 
@@ -470,14 +366,10 @@ impl DarcySystem {
     /// Split a solution vector of [`DarcySystem::matrix`] into face fluxes
     /// (prescribed ones filled in) and cell pressures.
     pub fn unpack(&self, x: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let flux = self
-            .known
-            .iter()
-            .zip(&self.column)
-            .map(|(k, &c)| k.unwrap_or_else(|| x[c]))
-            .collect();
-        let pressure = x[self.free_faces..self.free_faces + self.cells].to_vec();
-        (flux, pressure)
+        let mut all = self.split.lift(x, &self.fixed);
+        all.truncate(self.faces + self.cells);
+        let pressure = all.split_off(self.faces);
+        (all, pressure)
     }
 
     /// Solve with faer's unpivoted sparse LDLᵀ under a constrained
@@ -673,6 +565,12 @@ pub fn saddle_ordering(system: &DarcySystem) -> (Vec<usize>, Vec<usize>) {
 }
 
 /// Assemble the saddle-point system (see [`solve`] for the arguments).
+///
+/// Every block is a canonical operator over all faces and cells: the flux
+/// mass ([`flux_mass`]), the coupling B = Iᵀ(−I)∂ₙ = −∂ₙ, and for a
+/// problem without pressure faces the constraint row Iᵀ diag(|c|) 1. The
+/// known fluxes (flux faces and no-flow faces) are then eliminated by
+/// [`FixedSplit`], which keeps the matrix symmetric.
 pub fn assemble(
     complex: &Complex,
     tensors: &[Tensor],
@@ -680,7 +578,7 @@ pub fn assemble(
     source: &[f64],
     bc: &BoundaryConditions,
 ) -> Result<DarcySystem, DarcyError> {
-    let mass_entries = flux_mass(complex, tensors, mass)?;
+    let mass_operator = flux_mass(complex, tensors, mass)?;
     let n = complex.dim();
     let cells = complex.cell_count(n);
     if source.len() != cells {
@@ -694,31 +592,22 @@ pub fn assemble(
     let faces = boundary.rows();
 
     // Known fluxes: flux faces and unlisted (no-flow) boundary faces.
-    let mut known: Vec<Option<f64>> = vec![None; faces];
+    let mut fixed: Vec<Option<f64>> = vec![None; faces];
     let mut pressure_faces = 0usize;
     let mut outflow = 0.0;
-    for face in 0..faces {
-        let row = boundary.outer_view(face).expect("face row");
-        if row.nnz() != 1 {
+    for (face, row) in boundary.outer_iterator().enumerate() {
+        let [sign] = row.data() else {
             continue;
-        }
-        let sign = f64::from(*row.data().first().expect("one cell"));
+        };
+        let sign = f64::from(*sign);
         match conditions[face] {
             Some(FaceCondition::Pressure(_)) => pressure_faces += 1,
             // `classify` stores totals only (Flux), never FluxDensity.
             Some(FaceCondition::Flux(q) | FaceCondition::FluxDensity(q)) => {
-                known[face] = Some(sign * q);
+                fixed[face] = Some(sign * q);
                 outflow += q;
             }
-            None => known[face] = Some(0.0),
-        }
-    }
-    let mut column = vec![usize::MAX; faces];
-    let mut free = 0usize;
-    for face in 0..faces {
-        if known[face].is_none() {
-            column[face] = free;
-            free += 1;
+            None => fixed[face] = Some(0.0),
         }
     }
     let mean_constraint = pressure_faces == 0;
@@ -730,47 +619,46 @@ pub fn assemble(
             return Err(DarcyError::Incompatible { sources, outflow });
         }
     }
-    let size = free + cells + usize::from(mean_constraint);
-    let mut rhs = vec![0.0; size];
-    let mut triplets = Vec::with_capacity(mass_entries.len() + 4 * faces + 2 * cells);
 
-    for &(i, j, v) in &mass_entries {
-        match (column[i], known[j]) {
-            (ci, None) if ci != usize::MAX => triplets.push(Triplet::new(ci, column[j], v)),
-            // Symmetric elimination: known columns go to the right-hand side.
-            (ci, Some(u)) if ci != usize::MAX => rhs[ci] -= v * u,
-            _ => {}
-        }
+    // [[M_u, B, 0], [Bᵀ, 0, w], [0, wᵀ, 0]] over faces, cells and the
+    // multiplier, each block Aᵀ Ω B.
+    let coupling = Canonical::coupling(
+        CsMat::<i8>::eye(faces),
+        BlockMetric::from_weights(vec![-1.0; faces]),
+        complex.shared_boundary(n),
+    )?;
+    let mut fields = vec![faces, cells];
+    let mut blocks: Vec<(usize, usize, Block)> =
+        vec![(0, 0, mass_operator.into()), (0, 1, coupling.into())];
+    if mean_constraint {
+        let ones = CsMat::new(
+            (cells, 1),
+            (0..=cells).collect(),
+            vec![0; cells],
+            vec![1i8; cells],
+        );
+        let weights = BlockMetric::from_weights(complex.measure(n).to_vec());
+        let constraint = Canonical::coupling(CsMat::<i8>::eye(cells), weights, ones)?;
+        fields.push(1);
+        blocks.push((1, 2, constraint.into()));
     }
+    let whole = BlockSystem::new(&fields, Symmetry::Symmetric, blocks)?.matrix();
+
+    // The right-hand side: −∫_∂Ω p_D v·n on pressure faces, −F on cells.
+    let size = whole.nrows();
+    let mut rhs = vec![0.0; size];
     for (face, row) in boundary.outer_iterator().enumerate() {
-        for (c, &s) in row.iter() {
-            let b = -f64::from(s); // B = −∂ₙ
-            let pc = free + c;
-            match known[face] {
-                None => {
-                    triplets.push(Triplet::new(column[face], pc, b));
-                    triplets.push(Triplet::new(pc, column[face], b));
-                }
-                Some(u) => rhs[pc] -= b * u,
-            }
-            if let Some(FaceCondition::Pressure(p)) = conditions[face] {
-                rhs[column[face]] -= f64::from(s) * p;
-            }
+        if let (Some(FaceCondition::Pressure(p)), [sign]) = (conditions[face], row.data()) {
+            rhs[face] -= f64::from(*sign) * p;
         }
     }
     for c in 0..cells {
-        rhs[free + c] -= source[c];
+        rhs[faces + c] -= source[c];
     }
-    if mean_constraint {
-        let lambda = free + cells;
-        for c in 0..cells {
-            let w = complex.measure(n)[c];
-            triplets.push(Triplet::new(lambda, free + c, w));
-            triplets.push(Triplet::new(free + c, lambda, w));
-        }
-    }
-    let matrix = SparseColMat::try_new_from_triplets(size, size, &triplets)
-        .map_err(|e| SolveError::Symbolic(format!("{e:?}")))?;
+    fixed.resize(size, None);
+    let split = FixedSplit::new(&fixed);
+    let rhs = split.reduced_rhs(&whole, &rhs, &fixed);
+    let matrix = split.free_block(&whole);
     let points = match mass {
         FluxMass::Dec(kind) => complex
             .dual_vertices(kind)
@@ -781,10 +669,11 @@ pub fn assemble(
     Ok(DarcySystem {
         matrix,
         rhs,
-        free_faces: free,
+        free_faces: split.free().len() - (size - faces),
         cells,
-        known,
-        column,
+        fixed,
+        split,
+        faces,
         points,
     })
 }

@@ -40,11 +40,12 @@
 
 use crate::la::direct::{DirectSolver, Factor, Factorization, SolveError};
 use crate::la::eigen::{self, multiply, EigenError, Options};
+use crate::la::fixed::FixedSplit;
 use crate::metric::{dec, isotropic, MetricError};
 use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use faer::sparse::{SparseColMat, SparseColMatRef};
 use hasse_complex::{Complex, ComplexError, DualKind};
-use sprs::{CsMat, TriMat};
+use sprs::CsMat;
 
 /// Why a cavity could not be set up or solved.
 ///
@@ -105,9 +106,10 @@ pub enum Mass {
 /// assert_eq!(cavity.physical_count(), 5);
 /// ```
 pub struct Cavity {
-    edge_count: usize,
-    interior_edges: Vec<usize>,
-    interior_vertices: Vec<usize>,
+    /// Interior edges free, wall edges fixed at zero.
+    edges: FixedSplit,
+    /// Interior vertices free, wall vertices fixed at zero.
+    vertices: FixedSplit,
     stiffness: SparseColMat<usize, f64>,
     mass: SparseColMat<usize, f64>,
     /// G = δ₀ on interior edges × interior vertices, as f64 for products.
@@ -171,20 +173,18 @@ impl Cavity {
         if wall.cells(n - 1).is_empty() {
             return Err(MaxwellError::NoWall);
         }
-        let interior = |p: usize| -> Vec<usize> {
-            (0..complex.cell_count(p))
-                .filter(|&i| !wall.contains(p, i))
-                .collect()
-        };
-        let interior_edges = interior(1);
-        let interior_vertices = interior(0);
-        if interior_edges.is_empty() {
+        // Tangential E vanishes on the walls: wall edges (and, for the
+        // gradients, wall vertices) are fixed at zero.
+        let wall = &wall;
+        let on_wall = |p: usize| (0..complex.cell_count(p)).map(move |i| wall.contains(p, i));
+        let edges = FixedSplit::from_mask(on_wall(1));
+        let vertices = FixedSplit::from_mask(on_wall(0));
+        if edges.free().is_empty() {
             return Err(MaxwellError::NoInteriorEdges);
         }
-        let edge_count = complex.cell_count(1);
 
         // K = (δ₁ E)ᵀ ⋆₂ (δ₁ E): faces × interior edges.
-        let curl = select_columns(&complex.coboundary(1), &interior_edges);
+        let curl = edges.restrict_columns(&complex.coboundary(1));
         let star2 = complex.hodge_star(dual, 2)?;
         for (f, row) in curl.outer_iterator().enumerate() {
             // Faces made only of wall edges do not enter K.
@@ -204,7 +204,8 @@ impl Cavity {
         let metric = match mass {
             Mass::Hodge => {
                 let star1 = complex.hodge_star(dual, 1)?;
-                if let Some(&e) = interior_edges
+                if let Some(&e) = edges
+                    .free()
                     .iter()
                     .find(|&&e| star1[e].is_nan() || star1[e] <= 0.0)
                 {
@@ -223,15 +224,13 @@ impl Cavity {
                 dec::whitney_metric(complex, &vec![isotropic(1.0); tops])?
             }
         };
-        let identity = CsMat::<i8>::eye(edge_count);
-        let mass_matrix =
-            Canonical::new(select_columns(&identity, &interior_edges), metric.clone())?.assemble();
+        let mass_matrix = Canonical::new(edges.selection(), metric.clone())?.assemble();
 
         // Gᵀ M G = (δ₀ restricted to interior vertices)ᵀ Ω (…): a wall edge
         // has both ends on the wall, so its rows of δ₀[:, interior] vanish
         // and the product only sees interior edges.
-        let grad_all = select_columns(&complex.coboundary(0), &interior_vertices);
-        let gram = if interior_vertices.is_empty() {
+        let grad_all = vertices.restrict_columns(&complex.coboundary(0));
+        let gram = if vertices.free().is_empty() {
             None
         } else {
             let gram = Canonical::new(grad_all.clone(), metric)?.assemble();
@@ -240,7 +239,7 @@ impl Cavity {
                 .map_err(MaxwellError::DependentGradients)?;
             Some(factor)
         };
-        let gradient = to_faer(&select_rows(&grad_all, &interior_edges));
+        let gradient = to_faer(&edges.restrict_rows(&grad_all));
 
         let dim = complex.embedding_dim();
         let coords = complex.vertices().as_slice();
@@ -258,9 +257,8 @@ impl Cavity {
             .sum::<f64>()
             .sqrt();
         Ok(Self {
-            edge_count,
-            interior_edges,
-            interior_vertices,
+            edges,
+            vertices,
             stiffness,
             mass: mass_matrix,
             gradient,
@@ -271,12 +269,12 @@ impl Cavity {
 
     /// Number of unknowns: the interior edges.
     pub fn unknowns(&self) -> usize {
-        self.interior_edges.len()
+        self.edges.free().len()
     }
 
     /// Dimension of the gradient null space of K: the interior vertices.
     pub fn gradient_count(&self) -> usize {
-        self.interior_vertices.len()
+        self.vertices.free().len()
     }
 
     /// The most physical modes there are: unknowns − gradients.
@@ -286,7 +284,7 @@ impl Cavity {
 
     /// The interior edges, in unknown order.
     pub fn interior_edges(&self) -> &[usize] {
-        &self.interior_edges
+        self.edges.free()
     }
 
     /// The curl-curl matrix K on the interior edges.
@@ -332,11 +330,7 @@ impl Cavity {
     /// A field on the interior edges as a 1-cochain on every edge (zero
     /// tangential E on the walls).
     pub fn extend(&self, e: &[f64]) -> Vec<f64> {
-        let mut all = vec![0.0; self.edge_count];
-        for (&edge, &x) in self.interior_edges.iter().zip(e) {
-            all[edge] = x;
-        }
-        all
+        self.edges.lift(e, &[])
     }
 
     /// Default eigensolver settings with σ = −½ (π/D)², D the bounding-box
@@ -373,36 +367,6 @@ impl Cavity {
             shift: options.shift,
         })
     }
-}
-
-/// The columns `cols` of a, renumbered 0..cols.len().
-fn select_columns(a: &CsMat<i8>, cols: &[usize]) -> CsMat<i8> {
-    let mut new = vec![usize::MAX; a.cols()];
-    for (j, &c) in cols.iter().enumerate() {
-        new[c] = j;
-    }
-    let mut tri = TriMat::new((a.rows(), cols.len()));
-    for (&v, (i, j)) in a.iter() {
-        if new[j] != usize::MAX {
-            tri.add_triplet(i, new[j], v);
-        }
-    }
-    tri.to_csr()
-}
-
-/// The rows `rows` of a, renumbered.
-fn select_rows(a: &CsMat<i8>, rows: &[usize]) -> CsMat<i8> {
-    let mut new = vec![usize::MAX; a.rows()];
-    for (i, &r) in rows.iter().enumerate() {
-        new[r] = i;
-    }
-    let mut tri = TriMat::new((rows.len(), a.cols()));
-    for (&v, (i, j)) in a.iter() {
-        if new[i] != usize::MAX {
-            tri.add_triplet(new[i], j, v);
-        }
-    }
-    tri.to_csr()
 }
 
 fn to_faer(a: &CsMat<i8>) -> SparseColMat<usize, f64> {

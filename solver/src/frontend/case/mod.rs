@@ -151,7 +151,7 @@ pub struct HeatSpec {
 /// u·n. Boundary faces in no tag are no-flow.
 #[derive(Clone, Debug)]
 pub struct DarcySpec {
-    pub mass: crate::physics::darcy::FluxMass,
+    pub mass: crate::metric::fv::FluxMass,
     pub permeability: Coefficient,
     pub source: Expression,
     pub boundary: Vec<BoundarySpec>,

@@ -5,8 +5,9 @@
 
 use super::{check_residual, Field, RunError, RunResult};
 use crate::frontend::case::{BoundaryKindSpec, Case, Coefficient, DarcySpec};
+use crate::metric::fv::FluxMass;
 use crate::metric::Tensor;
-use crate::physics::darcy::{self, BoundaryConditions, DarcyError, DarcySolution, FluxMass};
+use crate::physics::darcy::{self, BoundaryConditions, DarcyError, DarcySolution};
 use crate::physics::diffusion::Errors;
 use hasse_complex::Complex;
 use std::collections::BTreeMap;

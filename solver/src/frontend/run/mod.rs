@@ -31,6 +31,7 @@ use crate::la::ordering::Ordering;
 use crate::metric::Location;
 use crate::metric::Tensor;
 use crate::physics::diffusion::{self, Diffusion, DiffusionError, Errors};
+use crate::physics::gradient::{normal_gradient, FaceMetric, NormalGradient};
 use crate::physics::BoundaryKind;
 use crate::physics::Conductivity;
 use crate::physics::ScalarFn;
@@ -553,56 +554,18 @@ fn gradient(
         )));
     }
     let faces = complex.cell_count(n - 1);
-    // jump_F = Σ_c −∂(F,c) f_c over the face's cells, interior faces only.
-    let boundary = complex.boundary(n);
-    let mut jump = vec![0.0; faces];
-    let mut incident = vec![0u8; faces];
-    for (value, (face, cell)) in boundary.iter() {
-        jump[face] -= f64::from(*value) * f[cell];
-        incident[face] += 1;
-    }
-    for (j, &k) in jump.iter_mut().zip(&incident) {
-        if k != 2 {
-            *j = 0.0;
-        }
-    }
-    let g: Vec<f64> = match &spec.metric {
-        GradientMetric::Diagonal(sigma) => jump.iter().map(|j| sigma * j).collect(),
-        GradientMetric::TwoPoint => {
-            let d = complex.embedding_dim();
-            let centre = complex.centroid(n);
-            let csc = complex.boundary_csc(n);
-            let mut cells_of: Vec<Vec<usize>> = vec![Vec::new(); faces];
-            for c in 0..complex.cell_count(n) {
-                if let Some(col) = csc.outer_view(c) {
-                    for (face, _) in col.iter() {
-                        cells_of[face].push(c);
-                    }
-                }
-            }
-            jump.iter()
-                .enumerate()
-                .map(|(face, j)| match cells_of[face].as_slice() {
-                    [a, b] => {
-                        let distance: f64 = (0..d)
-                            .map(|k| (centre[a * d + k] - centre[b * d + k]).powi(2))
-                            .sum::<f64>()
-                            .sqrt();
-                        j / distance
-                    }
-                    _ => 0.0,
-                })
-                .collect()
-        }
-        GradientMetric::File { path, scale } => {
-            let entries = read_metric_file(path, faces)?;
-            let mut g = vec![0.0; faces];
-            for (row, col, value) in entries {
-                g[row] += scale * value * jump[col];
-            }
-            g
-        }
+    let metric = match &spec.metric {
+        GradientMetric::Diagonal(sigma) => FaceMetric::Diagonal(*sigma),
+        GradientMetric::TwoPoint => FaceMetric::TwoPoint,
+        GradientMetric::File { path, scale } => FaceMetric::Entries(
+            read_metric_file(path, faces)?
+                .into_iter()
+                .map(|(row, column, value)| (row, column, scale * value))
+                .collect(),
+        ),
     };
+    let NormalGradient { jump, gradient: g } =
+        normal_gradient(complex, &f, &metric).map_err(|e| RunError::Input(e.to_string()))?;
     let seconds = started.elapsed().as_secs_f64();
     Ok(RunResult {
         problem: "gradient".into(),

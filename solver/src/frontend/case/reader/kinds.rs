@@ -8,8 +8,8 @@ use crate::frontend::case::{
     CoupledFieldSpec, CoupledSpec, DarcySpec, ElasticBoundaryKind, ElasticBoundarySpec,
     ElasticitySpec, HeatSpec, MaterialSpec, MaxwellSpec, Problem, TimeSpec,
 };
+use crate::metric::fv::FluxMass;
 use crate::metric::Method;
-use crate::physics::darcy::FluxMass;
 use crate::physics::elasticity::PlaneModel;
 use crate::physics::maxwell::Mass;
 use hasse_complex::DualKind;
