@@ -39,7 +39,7 @@
 //! dual kind.
 
 use super::fe::{gather, k_dot, simplex_gradients, Local, Point, Topology};
-use super::{check_tensors, CellTensors, MetricError, Tensor};
+use super::{CellTensors, MetricError, Tensor};
 use crate::operator::BlockMetric;
 use hasse_complex::{Complex, DualKind};
 use rayon::prelude::*;
@@ -73,7 +73,7 @@ pub fn hodge_metric<'a>(
     let top = Topology::new(complex, "DEC Hodge star")?;
     let n = top.n;
     let cells = complex.cell_count(n);
-    check_tensors(tensors, cells, top.d)?;
+    let tensors = tensors.checked(cells, top.d)?;
     if kind == DualKind::Circumcentric {
         if let Some(cell) = (0..cells).find(|&c| !top.is_simplex(c)) {
             return Err(MetricError::UnsupportedCell {
@@ -127,7 +127,7 @@ pub fn whitney_metric<'a>(
     let tensors = tensors.into();
     let top = Topology::new(complex, "DEC Whitney star")?;
     let cells = complex.cell_count(top.n);
-    check_tensors(tensors, cells, top.d)?;
+    let tensors = tensors.checked(cells, top.d)?;
     let locals = (0..cells)
         .into_par_iter()
         .map(|c| {

@@ -10,7 +10,7 @@
 //! takes differences across faces, Ω turns them into fluxes and δ = ∂ₙᵀ
 //! sums the fluxes of each cell.
 
-use super::{check_tensors, CellTensors, MetricError};
+use super::{CellTensors, MetricError};
 use crate::operator::BlockMetric;
 use hasse_complex::Complex;
 
@@ -154,7 +154,7 @@ pub fn five_point<'a>(
         });
     }
     let cells = complex.cell_count(n);
-    check_tensors(tensors, cells, d)?;
+    let tensors = tensors.checked(cells, d)?;
     if let Some(cell) =
         (0..cells).find(|&c| (0..d).any(|i| (0..d).any(|j| i != j && tensors.get(c)[i][j] != 0.0)))
     {

@@ -37,7 +37,7 @@ mod tests;
 mod topology;
 mod vem;
 
-use super::{check_tensors, CellTensors, MetricError, Tensor};
+use super::{CellTensors, MetricError, Tensor};
 use crate::la::parallel::{ranges, split_at_ranges};
 use crate::operator::BlockMetric;
 use hasse_complex::Complex;
@@ -276,7 +276,7 @@ fn stiffness(
     let top = Topology::new(complex, "FE stiffness")?;
     let n = top.n;
     let cells = complex.cell_count(n);
-    check_tensors(tensors, cells, top.d)?;
+    let tensors = tensors.checked(cells, top.d)?;
     // Without P1 cells every cell pushes one dense block over its edges:
     // the blocks' sizes are known from the topology, so they are written
     // straight into Ω's storage.

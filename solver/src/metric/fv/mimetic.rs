@@ -9,7 +9,7 @@
 //! that vanishes where the consistency term is exact.
 
 use super::{check_dimension, FaceGeometry};
-use crate::metric::{check_tensors, CellTensors, MetricError, Tensor};
+use crate::metric::{CellTensors, MetricError, Tensor};
 use crate::operator::BlockMetric;
 use hasse_complex::{Complex, DualKind};
 use nalgebra::DMatrix;
@@ -256,7 +256,7 @@ pub fn mimetic_hybrid<'a>(
     const METHOD: &str = "mimetic finite differences";
     let n = check_volume(complex, METHOD)?;
     let cells = complex.cell_count(n);
-    check_tensors(tensors, cells, complex.embedding_dim())?;
+    let tensors = tensors.checked(cells, complex.embedding_dim())?;
     let faces = complex.try_boundary(n)?.rows();
     let layout = HybridLayout { cells, faces };
     let geometry = FaceGeometry::new(complex);
@@ -395,7 +395,7 @@ pub fn flux_mass<'a>(
     let tensors = tensors.into();
     const METHOD: &str = "mimetic Darcy flux mass";
     let n = check_volume(complex, METHOD)?;
-    check_tensors(tensors, complex.cell_count(n), complex.embedding_dim())?;
+    let tensors = tensors.checked(complex.cell_count(n), complex.embedding_dim())?;
     match mass {
         FluxMass::Dec(kind) => {
             let points = complex.dual_vertices(kind)?;

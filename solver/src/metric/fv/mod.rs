@@ -26,7 +26,7 @@ mod mimetic;
 
 pub use mimetic::{flux_mass, half_face_incidence, mimetic_hybrid, FluxMass, HybridLayout};
 
-use super::{check_tensors, CellTensors, MetricError, Tensor};
+use super::{CellTensors, MetricError, Tensor};
 use crate::operator::BlockMetric;
 use hasse_complex::Complex;
 use rayon::prelude::*;
@@ -172,7 +172,7 @@ pub fn two_point<'a>(
     let tensors = tensors.into();
     const METHOD: &str = "two-point flux (TPFA)";
     let n = check_dimension(complex, METHOD)?;
-    check_tensors(tensors, complex.cell_count(n), complex.embedding_dim())?;
+    let tensors = tensors.checked(complex.cell_count(n), complex.embedding_dim())?;
     let boundary = complex.try_boundary(n)?;
     let faces = boundary.rows();
     let geometry = FaceGeometry::new(complex);
@@ -266,7 +266,7 @@ pub fn two_point_at<'a>(
     let n = check_dimension(complex, METHOD)?;
     let d = complex.embedding_dim();
     let cells = complex.cell_count(n);
-    check_tensors(tensors, cells, d)?;
+    let tensors = tensors.checked(cells, d)?;
     if points.len() != cells * d || points.iter().any(|x| !x.is_finite()) {
         return Err(MetricError::UnsupportedMesh {
             method: METHOD,

@@ -72,8 +72,8 @@ pub(super) enum CellConductivity {
 impl CellConductivity {
     pub(super) fn cells(&self) -> CellTensors<'_> {
         match self {
-            Self::Scalar(values) => CellTensors::Scalar(values),
-            Self::Full(tensors) => CellTensors::Full(tensors),
+            Self::Scalar(values) => CellTensors::scalar(values),
+            Self::Full(tensors) => CellTensors::full(tensors),
         }
     }
 }
@@ -212,18 +212,28 @@ impl Diffusion {
                 CellConductivity::Full(cells.into_par_iter().map(|c| f(at(c))).collect())
             }
         };
-        metric::check_tensors(conductivity.cells(), complex.cell_count(n), d).map_err(
-            |e| match e {
+        Ok(conductivity)
+    }
+
+    /// `tensors` checked once for the whole assembly (the metrics then
+    /// skip their own check), a bad cell reported at its centroid.
+    pub(super) fn checked_conductivity<'a>(
+        &self,
+        complex: &Complex,
+        tensors: CellTensors<'a>,
+    ) -> Result<CellTensors<'a>, DiffusionError> {
+        let (n, d) = (complex.dim(), complex.embedding_dim());
+        tensors
+            .checked(complex.cell_count(n), d)
+            .map_err(|e| match e {
                 MetricError::NotPositive { cell, .. } | MetricError::NonFinite { cell } => {
                     DiffusionError::Coefficient {
-                        point: at(cell).to_vec(),
+                        point: complex.centroid_of(n, cell).to_vec(),
                         source: e,
                     }
                 }
                 other => other.into(),
-            },
-        )?;
-        Ok(conductivity)
+            })
     }
 
     pub(super) fn boundary_faces(&self, complex: &Complex) -> Result<Faces, DiffusionError> {
@@ -274,7 +284,7 @@ impl Diffusion {
             );
         }
         let conductivity = self.cell_conductivity(complex)?;
-        let tensors = conductivity.cells();
+        let tensors = self.checked_conductivity(complex, conductivity.cells())?;
         let faces = self.boundary_faces(complex)?;
         let location = self.location();
         let cells = complex.cell_count(n);
