@@ -2,10 +2,11 @@
 //! `hasse converge` end to end (tables, CSV, JSON, PNG, SVG, `--expect`
 //! exit codes), and uniform refinement of the generators.
 
+use hasse_solver::frontend::converge::{Study, StudyError};
+use hasse_solver::frontend::output::study::write_plot;
 use hasse_solver::metric::Method;
 use hasse_solver::study::{
     least_squares_order, pairwise_orders, Norm, OrderError, PlotFormat, PlotOptions, Refinement,
-    Study, StudyError,
 };
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -272,16 +273,16 @@ fn the_library_draws_plots_of_any_size() {
         .unwrap();
     let dir = scratch("sizes");
     let png = dir.join("small.png");
-    result
-        .write_plot(
-            &png,
-            PlotFormat::Png,
-            PlotOptions {
-                width: 500,
-                height: 321,
-            },
-        )
-        .unwrap();
+    write_plot(
+        &result,
+        &png,
+        PlotFormat::Png,
+        PlotOptions {
+            width: 500,
+            height: 321,
+        },
+    )
+    .unwrap();
     assert_eq!(png_size(&std::fs::read(&png).unwrap()), (500, 321));
     let svg = result
         .svg(PlotOptions {
@@ -318,7 +319,7 @@ fn bad_studies_exit_2_and_write_nothing() {
                 "-o",
                 o,
             ],
-            "unknown method `fvm`",
+            "unknown method \"fvm\"; the methods are fd, fe, fv, fv-mimetic",
         ),
         (
             vec![

@@ -3,7 +3,8 @@
 //! the tissue-division case.
 
 use hasse_solver::frontend::case::Case;
-use hasse_solver::refine::{refine_and_solve, RefineSpec, Strategy};
+use hasse_solver::frontend::run::refine::refine_case;
+use hasse_solver::refine::{RefineSpec, Strategy};
 use std::path::Path;
 
 fn case(name: &str, overrides: &[&str]) -> Case {
@@ -40,7 +41,7 @@ fn uniform_split_keeps_second_order_on_cut_cells() {
             steps: 4,
             ..RefineSpec::default()
         };
-        let study = refine_and_solve(&c, &complex, &spec, &mut |_| {}).unwrap();
+        let study = refine_case(&c, &complex, &spec, &mut |_| {}).unwrap();
         let l2: Vec<f64> = study.steps.iter().map(|s| s.l2.unwrap()).collect();
         // VEM is in its asymptotic range from the start (orders 2.09, 2.07,
         // 2.03, 1.98); the mimetic method's first two pairs are
@@ -70,7 +71,7 @@ fn adaptive_refinement_beats_uniform_at_the_corner_singularity() {
     // refinement concentrates cells at the corner.
     let adaptive_case = case("l-shape-adaptive.toml", &[]);
     let complex = adaptive_case.build_mesh().unwrap();
-    let adaptive = refine_and_solve(
+    let adaptive = refine_case(
         &adaptive_case,
         &complex,
         &adaptive_case.refine.unwrap(),
@@ -85,7 +86,7 @@ fn adaptive_refinement_beats_uniform_at_the_corner_singularity() {
         steps: 3,
         ..RefineSpec::default()
     };
-    let uniform = refine_and_solve(&adaptive_case, &complex, &uniform, &mut |_| {}).unwrap();
+    let uniform = refine_case(&adaptive_case, &complex, &uniform, &mut |_| {}).unwrap();
     let last = uniform.steps.last().unwrap();
     let (uniform_cells, uniform_error) = (*last.cells.last().unwrap(), last.gradient_l2.unwrap());
     // Measured: adaptive 2136 cells, gradient error 3.89e-3; uniform 6144
@@ -128,7 +129,7 @@ fn adaptive_refinement_beats_uniform_at_the_corner_singularity() {
 fn tissue_divides_to_3200_cells_and_conserves_area() {
     let c = case("tissue-growth.toml", &["refine.steps=3"]);
     let complex = c.build_mesh().unwrap();
-    let study = refine_and_solve(&c, &complex, &c.refine.unwrap(), &mut |_| {}).unwrap();
+    let study = refine_case(&c, &complex, &c.refine.unwrap(), &mut |_| {}).unwrap();
     // Every cell divides into two at every step.
     let cells: Vec<usize> = study
         .steps

@@ -452,9 +452,8 @@ fn run_case(
             (None, None, result)
         }
         Some(spec) => {
-            match refinement::refine_and_solve(&case, &complex, spec, &mut |name| {
-                progress.phase(name)
-            }) {
+            match run::refine::refine_case(&case, &complex, spec, &mut |name| progress.phase(name))
+            {
                 Ok(study) => (
                     Some(study.complex),
                     Some((study.steps, study.levels)),
@@ -564,7 +563,7 @@ fn complex_kind(complex: &hasse_complex::Complex) -> String {
     )
 }
 
-/// `hasse converge`: a thin layer over [`hasse_solver::study::Study`].
+/// `hasse converge`: a thin layer over [`hasse_solver::frontend::converge::Study`].
 #[allow(clippy::too_many_arguments)]
 fn converge(
     path: &Path,
@@ -576,20 +575,28 @@ fn converge(
     set: &[String],
     quiet: bool,
 ) -> ExitCode {
-    use hasse_solver::study::{
-        parse_method, Expectation, PlotFormat, PlotOptions, Refinement, Study, StudyError,
-    };
+    use hasse_solver::frontend::converge::{Study, StudyError};
+    use hasse_solver::frontend::output::study::{write_csv, write_json, write_plot};
+    use hasse_solver::metric::Method;
+    use hasse_solver::study::{Expectation, PlotFormat, PlotOptions, Refinement};
     let bad_input = |message: String| {
         eprintln!("error: {message}");
         ExitCode::from(EXIT_BAD_INPUT)
     };
     let methods = match methods
         .iter()
-        .map(|m| parse_method(m))
+        .map(|m| m.parse::<Method>())
         .collect::<Result<Vec<_>, _>>()
     {
         Ok(methods) => methods,
-        Err(e) => return bad_input(e.to_string()),
+        Err(e) => {
+            let names: Vec<String> = Method::names().iter().map(|s| s.to_string()).collect();
+            let help = match hasse_solver::frontend::case::expr::closest(&e.name, &names) {
+                Some(name) => format!("\n    help: did you mean `{name}`?"),
+                None => String::new(),
+            };
+            return bad_input(format!("--methods: {e}{help}"));
+        }
     };
     let expect: Option<Expectation> = match expect.map(str::parse).transpose() {
         Ok(e) => e,
@@ -652,11 +659,11 @@ fn converge(
         return ExitCode::from(EXIT_SOLVE_FAILED);
     }
     let file = |ext: &str| directory.join(format!("convergence.{ext}"));
-    let written = result
-        .write_csv(&file("csv"))
-        .and_then(|()| result.write_json(&file("json")))
-        .and_then(|()| result.write_plot(&file("png"), PlotFormat::Png, PlotOptions::default()))
-        .and_then(|()| result.write_plot(&file("svg"), PlotFormat::Svg, PlotOptions::default()));
+    let plot = |ext, format| write_plot(&result, &file(ext), format, PlotOptions::default());
+    let written = write_csv(&result, &file("csv"))
+        .and_then(|()| write_json(&result, &file("json")))
+        .and_then(|()| plot("png", PlotFormat::Png))
+        .and_then(|()| plot("svg", PlotFormat::Svg));
     if let Err(e) = written {
         eprintln!("error: writing the study: {e}");
         return ExitCode::from(EXIT_SOLVE_FAILED);

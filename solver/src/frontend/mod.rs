@@ -1,6 +1,7 @@
 //! The front end: case files, running them, output files.
 
 pub mod case;
+pub mod converge;
 pub mod info;
 pub mod mesh_spec;
 pub mod output;

@@ -11,24 +11,36 @@
 //! refined solution.
 //!
 //! ```
-//! use hasse_solver::frontend::case::Case;
-//! use hasse_solver::refine::{refine_and_solve, RefineSpec, Strategy};
-//! let text = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nmethod = \"fe\"\nsource = \"2*pi^2*sin(pi*x)*sin(pi*y)\"\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n[exact]\nsolution = \"sin(pi*x)*sin(pi*y)\"\n";
-//! let case = Case::from_text("demo.toml", text, &[]).unwrap();
-//! let complex = case.build_mesh().unwrap();
+//! use hasse_complex::generate::rectangle;
+//! use hasse_solver::metric::Method;
+//! use hasse_solver::physics::diffusion::Diffusion;
+//! use hasse_solver::physics::{BoundaryKind, Conductivity};
+//! use hasse_solver::refine::{refine_and_solve, Exact, RefineSpec, Strategy};
+//! use std::f64::consts::PI;
+//! use std::sync::Arc;
+//! let problem = Diffusion::new(
+//!     Method::Fe,
+//!     Conductivity::Scalar(Arc::new(|_| 1.0)),
+//!     Arc::new(|x: &[f64]| 2.0 * PI * PI * (PI * x[0]).sin() * (PI * x[1]).sin()),
+//! )
+//! .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)));
+//! let exact = Exact {
+//!     solution: Arc::new(|x: &[f64]| (PI * x[0]).sin() * (PI * x[1]).sin()),
+//!     gradient: None,
+//! };
+//! let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
 //! let spec = RefineSpec { strategy: Strategy::Uniform, steps: 2, ..RefineSpec::default() };
-//! let study = refine_and_solve(&case, &complex, &spec, &mut |_| {}).unwrap();
+//! let study = refine_and_solve(&problem, &mesh, &spec, Some(&exact), &mut |_| {}).unwrap();
 //! assert_eq!(study.steps.len(), 3); // the coarse solve and two refinements
-//! assert_eq!(study.complex.cell_count(2), 16 * 16);
+//! assert_eq!(study.levels[2].complex.cell_count(2), 16 * 16);
 //! let (coarse, fine) = (study.steps[0].l2.unwrap(), study.steps[2].l2.unwrap());
 //! assert!(fine < coarse / 8.0); // two halvings of h, second order
 //! ```
 
-use crate::frontend::case::{Case, Problem};
-use crate::frontend::run::{self, RunError};
 use crate::la::iterative::CgOptions;
 use crate::metric::Location;
-use crate::physics::diffusion::{self, Diffusion, Iterative, Solution};
+use crate::physics::diffusion::{self, Diffusion, DiffusionError, Iterative, Solution};
+use crate::physics::{ScalarFn, VectorFn};
 use hasse_complex::refine;
 use hasse_complex::split::Refinement;
 use hasse_complex::Complex;
@@ -101,18 +113,51 @@ pub struct StepReport {
     pub seconds: f64,
 }
 
-/// The study's steps, the final complex and its solution.
-pub struct RefinementStudy {
-    pub steps: Vec<StepReport>,
-    /// Every level's complex and fields (`u`, and `u_exact`, `error` when
-    /// the case has an exact solution), for a time series whose mesh changes.
-    pub levels: Vec<(Complex, Vec<run::Field>)>,
-    pub complex: Complex,
-    pub result: run::RunResult,
+/// The exact solution of a refined problem, for the errors of each step.
+#[derive(Clone)]
+pub struct Exact {
+    /// u(x).
+    pub solution: ScalarFn,
+    /// ∇u(x), for the gradient error.
+    pub gradient: Option<VectorFn>,
 }
 
-fn input(e: impl fmt::Display) -> RunError {
-    RunError::Input(e.to_string())
+/// One level of a refinement study: the complex and the solution on it.
+#[derive(Clone, Debug)]
+pub struct Level {
+    pub complex: Complex,
+    pub solution: Solution,
+}
+
+/// The study's steps and every level, the last one the finest.
+#[derive(Clone, Debug)]
+pub struct RefinementStudy {
+    pub steps: Vec<StepReport>,
+    pub levels: Vec<Level>,
+}
+
+/// Why a refinement study stopped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RefineError {
+    /// A solve on some level failed.
+    #[error(transparent)]
+    Solve(#[from] DiffusionError),
+    /// The mesh could not be refined as asked (a cell SPLIT cannot cut, a
+    /// Dörfler fraction outside (0, 1]), or a field not moved.
+    #[error("{0}")]
+    Refinement(String),
+}
+
+impl RefineError {
+    /// Whether the input (strategy, θ, mesh) is at fault rather than a
+    /// solve.
+    pub fn is_input(&self) -> bool {
+        matches!(self, RefineError::Refinement(_))
+    }
+}
+
+fn input(e: impl fmt::Display) -> RefineError {
+    RefineError::Refinement(e.to_string())
 }
 
 /// Move a solution's unknowns to the refined complex: nodal values
@@ -123,7 +168,7 @@ fn transfer(
     fine: &Complex,
     refinement: &Refinement,
     solution: &Solution,
-) -> Result<Vec<f64>, RunError> {
+) -> Result<Vec<f64>, RefineError> {
     let n = coarse.dim();
     let copy = |p: usize, values: &[f64]| -> Vec<f64> {
         (0..fine.cell_count(p))
@@ -196,7 +241,7 @@ fn refine_once(
     complex: &Complex,
     strategy: Strategy,
     eta: &[f64],
-) -> Result<(Complex, Refinement, Option<usize>), RunError> {
+) -> Result<(Complex, Refinement, Option<usize>), RefineError> {
     let all: Vec<usize> = (0..complex.cell_count(complex.dim())).collect();
     match strategy {
         Strategy::Uniform => refine::uniform(complex).map(|(k, r)| (k, r, None)),
@@ -216,70 +261,15 @@ fn refine_once(
     .map_err(input)
 }
 
-fn diffusion_of(case: &Case) -> Result<Diffusion, RunError> {
-    match &case.problem {
-        Problem::Diffusion(spec) => Ok(run::diffusion_problem(case, spec)),
-        other => Err(RunError::Input(format!(
-            "refinement re-solves diffusion problems; this case is kind = \"{}\"",
-            other.kind()
-        ))),
-    }
-}
-
-/// The primary field of a level and, with an exact solution, its error.
-fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<run::Field> {
-    let dim = match solution.location {
-        Location::Nodal => 0,
-        _ => complex.dim(),
-    };
-    let u = solution.field(complex).to_vec();
-    let mut fields = Vec::new();
-    if let Some(solution_fn) = case.exact.as_ref().and_then(|e| e.solution.as_ref()) {
-        let points: Vec<Vec<f64>> = match &solution.cell_points {
-            Some(given) => given
-                .chunks(complex.embedding_dim())
-                .map(<[f64]>::to_vec)
-                .collect(),
-            None => run::field_points(complex, dim),
-        };
-        let exact_values: Vec<f64> = points.iter().map(|x| solution_fn.eval(x, 0.0)).collect();
-        let error = u.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
-        fields.push(run::Field {
-            name: "u_exact".into(),
-            dim,
-            values: exact_values,
-            description: "the exact solution".into(),
-        });
-        fields.push(run::Field {
-            name: "error".into(),
-            dim,
-            values: error,
-            description: "u − u_exact".into(),
-        });
-    }
-    fields.insert(
-        0,
-        run::Field {
-            name: "u".into(),
-            dim,
-            values: u,
-            description: "the solution on this level".into(),
-        },
-    );
-    fields
-}
-
 fn report(
     step: usize,
     complex: &Complex,
-    case: &Case,
+    exact: Option<&Exact>,
     solution: &Solution,
     seconds: f64,
 ) -> StepReport {
-    let errors = case.exact.as_ref().and_then(|exact| {
-        let u = run::scalar_fn(exact.solution.as_ref()?);
-        let grad = exact.gradient.as_ref().map(|g| run::vector_fn(g));
-        Some(diffusion::errors(complex, solution, &u, grad.as_ref()))
+    let errors = exact.map(|exact| {
+        diffusion::errors(complex, solution, &exact.solution, exact.gradient.as_ref())
     });
     StepReport {
         step,
@@ -296,29 +286,29 @@ fn report(
     }
 }
 
-/// Solve the case on `complex`, then refine `spec.steps` times, re-solving
-/// after each step; `phase` hears about each step.
+/// Solve `problem` on `complex`, then refine `spec.steps` times, re-solving
+/// after each step; `exact` gives each step's errors, `phase` hears about
+/// each step.
 pub fn refine_and_solve(
-    case: &Case,
+    problem: &Diffusion,
     complex: &Complex,
     spec: &RefineSpec,
+    exact: Option<&Exact>,
     phase: &mut dyn FnMut(&str),
-) -> Result<RefinementStudy, RunError> {
-    let problem = diffusion_of(case)?;
+) -> Result<RefinementStudy, RefineError> {
     let source = problem.source.clone();
-    let solve_error = |e: diffusion::DiffusionError| RunError::Solve(e.to_string());
     phase("step 0: solving on the initial mesh");
     let started = std::time::Instant::now();
     let mut current = complex.clone();
-    let mut solution = problem.solve(&current).map_err(solve_error)?;
+    let mut solution = problem.solve(&current)?;
     let mut steps = vec![report(
         0,
         &current,
-        case,
+        exact,
         &solution,
         started.elapsed().as_secs_f64(),
     )];
-    let mut levels = vec![(current.clone(), level_fields(case, &current, &solution))];
+    let mut levels = Vec::new();
     for step in 1..=spec.steps {
         phase(&format!("step {step}: refining ({})", spec.strategy.name()));
         let started = std::time::Instant::now();
@@ -345,31 +335,29 @@ pub fn refine_and_solve(
             initial: None,
             ..Iterative::default()
         });
-        let cold = cold_problem.solve(&fine).map_err(solve_error)?;
+        let cold = cold_problem.solve(&fine)?;
         let mut warm_problem = problem.clone();
         warm_problem.iterative = Some(Iterative {
             options,
             initial: Some(guess),
             ..Iterative::default()
         });
-        let warm = warm_problem.solve(&fine).map_err(solve_error)?;
-        let mut r = report(step, &fine, case, &warm, started.elapsed().as_secs_f64());
+        let warm = warm_problem.solve(&fine)?;
+        let mut r = report(step, &fine, exact, &warm, started.elapsed().as_secs_f64());
         r.cold_iterations = cold.iterations.map(|c| c.iterations);
         r.warm_iterations = warm.iterations.map(|c| c.iterations);
         r.warm_initial_residual = warm.iterations.map(|c| c.initial_residual);
         steps.push(r);
-        levels.push((fine.clone(), level_fields(case, &fine, &warm)));
-        current = fine;
-        solution = warm;
+        levels.push(Level {
+            complex: std::mem::replace(&mut current, fine),
+            solution: std::mem::replace(&mut solution, warm),
+        });
     }
-    phase("post-processing the final mesh");
-    let result = run::solve(case, &current, &mut |_| {})?;
-    Ok(RefinementStudy {
-        steps,
-        levels,
+    levels.push(Level {
         complex: current,
-        result,
-    })
+        solution,
+    });
+    Ok(RefinementStudy { steps, levels })
 }
 
 impl fmt::Display for StepReport {

@@ -7,11 +7,10 @@
 //! font library; SVGs name the font family and leave rendering to the
 //! viewer.
 
-use super::write::{io_error, temporary_path, write_atomically, WriteError};
 use super::{Norm, StudyResult};
+use image::ImageEncoder;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::path::Path;
 use std::sync::OnceLock;
 
 /// The embedded font (DejaVu Sans subset; licence next to it).
@@ -31,7 +30,7 @@ pub enum PlotError {
     Empty,
 }
 
-/// Image formats of [`StudyResult::write_plot`].
+/// Image formats of a study's plot.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PlotFormat {
     Png,
@@ -305,10 +304,10 @@ impl StudyResult {
         Ok(text)
     }
 
-    /// Write the plot to `path` as PNG or SVG (atomically).
+    /// The plot as a PNG image (the bytes of the file).
     ///
     /// ```
-    /// use hasse_solver::study::{PlotFormat, PlotOptions, Refinement, StudyResult, StudyRow};
+    /// use hasse_solver::study::{PlotOptions, Refinement, StudyResult, StudyRow};
     /// let row = |level: usize, h: f64, l2: f64| StudyRow {
     ///     method: "fe".into(), level, resolution: vec![], h, cells: 0, unknowns: 0,
     ///     l2, max: l2, gradient_l2: None, flux: None, mesh_seconds: 0.0, solve_seconds: 0.0,
@@ -317,38 +316,21 @@ impl StudyResult {
     ///     case: "demo.toml".into(), title: Some("demo".into()), refinement: Refinement::Uniform,
     ///     levels: 2, methods: vec!["fe".into()], rows: vec![row(0, 0.2, 4e-2), row(1, 0.1, 1e-2)],
     /// };
-    /// let path = std::env::temp_dir().join(format!("hasse-doc-plot-{}.png", std::process::id()));
-    /// result.write_plot(&path, PlotFormat::Png, PlotOptions { width: 320, height: 200 }).unwrap();
-    /// let png = std::fs::read(&path).unwrap();
+    /// let png = result.png(PlotOptions { width: 320, height: 200 }).unwrap();
     /// assert_eq!(&png[1..4], b"PNG");
-    /// # std::fs::remove_file(&path).unwrap();
     /// ```
-    pub fn write_plot(
-        &self,
-        path: &Path,
-        format: PlotFormat,
-        options: PlotOptions,
-    ) -> Result<(), WriteError> {
-        match format {
-            PlotFormat::Svg => write_atomically(path, self.svg(options)?.as_bytes()),
-            PlotFormat::Png => {
-                register_font()?;
-                // The encoder writes the file itself; let it write a
-                // temporary one and move that into place.
-                let temporary = temporary_path(path);
-                let drawn = {
-                    let root = BitMapBackend::new(&temporary, (options.width, options.height))
-                        .into_drawing_area();
-                    self.draw(root)
-                };
-                let moved = drawn
-                    .map_err(WriteError::from)
-                    .and_then(|()| std::fs::rename(&temporary, path).map_err(io_error(path)));
-                if moved.is_err() {
-                    let _ = std::fs::remove_file(&temporary);
-                }
-                moved
-            }
+    pub fn png(&self, options: PlotOptions) -> Result<Vec<u8>, PlotError> {
+        register_font()?;
+        let (width, height) = (options.width, options.height);
+        let mut rgb = vec![0u8; 3 * width as usize * height as usize];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
+            self.draw(root)?;
         }
+        let mut bytes = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut bytes)
+            .write_image(&rgb, width, height, image::ColorType::Rgb8)
+            .map_err(|e| PlotError::Draw(e.to_string()))?;
+        Ok(bytes)
     }
 }

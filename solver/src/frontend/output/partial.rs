@@ -2,10 +2,11 @@
 //! goes on, so that an interrupted or failed run keeps its completed
 //! levels readable. See [`PartialOutput`].
 
+use super::atomic::{create_dir, is_temporary, remove_if_present, write_atomically, write_text};
+use super::levels::{check_level, rfc3339_now};
 use super::topology::GridTopology;
 use super::{
-    check_level, create_dir, hdf5_file, is_temporary, remove_if_present, rfc3339_now, split_stem,
-    write_atomically, write_run, write_text, xdmf, Cochain, Level, Levels, MeshAt, OutputError,
+    hdf5_file, split_stem, write_run, xdmf, Cochain, Level, Levels, MeshAt, OutputError,
     OutputFiles, Provenance, RunOutput, Step,
 };
 use hasse_complex::Complex;

@@ -48,6 +48,7 @@ mod darcy;
 mod elasticity;
 mod heat;
 mod maxwell;
+pub mod refine;
 
 /// A scalar cochain computed by a run: values on the `dim`-cells.
 #[derive(Clone, Debug, PartialEq)]
