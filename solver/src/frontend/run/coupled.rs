@@ -2,8 +2,9 @@
 //! diffusion operators and the reaction blocks as one block system; each
 //! field is written on its own cells and compared with its exact field.
 
-use super::{diffusion_problem, field_points, scalar_fn, Field, RunError, RunResult};
+use super::{diffusion_problem, field_points, scalar_fn, RunError, RunResult};
 use crate::frontend::case::{Case, CoupledSpec};
+use crate::frontend::output::Cochain;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::Location;
 use crate::physics::coupled::{Coupled, CoupledError, CoupledField, Reaction};
@@ -59,12 +60,10 @@ pub(super) fn solve(
     let mut notes = Vec::new();
     let mut report = serde_json::Map::new();
     for (field, values) in spec.fields.iter().zip(&solution.fields) {
-        out.push(Field {
-            name: field.name.clone(),
-            dim,
-            values: values.clone(),
-            description: format!("coupled field {}", field.name),
-        });
+        out.push(
+            Cochain::new(field.name.clone(), dim, values.clone())
+                .with_description(format!("coupled field {}", field.name)),
+        );
         if let Some(exact) = &field.exact {
             let exact_values: Vec<f64> = points.iter().map(|x| exact.eval(x, 0.0)).collect();
             let (difference, l2, max) = super::weighted_errors(values, &exact_values, &weights);
@@ -76,18 +75,14 @@ pub(super) fn solve(
                 format!("errors_{}", field.name),
                 serde_json::json!({ "l2": l2, "max": max }),
             );
-            out.push(Field {
-                name: format!("{}_exact", field.name),
-                dim,
-                values: exact_values,
-                description: format!("the exact {}", field.name),
-            });
-            out.push(Field {
-                name: format!("{}_error", field.name),
-                dim,
-                values: difference,
-                description: format!("{} − exact", field.name),
-            });
+            out.push(
+                Cochain::new(format!("{}_exact", field.name), dim, exact_values)
+                    .with_description(format!("the exact {}", field.name)),
+            );
+            out.push(
+                Cochain::new(format!("{}_error", field.name), dim, difference)
+                    .with_description(format!("{} − exact", field.name)),
+            );
         }
     }
     let methods = format!(

@@ -3,8 +3,9 @@
 //! = ∫f per cell reported, and pressure and flux errors against an exact
 //! pressure.
 
-use super::{check_residual, Field, RunError, RunResult};
+use super::{check_residual, RunError, RunResult};
 use crate::frontend::case::{BoundaryKindSpec, Case, Coefficient, DarcySpec};
+use crate::frontend::output::Cochain;
 use crate::metric::fv::FluxMass;
 use crate::metric::Tensor;
 use crate::physics::darcy::{self, BoundaryConditions, DarcyError, DarcySolution};
@@ -175,25 +176,13 @@ pub(super) fn solve(
         .max(f64::MIN_POSITIVE);
     let worst = imbalance.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut fields = vec![
-        Field {
-            name: "pressure".into(),
-            dim: n,
-            values: solution.pressure.clone(),
-            description: "p per top cell (at the dual vertices of the flux mass)".into(),
-        },
-        Field {
-            name: "flux".into(),
-            dim: n - 1,
-            values: solution.flux.clone(),
-            description: "∫_F u·n_F: total flux through each (n−1)-cell along its normal".into(),
-        },
-        Field {
-            name: "conservation".into(),
-            dim: n,
-            values: imbalance,
-            description: "net outflow − ∫f per cell (zero to rounding: local mass conservation)"
-                .into(),
-        },
+        Cochain::new("pressure", n, solution.pressure.clone())
+            .with_description("p per top cell (at the dual vertices of the flux mass)"),
+        Cochain::new("flux", n - 1, solution.flux.clone())
+            .with_description("∫_F u·n_F: total flux through each (n−1)-cell along its normal"),
+        Cochain::new("conservation", n, imbalance).with_description(
+            "net outflow − ∫f per cell (zero to rounding: local mass conservation)",
+        ),
     ];
     let (errors, flux_error) = match case.exact.as_ref() {
         Some(exact) => match exact.solution.as_ref() {
@@ -206,18 +195,11 @@ pub(super) fn solve(
                     .zip(&exact_values)
                     .map(|(a, b)| a - b)
                     .collect();
-                fields.push(Field {
-                    name: "pressure_exact".into(),
-                    dim: n,
-                    values: exact_values,
-                    description: "the exact pressure at the cell points".into(),
-                });
-                fields.push(Field {
-                    name: "error".into(),
-                    dim: n,
-                    values: difference,
-                    description: "p − p_exact".into(),
-                });
+                fields.push(
+                    Cochain::new("pressure_exact", n, exact_values)
+                        .with_description("the exact pressure at the cell points"),
+                );
+                fields.push(Cochain::new("error", n, difference).with_description("p − p_exact"));
                 let flux_error = exact.gradient.as_ref().map(|g| {
                     flux_error(complex, &solution, &spec.permeability, |x| {
                         let mut v = [0.0; 3];

@@ -2,9 +2,10 @@
 //! [`crate::physics::elasticity`] on the vertices, one field per component, errors
 //! against an exact displacement.
 
-use super::{check_residual, scalar_fn, Field, RunError, RunResult};
+use super::{check_residual, scalar_fn, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{Case, ElasticBoundaryKind, ElasticitySpec, MaterialSpec};
+use crate::frontend::output::Cochain;
 use crate::physics::diffusion::Errors;
 use crate::physics::elasticity::{
     Coefficient, ElasticBoundary, Elasticity, ElasticityError, Material,
@@ -83,12 +84,10 @@ pub(super) fn solve(
     let mut warnings = Vec::new();
     check_residual(case, u.report.relative_residual, &mut warnings)?;
     let axes = ["x", "y", "z"];
-    let mut fields: Vec<Field> = (0..u.dim)
-        .map(|a| Field {
-            name: format!("u_{}", axes[a]),
-            dim: 0,
-            values: u.component(a).to_vec(),
-            description: format!("displacement component {}", axes[a]),
+    let mut fields: Vec<Cochain> = (0..u.dim)
+        .map(|a| {
+            Cochain::new(format!("u_{}", axes[a]), 0, u.component(a).to_vec())
+                .with_description(format!("displacement component {}", axes[a]))
         })
         .collect();
     let errors = match case.exact.as_ref().and_then(|e| e.displacement.as_ref()) {
@@ -108,12 +107,10 @@ pub(super) fn solve(
                     .enumerate()
                     .map(|(v, value)| value - exact_fn(complex.vertices().point(v))[a])
                     .collect();
-                fields.push(Field {
-                    name: format!("error_{axis}"),
-                    dim: 0,
-                    values: difference,
-                    description: format!("u_{axis} − exact"),
-                });
+                fields.push(
+                    Cochain::new(format!("error_{axis}"), 0, difference)
+                        .with_description(format!("u_{axis} − exact")),
+                );
             }
             Some(Errors {
                 l2,

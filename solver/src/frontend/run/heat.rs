@@ -2,9 +2,10 @@
 //! the case's mesh, the temperature written at every saved level, errors
 //! against an exact u(x, t) at each of them.
 
-use super::{conductivity, scalar_fn, Field, LevelStream, RunError, RunResult};
+use super::{conductivity, scalar_fn, LevelStream, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{BoundaryKindSpec, Case, HeatSpec};
+use crate::frontend::output::Cochain;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::physics::diffusion::Errors;
 use crate::physics::heat::{Heat, HeatBoundary, HeatError, HeatEvent, History, TimeFn};
@@ -134,30 +135,22 @@ pub(super) fn solve_streaming<'a>(
                     time: t, field: u, ..
                 } => {
                     let post = Instant::now();
-                    let mut fields = vec![Field {
-                        name: "u".into(),
-                        dim,
-                        values: u.to_vec(),
-                        description: "the temperature".into(),
-                    }];
+                    let mut fields = vec![
+                        Cochain::new("u", dim, u.to_vec()).with_description("the temperature")
+                    ];
                     if let Some(solution) = exact {
                         let exact_values: Vec<f64> =
                             points.iter().map(|x| solution.eval(x, t)).collect();
                         let (difference, l2, max) =
                             super::weighted_errors(u, &exact_values, &weights);
                         level_errors.push((t, l2, max));
-                        fields.push(Field {
-                            name: "u_exact".into(),
-                            dim,
-                            values: exact_values,
-                            description: "the exact solution at the unknowns' points".into(),
-                        });
-                        fields.push(Field {
-                            name: "error".into(),
-                            dim,
-                            values: difference,
-                            description: "u − u_exact".into(),
-                        });
+                        fields.push(
+                            Cochain::new("u_exact", dim, exact_values)
+                                .with_description("the exact solution at the unknowns' points"),
+                        );
+                        fields.push(
+                            Cochain::new("error", dim, difference).with_description("u − u_exact"),
+                        );
                     }
                     post_seconds += post.elapsed().as_secs_f64();
                     if let Some(stream) = stream.as_deref_mut() {

@@ -2,8 +2,9 @@
 //! [`crate::physics::maxwell::Cavity`], each written as an edge cochain, their ω²
 //! compared with the case's exact eigenvalues.
 
-use super::{Field, RunError, RunResult};
+use super::{RunError, RunResult};
 use crate::frontend::case::{Case, MaxwellSpec};
+use crate::frontend::output::Cochain;
 use crate::la::eigen::EigenError;
 use crate::physics::maxwell::{Cavity, Mass, MaxwellError};
 use hasse_complex::{Complex, DualKind};
@@ -94,15 +95,10 @@ pub(super) fn solve(
         .iter()
         .zip(&modes.eigenvalues)
         .enumerate()
-        .map(|(k, (e, value))| Field {
-            name: format!("mode_{}", k + 1),
-            dim: 1,
-            values: cavity.extend(e),
-            description: format!(
+        .map(|(k, (e, value))| Cochain::new(format!("mode_{}", k + 1), 1, cavity.extend(e)).with_description(format!(
                 "electric field of mode {} (ω² = {value:.10e}) as an edge cochain ∫_e E·t, zero on the walls, M-normalised",
                 k + 1
-            ),
-        })
+            )))
         .collect();
     let mut report = serde_json::Map::new();
     report.insert("modes".into(), serde_json::Value::Array(rows));

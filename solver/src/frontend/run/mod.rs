@@ -26,6 +26,7 @@
 use crate::frontend::case::{
     BoundaryKindSpec, Case, Coefficient, DiffusionSpec, GradientMetric, GradientSpec, Problem,
 };
+use crate::frontend::output::Cochain;
 use crate::la::direct::Factorization;
 use crate::la::ordering::Ordering;
 use crate::metric::Location;
@@ -50,15 +51,6 @@ mod heat;
 mod maxwell;
 pub mod refine;
 
-/// A scalar cochain computed by a run: values on the `dim`-cells.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Field {
-    pub name: String,
-    pub dim: usize,
-    pub values: Vec<f64>,
-    pub description: String,
-}
-
 /// What a run produced.
 #[derive(Clone, Debug)]
 pub struct RunResult {
@@ -66,7 +58,7 @@ pub struct RunResult {
     pub problem: String,
     pub method: Option<String>,
     pub unknowns: usize,
-    pub fields: Vec<Field>,
+    pub fields: Vec<Cochain>,
     pub errors: Option<Errors>,
     /// L² error of face fluxes (cell-centred and hybrid methods).
     pub flux_error: Option<f64>,
@@ -83,7 +75,7 @@ pub struct RunResult {
     /// Saved time levels of a transient run, (t, fields) in order; the
     /// output writes them as a time series. Empty for steady problems,
     /// whose `fields` are the one step.
-    pub series: Vec<(f64, Vec<Field>)>,
+    pub series: Vec<(f64, Vec<Cochain>)>,
     /// Further summary lines (label, text), e.g. time stepping or modes.
     pub notes: Vec<(String, String)>,
     /// Problem-specific entries of the stored report (per-level errors,
@@ -322,25 +314,17 @@ fn solve_diffusion(
         _ => n,
     };
     let field = solution.field(complex).to_vec();
-    let mut fields = vec![Field {
-        name: "u".into(),
-        dim: field_dim,
-        values: field.clone(),
-        description: "the solution".into(),
-    }];
+    let mut fields =
+        vec![Cochain::new("u", field_dim, field.clone()).with_description("the solution")];
     match solution.location {
-        Location::Nodal => fields.push(Field {
-            name: "flux".into(),
-            dim: 1,
-            values: solution.flux.clone(),
-            description: "edge cochain Ω A u (the discrete flux along edges)".into(),
-        }),
-        Location::CellCentred => fields.push(Field {
-            name: "flux".into(),
-            dim: n - 1,
-            values: solution.flux.clone(),
-            description: "flux through each (n−1)-cell along its orientation".into(),
-        }),
+        Location::Nodal => fields.push(
+            Cochain::new("flux", 1, solution.flux.clone())
+                .with_description("edge cochain Ω A u (the discrete flux along edges)"),
+        ),
+        Location::CellCentred => fields.push(
+            Cochain::new("flux", n - 1, solution.flux.clone())
+                .with_description("flux through each (n−1)-cell along its orientation"),
+        ),
         // Half-face fluxes have no cells of their own to live on.
         Location::Hybrid => {}
     }
@@ -357,12 +341,14 @@ fn solve_diffusion(
             0
         })
     {
-        fields.push(Field {
-            name: format!("grad_{name}"),
-            dim: n,
-            values: gradient.iter().map(|g| g[axis]).collect(),
-            description: format!("∂u/∂{name} reconstructed per cell"),
-        });
+        fields.push(
+            Cochain::new(
+                format!("grad_{name}"),
+                n,
+                gradient.iter().map(|g| g[axis]).collect(),
+            )
+            .with_description(format!("∂u/∂{name} reconstructed per cell")),
+        );
     }
     let exact = case
         .exact
@@ -396,18 +382,12 @@ fn solve_diffusion(
                 let mean = difference.iter().sum::<f64>() / difference.len().max(1) as f64;
                 difference.iter_mut().for_each(|d| *d -= mean);
             }
-            fields.push(Field {
-                name: "u_exact".into(),
-                dim: field_dim,
-                values: exact_values,
-                description: "the exact solution at the unknowns' points".into(),
-            });
-            fields.push(Field {
-                name: "error".into(),
-                dim: field_dim,
-                values: difference,
-                description: "u − u_exact".into(),
-            });
+            fields.push(
+                Cochain::new("u_exact", field_dim, exact_values)
+                    .with_description("the exact solution at the unknowns' points"),
+            );
+            fields
+                .push(Cochain::new("error", field_dim, difference).with_description("u − u_exact"));
             (Some(errors), flux_error)
         }
     };
@@ -573,25 +553,12 @@ fn gradient(
         method: None,
         unknowns: 0,
         fields: vec![
-            Field {
-                name: "f".into(),
-                dim: n,
-                values: f,
-                description: "the field sampled at cell centroids".into(),
-            },
-            Field {
-                name: "jump".into(),
-                dim: n - 1,
-                values: jump,
-                description: "−∂ᵀ f: the jump of f across each interior face along its normal"
-                    .into(),
-            },
-            Field {
-                name: "normal_gradient".into(),
-                dim: n - 1,
-                values: g,
-                description: "Ω (−∂ᵀ f): the normal gradient as a face cochain".into(),
-            },
+            Cochain::new("f", n, f).with_description("the field sampled at cell centroids"),
+            Cochain::new("jump", n - 1, jump).with_description(
+                "−∂ᵀ f: the jump of f across each interior face along its normal",
+            ),
+            Cochain::new("normal_gradient", n - 1, g)
+                .with_description("Ω (−∂ᵀ f): the normal gradient as a face cochain"),
         ],
         errors: None,
         flux_error: None,
@@ -691,17 +658,13 @@ impl RunResult {
     }
 }
 
-/// Fields as output cochains, each with its description and the method.
-fn cochains(fields: &[Field], method: Option<&str>) -> Vec<crate::frontend::output::Cochain> {
+/// The run's cochains, each marked with the method that computed it.
+fn cochains(fields: &[Cochain], method: Option<&str>) -> Vec<Cochain> {
     fields
         .iter()
-        .map(|f| {
-            let c = crate::frontend::output::Cochain::new(f.name.clone(), f.dim, f.values.clone())
-                .with_description(f.description.clone());
-            match method {
-                Some(m) => c.with_method(m),
-                None => c,
-            }
+        .map(|c| match method {
+            Some(m) => c.clone().with_method(m),
+            None => c.clone(),
         })
         .collect()
 }
@@ -761,7 +724,7 @@ pub fn write_output(
 /// at "time" k, each with its own complex (see `cases/OUTPUT.md`).
 pub fn write_levels(
     case: &Case,
-    levels: &[(Complex, Vec<Field>)],
+    levels: &[(Complex, Vec<Cochain>)],
     report: serde_json::Value,
     stem: &std::path::Path,
 ) -> Result<crate::frontend::output::OutputFiles, crate::frontend::output::OutputError> {
@@ -867,7 +830,7 @@ impl<'a> LevelStream<'a> {
         &mut self,
         complex: &'a Complex,
         time: f64,
-        fields: &[Field],
+        fields: &[Cochain],
         method: Option<&str>,
         phase: &mut dyn FnMut(&str),
     ) {

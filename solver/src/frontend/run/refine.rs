@@ -2,8 +2,9 @@
 //! problem ([`crate::refine`]), each level's fields for the output, and
 //! the run result of the finest level.
 
-use super::{diffusion_problem, field_points, scalar_fn, vector_fn, Field, RunError, RunResult};
+use super::{diffusion_problem, field_points, scalar_fn, vector_fn, RunError, RunResult};
 use crate::frontend::case::{Case, Problem};
+use crate::frontend::output::Cochain;
 use crate::metric::Location;
 use crate::physics::diffusion::Solution;
 use crate::refine::{refine_and_solve, Exact, RefineSpec, StepReport};
@@ -17,7 +18,7 @@ pub struct CaseRefinement {
     /// Every level's complex and fields (`u`, and `u_exact`, `error` when
     /// the case has an exact solution), for a time series whose mesh
     /// changes.
-    pub levels: Vec<(Complex, Vec<Field>)>,
+    pub levels: Vec<(Complex, Vec<Cochain>)>,
     /// The finest complex.
     pub complex: Complex,
     /// The case run on the finest complex.
@@ -69,7 +70,7 @@ pub fn refine_case(
             RunError::Solve(e.to_string())
         }
     })?;
-    let levels: Vec<(Complex, Vec<Field>)> = study
+    let levels: Vec<(Complex, Vec<Cochain>)> = study
         .levels
         .into_iter()
         .map(|level| {
@@ -92,7 +93,7 @@ pub fn refine_case(
 }
 
 /// The primary field of a level and, with an exact solution, its error.
-fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<Field> {
+fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<Cochain> {
     let dim = match solution.location {
         Location::Nodal => 0,
         _ => complex.dim(),
@@ -109,27 +110,14 @@ fn level_fields(case: &Case, complex: &Complex, solution: &Solution) -> Vec<Fiel
         };
         let exact_values: Vec<f64> = points.iter().map(|x| solution_fn.eval(x, 0.0)).collect();
         let error = u.iter().zip(&exact_values).map(|(a, b)| a - b).collect();
-        fields.push(Field {
-            name: "u_exact".into(),
-            dim,
-            values: exact_values,
-            description: "the exact solution".into(),
-        });
-        fields.push(Field {
-            name: "error".into(),
-            dim,
-            values: error,
-            description: "u − u_exact".into(),
-        });
+        fields.push(
+            Cochain::new("u_exact", dim, exact_values).with_description("the exact solution"),
+        );
+        fields.push(Cochain::new("error", dim, error).with_description("u − u_exact"));
     }
     fields.insert(
         0,
-        Field {
-            name: "u".into(),
-            dim,
-            values: u,
-            description: "the solution on this level".into(),
-        },
+        Cochain::new("u", dim, u).with_description("the solution on this level"),
     );
     fields
 }
