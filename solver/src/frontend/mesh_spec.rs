@@ -119,7 +119,66 @@ pub fn read_case_mesh(path: &Path) -> Result<MeshSpec, MeshError> {
     })
 }
 
+/// The field names of a struct as serde reads them: the names it passes
+/// to `deserialize_struct`, caught by a deserializer that reads nothing
+/// else. So the list of `[mesh]` keys is `MeshSpec`'s fields, not a copy.
+fn struct_fields<T: for<'de> Deserialize<'de>>() -> &'static [&'static str] {
+    struct Fields(Option<&'static [&'static str]>);
+    #[derive(Debug)]
+    struct Stop;
+    impl std::fmt::Display for Stop {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("field names read")
+        }
+    }
+    impl std::error::Error for Stop {}
+    impl serde::de::Error for Stop {
+        fn custom<M: std::fmt::Display>(_: M) -> Self {
+            Stop
+        }
+    }
+    impl<'de> serde::Deserializer<'de> for &mut Fields {
+        type Error = Stop;
+        fn deserialize_any<V: serde::de::Visitor<'de>>(self, _: V) -> Result<V::Value, Stop> {
+            Err(Stop)
+        }
+        fn deserialize_struct<V: serde::de::Visitor<'de>>(
+            self,
+            _name: &'static str,
+            fields: &'static [&'static str],
+            _visitor: V,
+        ) -> Result<V::Value, Stop> {
+            self.0 = Some(fields);
+            Err(Stop)
+        }
+        serde::forward_to_deserialize_any! {
+            bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string
+            bytes byte_buf option unit unit_struct newtype_struct seq tuple
+            tuple_struct map enum identifier ignored_any
+        }
+    }
+    let mut fields = Fields(None);
+    let _ = T::deserialize(&mut fields);
+    fields.0.unwrap_or(&[])
+}
+
 impl MeshSpec {
+    /// The keys of the `[mesh]` table: `MeshSpec`'s fields.
+    ///
+    /// ```
+    /// use hasse_solver::frontend::mesh_spec::MeshSpec;
+    /// let mut keys = MeshSpec::keys().to_vec();
+    /// keys.sort_unstable();
+    /// assert_eq!(keys, [
+    ///     "cavity", "cells", "file", "generator", "grading", "inner_radius", "lloyd",
+    ///     "major_radius", "minor_radius", "n", "outer_radius", "perturb", "radius", "seed",
+    ///     "subdivisions", "x", "y", "z",
+    /// ]);
+    /// ```
+    pub fn keys() -> &'static [&'static str] {
+        struct_fields::<MeshSpec>()
+    }
+
     /// Build the complex; `case_path` names the case file in messages and
     /// anchors relative mesh paths.
     pub fn build(&self, case_path: &Path) -> Result<Complex, MeshError> {

@@ -38,26 +38,6 @@ const TOP_KEYS: &[&str] = &[
     "time",
     "field",
 ];
-const MESH_KEYS: &[&str] = &[
-    "generator",
-    "file",
-    "n",
-    "x",
-    "y",
-    "z",
-    "grading",
-    "cells",
-    "perturb",
-    "seed",
-    "radius",
-    "subdivisions",
-    "inner_radius",
-    "outer_radius",
-    "major_radius",
-    "minor_radius",
-    "cavity",
-    "lloyd",
-];
 const PROBLEM_KEYS: &[&str] = &[
     "kind",
     "method",
@@ -507,7 +487,7 @@ impl Reader {
         };
         spans.insert(String::new(), entry.span().unwrap_or(0..0));
         let before = self.collector.diagnostics.len();
-        self.check_keys(table, "mesh", MESH_KEYS);
+        self.check_keys(table, "mesh", MeshSpec::keys());
         for (key, item) in table.iter() {
             if let Some(span) = item
                 .span()
@@ -534,7 +514,7 @@ impl Reader {
                     Err(e) => {
                         // Find which key the message is about to point at it.
                         let message = e.message().trim().to_string();
-                        let key = MESH_KEYS.iter().find(|k| {
+                        let key = MeshSpec::keys().iter().find(|k| {
                             message.contains(&format!("mesh.{k}"))
                                 || message.contains(&format!("`{k}`"))
                         });
