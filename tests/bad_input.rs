@@ -12,6 +12,9 @@ use std::process::{Command, Output};
 struct Bad {
     /// File stem in tests/bad-input/.
     file: &'static str,
+    /// `--set` overrides the file is run with (the bad value comes from the
+    /// command line: the error must name the `--set` text, not a line).
+    set: &'static [&'static str],
     exit: i32,
     /// Line the first error names (`file:line:`), when the problem has one.
     line: Option<usize>,
@@ -22,24 +25,28 @@ struct Bad {
 const CATALOGUE: &[Bad] = &[
     // ---- the case file itself
     Bad {
+        set: &[],
         file: "malformed",
         exit: 2,
         line: Some(3),
         says: &["not valid TOML", "help: see https://toml.io"],
     },
     Bad {
+        set: &[],
         file: "unknown-key",
         exit: 2,
         line: Some(7),
         says: &["`problem.methdo`: unknown key", "did you mean `method`?"],
     },
     Bad {
+        set: &[],
         file: "wrong-type",
         exit: 2,
         line: Some(8),
         says: &["`problem.conductivity`: expected a number or an expression string, found a boolean"],
     },
     Bad {
+        set: &[],
         file: "several-problems",
         exit: 2,
         line: Some(5),
@@ -47,120 +54,192 @@ const CATALOGUE: &[Bad] = &[
     },
     // ---- expressions
     Bad {
+        set: &[],
         file: "bad-expression",
         exit: 2,
         line: Some(8),
         says: &["cannot parse `sin(pi*x`", "help: operators"],
     },
     Bad {
+        set: &[],
         file: "unknown-variable",
         exit: 2,
         line: Some(11),
         says: &["unknown variable `kapa`", "did you mean `kappa`?"],
     },
     Bad {
+        set: &[],
         file: "nonfinite-constant",
         exit: 2,
         line: Some(12),
         says: &["`boundary[0].value`: `sqrt(-1)` evaluates to NaN", "help: give a finite value"],
     },
     Bad {
+        set: &[],
         file: "division-by-zero",
         exit: 2,
-        line: None,
-        says: &["source is not finite at [0.375, 0.125]", "no output written"],
-    },
-    Bad {
-        file: "singular-source",
-        exit: 2,
-        line: None,
-        says: &["source is not finite at [0.125, 0.125]", "no output written"],
-    },
-    // ---- coefficients
-    Bad {
-        file: "negative-conductivity",
-        exit: 2,
-        line: None,
+        line: Some(9),
         says: &[
-            "conductivity at [0.125, 0.125]",
-            "top cell 0 is not symmetric positive definite",
-            "check the conductivity expression there",
+            "`problem.source`: the source is not finite (∞) at (0.375, 0.125)",
+            "check divisions",
+            "no output written",
         ],
     },
     Bad {
-        file: "nan-conductivity",
+        set: &[],
+        file: "singular-source",
+        exit: 2,
+        line: Some(11),
+        says: &[
+            "`problem.source`: the source is not finite (NaN) at (0.125, 0.125)",
+            "no output written",
+        ],
+    },
+    Bad {
+        set: &[],
+        file: "nan-source",
+        exit: 2,
+        line: Some(10),
+        // The first Gauss point of cell 0 = [−1, −½] × [0, ¼]: x = −¾ − ¼/√3.
+        says: &[
+            "`problem.source`: the source is not finite (NaN) at (-0.8943375672974064, ",
+            "no output written",
+        ],
+    },
+    Bad {
+        set: &["problem.source=ln(x)"],
+        file: "nan-source-set",
         exit: 2,
         line: None,
-        says: &["conductivity at [0.125, 0.125]", "top cell 0 is not finite"],
+        says: &[
+            "`problem.source`: the source is not finite (NaN) at (-0.8943375672974064, ",
+            "no output written",
+        ],
+    },
+    // ---- coefficients
+    Bad {
+        set: &[],
+        file: "negative-conductivity",
+        exit: 2,
+        line: Some(8),
+        says: &[
+            "`problem.conductivity`: the conductivity at (0.125, 0.125) (top cell 0) is not symmetric positive definite",
+            "help: the conductivity must be finite and positive",
+        ],
+    },
+    Bad {
+        set: &["problem.conductivity=x - 0.5"],
+        file: "negative-conductivity-set",
+        exit: 2,
+        line: None,
+        says: &[
+            "`problem.conductivity`: the conductivity at (0.125, 0.125) (top cell 0) is not symmetric positive definite",
+        ],
+    },
+    Bad {
+        set: &[],
+        file: "nan-conductivity",
+        exit: 2,
+        line: Some(9),
+        says: &["`problem.conductivity`: the conductivity at (0.125, 0.125) (top cell 0) is not finite"],
+    },
+    Bad {
+        set: &[],
+        file: "tensor-size",
+        exit: 2,
+        line: Some(8),
+        says: &[
+            "`problem.conductivity`: a 3×3 tensor, but the mesh lives in 2 dimensions",
+            "help: give 2 rows of 2 entries",
+        ],
+    },
+    Bad {
+        set: &["problem.conductivity=[[1,0,0],[0,1,0],[0,0,1]]"],
+        file: "tensor-size-set",
+        exit: 2,
+        line: None,
+        says: &["`problem.conductivity`: a 3×3 tensor, but the mesh lives in 2 dimensions"],
     },
     // ---- mesh files
     Bad {
+        set: &[],
         file: "missing-mesh-file",
         exit: 2,
         line: Some(3),
         says: &["`mesh.file`: cannot read Gmsh mesh", "No such file", "relative to the case file"],
     },
     Bad {
+        set: &[],
         file: "unreadable-mesh",
         exit: 2,
         line: Some(3),
         says: &["`mesh.file`: cannot read Gmsh mesh", "directory.msh", "check the path"],
     },
     Bad {
+        set: &[],
         file: "mesh-truncated",
         exit: 2,
         line: Some(3),
         says: &["truncated.msh' is not a valid Gmsh .msh 4.1 file", "probably truncated", "re-export it"],
     },
     Bad {
+        set: &[],
         file: "mesh-version-2",
         exit: 2,
         line: Some(3),
         says: &["format version 2.2, but only version 4.1 can be read", "-format msh4"],
     },
     Bad {
+        set: &[],
         file: "mesh-missing-node",
         exit: 2,
         line: Some(3),
         says: &["element 4 refers to node 9, which is not listed in the $Nodes section"],
     },
     Bad {
+        set: &[],
         file: "mesh-duplicate-vertices",
         exit: 2,
         line: Some(3),
         says: &["vertices 2 and 4 coincide at [1.0, 1.0]", "merge duplicate nodes"],
     },
     Bad {
+        set: &[],
         file: "mesh-degenerate",
         exit: 2,
         line: Some(3),
         says: &["2-cell 1 (vertices [0, 1, 3]) has zero 2-measure", "Gmsh element 2"],
     },
     Bad {
+        set: &[],
         file: "mesh-inverted",
         exit: 2,
         line: Some(4),
         says: &["top cells 0 and 1 lie on the same side of their shared face 0", "inverted"],
     },
     Bad {
+        set: &[],
         file: "mesh-overlap",
         exit: 2,
         line: Some(4),
         says: &["face 0 bounds 3 top cells ([0, 1, 2])", "the cells overlap"],
     },
     Bad {
+        set: &[],
         file: "mesh-non-manifold",
         exit: 2,
         line: Some(3),
         says: &["1-cell 0 (vertices [0, 1]) bounds 3 top cells", "not a manifold"],
     },
     Bad {
+        set: &[],
         file: "mesh-mobius",
         exit: 2,
         line: Some(3),
         says: &["not orientable: top cell 4", "Gmsh element 5"],
     },
     Bad {
+        set: &[],
         file: "too-big",
         exit: 2,
         line: Some(5),
@@ -172,12 +251,14 @@ const CATALOGUE: &[Bad] = &[
     },
     // ---- boundary conditions and the system
     Bad {
+        set: &[],
         file: "unknown-tag",
         exit: 2,
         line: Some(10),
         says: &["no tag `bondary` in the mesh", "did you mean `boundary`?"],
     },
     Bad {
+        set: &[],
         file: "disconnected",
         exit: 2,
         line: None,
@@ -188,12 +269,14 @@ const CATALOGUE: &[Bad] = &[
         ],
     },
     Bad {
+        set: &[],
         file: "incompatible-neumann",
         exit: 2,
         line: None,
         says: &["pure Neumann problem with incompatible data", "∫f + ∮g = 0"],
     },
     Bad {
+        set: &[],
         file: "singular-system",
         exit: 1,
         line: None,
@@ -201,6 +284,7 @@ const CATALOGUE: &[Bad] = &[
     },
     // ---- output
     Bad {
+        set: &[],
         file: "output-not-writable",
         exit: 2,
         line: None,
@@ -245,6 +329,9 @@ fn every_bad_input_is_refused_clearly_and_writes_nothing() {
         let file = format!("tests/bad-input/{}.toml", bad.file);
         let stem = dir.join("out");
         let mut args = vec!["run", file.as_str()];
+        for set in bad.set {
+            args.extend(["--set", set]);
+        }
         // This file is about its own [output] directory.
         if bad.file != "output-not-writable" {
             args.extend(["-o", stem.to_str().unwrap()]);
@@ -262,9 +349,10 @@ fn every_bad_input_is_refused_clearly_and_writes_nothing() {
         if stderr.contains("panicked") {
             wrong.push("it panicked".into());
         }
-        let at = match bad.line {
-            Some(line) => format!("error: {file}:{line}:"),
-            None => format!("error: {file}: "),
+        let at = match (bad.line, bad.set) {
+            (Some(line), _) => format!("error: {file}:{line}:"),
+            (None, []) => format!("error: {file}: "),
+            (None, [set, ..]) => format!("error: {file}: --set {set}: "),
         };
         if !stderr.starts_with(&at) {
             wrong.push(format!("the first error does not start with `{at}`"));
@@ -286,16 +374,14 @@ fn every_bad_input_is_refused_clearly_and_writes_nothing() {
     assert!(failures.is_empty(), "{}", failures.join("\n\n"));
 }
 
-/// `hasse check` reads the same files without solving: problems of the file
-/// and of the mesh are found (exit 2); problems that only evaluation or the
-/// solve reveals are not, and check says the case is fine (exit 0).
+/// `hasse check` reads the same files without solving: problems of the file,
+/// of the mesh and of the data where the solve evaluates them (sources and
+/// coefficients) are found (exit 2), with the same first message as `hasse
+/// run`; problems that only the assembled system or the output reveal are
+/// not, and check says the case is fine (exit 0).
 #[test]
 fn check_finds_what_needs_no_solve() {
     let solve_only = [
-        "division-by-zero",
-        "singular-source",
-        "negative-conductivity",
-        "nan-conductivity",
         "disconnected",
         "incompatible-neumann",
         "singular-system",
@@ -303,11 +389,18 @@ fn check_finds_what_needs_no_solve() {
     ];
     for bad in CATALOGUE {
         let file = format!("tests/bad-input/{}.toml", bad.file);
-        let out = hasse(&["check", &file], &root());
+        let mut args = vec!["check", file.as_str()];
+        for set in bad.set {
+            args.extend(["--set", set]);
+        }
+        let out = hasse(&args, &root());
         let stderr = String::from_utf8_lossy(&out.stderr);
         let expected = if solve_only.contains(&bad.file) { 0 } else { 2 };
         assert_eq!(out.status.code(), Some(expected), "{file}:\n{stderr}");
         assert!(!stderr.contains("panicked"), "{file}:\n{stderr}");
+        if expected == 2 {
+            assert!(stderr.contains(bad.says[0]), "{file}:\n{stderr}");
+        }
     }
 }
 

@@ -21,6 +21,7 @@ use hasse_complex::{Complex, TopCells, Vertices};
 use hasse_solver::physics::elasticity::{
     Coefficient, ElasticBoundary, Elasticity, ElasticityError, Material, PlaneModel,
 };
+use hasse_solver::physics::Datum;
 use hasse_solver::physics::VectorFn;
 use nalgebra::DMatrix;
 use std::f64::consts::PI;
@@ -666,7 +667,10 @@ fn bad_input_is_a_typed_error() {
             )
             .solve(&mesh),
         Err(ElasticityError::NonFinite {
-            what: "displacement",
+            datum: Datum::BoundaryValue {
+                condition: 0,
+                kind: "displacement"
+            },
             ..
         })
     ));
@@ -677,7 +681,7 @@ fn bad_input_is_a_typed_error() {
         ))
         .solve(&mesh),
         Err(ElasticityError::NonFinite {
-            what: "body force",
+            datum: Datum::BodyForce,
             ..
         })
     ));

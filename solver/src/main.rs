@@ -87,8 +87,10 @@ enum Command {
     ///
     /// Reports unknown or misspelt keys (with a suggestion), wrong types,
     /// missing files, expressions that do not parse or use unknown names,
-    /// and boundary tags that the mesh does not have, each with file, line
-    /// and column. Exit code 0 when the case is valid, 2 otherwise.
+    /// boundary tags that the mesh does not have, and coefficients,
+    /// sources and materials that are not finite or not positive where the
+    /// solve would evaluate them, each with file, line and column (or the
+    /// --set text). Exit code 0 when the case is valid, 2 otherwise.
     ///
     /// Example: hasse check cases/l-shape.toml
     Check {
@@ -326,6 +328,13 @@ fn check_case(path: &Path, set: &[String]) -> ExitCode {
     };
     match case.build_mesh() {
         Ok(complex) => {
+            // The data where the solve evaluates them: coefficients and
+            // sources that are not finite or not positive are refused here.
+            if let Err(e) = run::check_data(&case, &complex) {
+                eprintln!("error: {e}");
+                eprintln!("{}: 1 problem found", path.display());
+                return ExitCode::from(EXIT_BAD_INPUT);
+            }
             println!(
                 "{}: ok ({}, mesh cells per dimension {:?})",
                 path.display(),
@@ -478,7 +487,7 @@ fn run_case(
         Ok(result) => result,
         Err(e) => {
             progress.finish();
-            eprintln!("error: {}: {e}", path.display());
+            eprintln!("error: {e}");
             left_behind(stream.as_ref());
             return ExitCode::from(if e.is_input() {
                 EXIT_BAD_INPUT

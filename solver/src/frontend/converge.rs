@@ -74,7 +74,7 @@ pub enum StudyError {
     #[error("{case}: {message}")]
     Refinement { case: String, message: String },
     /// A level failed to solve.
-    #[error("{case}: level {level}, method {method}: {source}")]
+    #[error("level {level}, method {method}: {source}")]
     Run {
         case: String,
         level: usize,

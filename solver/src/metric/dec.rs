@@ -177,7 +177,11 @@ pub fn load(
         let cell = (0..complex.cell_count(n))
             .find(|&c| complex.cell_vertices(n, c).contains(&v))
             .unwrap_or(0);
-        return Err(MetricError::NonFinite { cell });
+        return Err(MetricError::NonFiniteSource {
+            cell,
+            point: vertices.point(v).to_vec(),
+            value: values[v],
+        });
     }
     Ok(star.iter().zip(values).map(|(s, x)| s * x).collect())
 }

@@ -48,6 +48,14 @@ pub enum MetricError {
     NotPositive { cell: usize, value: f64 },
     #[error("coefficient in top cell {cell} is not finite")]
     NonFinite { cell: usize },
+    /// The source (right-hand side) evaluated to NaN or ±∞ where a load
+    /// needs it.
+    #[error("the source is {value} at {point:?} (in top cell {cell})")]
+    NonFiniteSource {
+        cell: usize,
+        point: Vec<f64>,
+        value: f64,
+    },
     #[error("{count} coefficients given for {cells} top cells")]
     CoefficientCount { count: usize, cells: usize },
     #[error(transparent)]

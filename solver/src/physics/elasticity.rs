@@ -41,7 +41,9 @@ use crate::metric::MetricError;
 use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use crate::physics::diffusion::{self, DiffusionError};
 use crate::physics::VectorFn;
-use crate::physics::{tagged_boundary_faces, ScalarFn, TagError};
+use crate::physics::{
+    non_finite_text, point_text, tagged_boundary_faces, Datum, ScalarFn, TagError,
+};
 use faer::sparse::SparseColMat;
 use hasse_complex::Complex;
 use nalgebra::DMatrix;
@@ -189,10 +191,13 @@ pub enum ElasticityError {
         component: usize,
         d: usize,
     },
-    #[error("{what} is not finite at {location:?}")]
+    /// A given function (body force, boundary displacement or traction)
+    /// is NaN or ±∞ at a point.
+    #[error("{datum} is not finite ({}) at {}", non_finite_text(*.value), point_text(.point))]
     NonFinite {
-        what: &'static str,
-        location: Vec<f64>,
+        datum: Datum,
+        point: Vec<f64>,
+        value: f64,
     },
     #[error("the prescribed displacements leave {free} of the {modes} rigid-body modes (translations and rotations) of part {part} of the mesh free, so the solution is not unique; prescribe displacements on enough of its boundary (pure traction problems have no unique solution)")]
     RigidModes {
@@ -274,13 +279,14 @@ impl Displacement {
     }
 }
 
-fn evaluate(value: f64, what: &'static str, x: &[f64]) -> Result<f64, ElasticityError> {
+fn evaluate(value: f64, datum: Datum, x: &[f64]) -> Result<f64, ElasticityError> {
     if value.is_finite() {
         Ok(value)
     } else {
         Err(ElasticityError::NonFinite {
-            what,
-            location: x.to_vec(),
+            datum,
+            point: x.to_vec(),
+            value,
         })
     }
 }
@@ -381,6 +387,33 @@ impl Elasticity {
             .collect()
     }
 
+    /// The material in every cell and the body force's load, checked as
+    /// [`Elasticity::assemble`] checks them, without building the
+    /// stiffness: bad data refused before solving.
+    pub fn check_data(&self, complex: &Complex) -> Result<(), ElasticityError> {
+        self.lame(complex)?;
+        self.body_load(complex).map(|_| ())
+    }
+
+    /// ∫ f_a φ_v for every component a, component after component.
+    fn body_load(&self, complex: &Complex) -> Result<Vec<f64>, ElasticityError> {
+        let d = complex.embedding_dim();
+        let mut rhs = Vec::with_capacity(d * complex.cell_count(0));
+        for a in 0..d {
+            let force = &self.body_force;
+            let load = fe::load(complex, &|x| force(x)[a]).map_err(|e| match e {
+                MetricError::NonFiniteSource { point, value, .. } => ElasticityError::NonFinite {
+                    datum: Datum::BodyForce,
+                    point,
+                    value,
+                },
+                other => other.into(),
+            })?;
+            rhs.extend(load);
+        }
+        Ok(rhs)
+    }
+
     /// Assemble K = Aᵀ Ω A, the loads and the prescribed components.
     pub fn assemble(&self, complex: &Complex) -> Result<ElasticSystem, ElasticityError> {
         let started = Instant::now();
@@ -391,18 +424,7 @@ impl Elasticity {
         let metric = stiffness_metric(complex, &lame)?;
         let mut canonical = Canonical::new(incidence(complex), metric)?;
 
-        let mut rhs = Vec::with_capacity(d * vertices);
-        for a in 0..d {
-            let force = &self.body_force;
-            let load = fe::load(complex, &|x| force(x)[a]).map_err(|e| match e {
-                MetricError::NonFinite { cell } => ElasticityError::NonFinite {
-                    what: "body force",
-                    location: complex.centroid_of(n, cell).to_vec(),
-                },
-                other => other.into(),
-            })?;
-            rhs.extend(load);
-        }
+        let mut rhs = self.body_load(complex)?;
 
         let mut fixed = vec![None; d * vertices];
         let condition = self.boundary_faces(complex, d)?;
@@ -412,21 +434,29 @@ impl Elasticity {
             let share = area[f] / face.len() as f64;
             for &v in face {
                 let x = complex.vertices().point(v);
+                let displacement = Datum::BoundaryValue {
+                    condition: k,
+                    kind: "displacement",
+                };
+                let traction = Datum::BoundaryValue {
+                    condition: k,
+                    kind: "traction",
+                };
                 match &self.boundary[k].1 {
                     ElasticBoundary::Displacement(g) => {
                         let g = g(x);
                         for (a, &ga) in g.iter().enumerate().take(d) {
-                            fixed[a * vertices + v] = Some(evaluate(ga, "displacement", x)?);
+                            fixed[a * vertices + v] = Some(evaluate(ga, displacement, x)?);
                         }
                     }
                     ElasticBoundary::Component { component, value } => {
                         fixed[component * vertices + v] =
-                            Some(evaluate(value(x), "displacement", x)?);
+                            Some(evaluate(value(x), displacement, x)?);
                     }
                     ElasticBoundary::Traction(t) => {
                         let t = t(x);
                         for (a, &ta) in t.iter().enumerate().take(d) {
-                            rhs[a * vertices + v] += evaluate(ta, "traction", x)? * share;
+                            rhs[a * vertices + v] += evaluate(ta, traction, x)? * share;
                         }
                     }
                 }

@@ -24,9 +24,7 @@ use crate::metric::Location;
 use crate::metric::Method;
 use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use crate::physics::diffusion::{Diffusion, DiffusionError};
-use crate::physics::BoundaryKind;
-use crate::physics::Conductivity;
-use crate::physics::ScalarFn;
+use crate::physics::{non_finite_text, point_text, BoundaryKind, Conductivity, Datum, ScalarFn};
 use hasse_complex::Complex;
 use sprs::CsMat;
 use std::sync::Arc;
@@ -79,12 +77,18 @@ pub enum HeatError {
     Theta { theta: f64 },
     #[error("start time t₀ = {t0} is not finite")]
     StartTime { t0: f64 },
-    #[error("{what} is not finite at {location:?} (t = {time})")]
+    /// A given function (the initial value) is NaN or ±∞ at a point.
+    #[error("{datum} is not finite ({}) at {} (t = {time})", non_finite_text(*.value), point_text(.point))]
     NonFinite {
-        what: &'static str,
-        location: Vec<f64>,
+        datum: Datum,
+        point: Vec<f64>,
+        value: f64,
         time: f64,
     },
+    /// The temperature itself overflowed: an unstable scheme (θ < ½ with
+    /// a step above the stability limit), not a wrong datum.
+    #[error("the temperature is not finite at {} at t = {time}: the scheme is unstable (θ < ½ needs Δt below about h²/(2K) per dimension); use θ ≥ ½ or a smaller step", point_text(.point))]
+    Overflow { point: Vec<f64>, time: f64 },
     #[error("the {method} method has no mass matrix here: transient heat needs nodal or cell-centred unknowns")]
     Unsupported { method: &'static str },
     #[error(transparent)]
@@ -347,8 +351,9 @@ impl Heat {
             let v = first.fixed[i].unwrap_or_else(|| initial(x));
             if !v.is_finite() {
                 return Err(HeatError::NonFinite {
-                    what: "initial value",
-                    location: x.to_vec(),
+                    datum: Datum::Initial,
+                    point: x.to_vec(),
+                    value: v,
                     time: t0,
                 });
             }
@@ -439,9 +444,8 @@ impl Heat {
                     })
                     .unwrap_or(0);
                 let i = free[k];
-                HeatError::NonFinite {
-                    what: "temperature",
-                    location: points[i * d..(i + 1) * d].to_vec(),
+                HeatError::Overflow {
+                    point: points[i * d..(i + 1) * d].to_vec(),
                     time: t,
                 }
             };
@@ -534,7 +538,7 @@ mod tests {
         assert!(matches!(
             heat(0.1, 1.0).run(&mesh, &*nan, 1, 1),
             Err(HeatError::NonFinite {
-                what: "initial value",
+                datum: Datum::Initial,
                 ..
             })
         ));
@@ -547,10 +551,10 @@ mod tests {
         })));
         assert!(matches!(
             bad_source.run(&mesh, &*one, 3, 1),
-            // The FE load reports a NaN source through its metric error.
-            Err(HeatError::Diffusion(
-                DiffusionError::NonFinite { .. } | DiffusionError::Metric(_)
-            ))
+            Err(HeatError::Diffusion(DiffusionError::NonFinite {
+                datum: Datum::Source,
+                ..
+            }))
         ));
         let hybrid = Heat::new(Method::FvMimetic, Conductivity::Scalar(one.clone()), 0.1);
         assert!(matches!(
@@ -576,12 +580,7 @@ mod tests {
                 levels.push(time);
             }
         });
-        let Err(HeatError::NonFinite {
-            what: "temperature",
-            time,
-            ..
-        }) = result
-        else {
+        let Err(HeatError::Overflow { time, .. }) = result else {
             panic!("expected a non-finite temperature, got {result:?}");
         };
         assert!(levels.len() >= 2 && time > *levels.last().unwrap());

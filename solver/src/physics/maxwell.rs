@@ -94,6 +94,24 @@ pub enum Mass {
     Whitney,
 }
 
+impl Mass {
+    /// Every mass, in the order help texts list them.
+    pub const ALL: [Mass; 2] = [Mass::Hodge, Mass::Whitney];
+
+    /// The name case files use (`problem.mass`).
+    ///
+    /// ```
+    /// use hasse_solver::physics::maxwell::Mass;
+    /// assert_eq!(Mass::ALL.map(|m| m.name()), ["hodge", "whitney"]);
+    /// ```
+    pub fn name(&self) -> &'static str {
+        match self {
+            Mass::Hodge => "hodge",
+            Mass::Whitney => "whitney",
+        }
+    }
+}
+
 /// The cavity operators on one complex, ready to give modes.
 ///
 /// ```

@@ -52,6 +52,74 @@ pub struct BoundaryCondition {
     pub kind: BoundaryKind,
 }
 
+/// Which input of a problem a value came from, so that an error about
+/// the value can point back to where the input gave it (a front end maps
+/// a datum to its key in a case file).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Datum {
+    /// The source f.
+    Source,
+    /// The coefficient K (conductivity, permeability).
+    Coefficient,
+    /// The initial value of a transient problem.
+    Initial,
+    /// The value of boundary condition `condition` (its index among the
+    /// problem's conditions, in the order they were given), of `kind`
+    /// Dirichlet, Neumann or Robin.
+    BoundaryValue {
+        condition: usize,
+        kind: &'static str,
+    },
+    /// The Robin α of boundary condition `condition`.
+    RobinAlpha { condition: usize },
+    /// A named parameter: a material constant (λ, μ, E, ν) or a reaction
+    /// coefficient (a, b, c).
+    Parameter(&'static str),
+    /// The body force of elasticity.
+    BodyForce,
+}
+
+impl std::fmt::Display for Datum {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Datum::Source => f.write_str("the source"),
+            Datum::Coefficient => f.write_str("the coefficient K"),
+            Datum::Initial => f.write_str("the initial value"),
+            Datum::BoundaryValue { condition, kind } => {
+                write!(f, "the {kind} value of boundary condition {condition}")
+            }
+            Datum::RobinAlpha { condition } => {
+                write!(f, "the Robin α of boundary condition {condition}")
+            }
+            Datum::Parameter(name) => write!(f, "the parameter {name}"),
+            Datum::BodyForce => f.write_str("the body force"),
+        }
+    }
+}
+
+/// A point written as `(x, y, z)` with its coordinates' shortest
+/// round-trip digits, for messages.
+///
+/// ```
+/// use hasse_solver::physics::point_text;
+/// assert_eq!(point_text(&[0.375, 0.125]), "(0.375, 0.125)");
+/// ```
+pub fn point_text(x: &[f64]) -> String {
+    let coordinates: Vec<String> = x.iter().map(|v| format!("{v}")).collect();
+    format!("({})", coordinates.join(", "))
+}
+
+/// `value`'s kind of non-finiteness: NaN, ∞ or −∞.
+pub(crate) fn non_finite_text(value: f64) -> &'static str {
+    if value.is_nan() {
+        "NaN"
+    } else if value > 0.0 {
+        "∞"
+    } else {
+        "−∞"
+    }
+}
+
 /// Why the faces of a boundary tag could not be found.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum TagError {

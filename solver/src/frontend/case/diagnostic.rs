@@ -13,6 +13,10 @@ pub struct Diagnostic {
     pub line: usize,
     /// 1-based column (in characters).
     pub column: usize,
+    /// The `--set KEY=VALUE` text that gave the key its value, when it
+    /// came from the command line: messages then point there instead of
+    /// at a line of the file.
+    pub set: Option<String>,
     /// The dotted key, e.g. `boundary[1].value`; empty for file-level problems.
     pub key: String,
     pub message: String,
@@ -22,7 +26,9 @@ pub struct Diagnostic {
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.line > 0 {
+        if let Some(set) = &self.set {
+            write!(f, "{}: --set {set}: ", self.file)?;
+        } else if self.line > 0 {
             write!(f, "{}:{}:{}: ", self.file, self.line, self.column)?;
         } else {
             write!(f, "{}: ", self.file)?;
@@ -78,6 +84,13 @@ pub struct Collector {
     file: String,
     text: String,
     line_starts: Vec<usize>,
+    /// Keys set with `--set` (`problem.method`, `boundary[0].value`) and
+    /// the assignment as given: a diagnostic about such a key, or a key
+    /// under it, names the assignment.
+    overrides: Vec<(String, String)>,
+    /// The span of every key the reader looked up, by its dotted name
+    /// (filled while reading, through a shared reference).
+    spans: std::cell::RefCell<std::collections::BTreeMap<String, Range<usize>>>,
     pub diagnostics: Vec<Diagnostic>,
 }
 
@@ -90,7 +103,69 @@ impl Collector {
             file: file.to_string(),
             text: text.to_string(),
             line_starts,
+            overrides: Vec::new(),
+            spans: Default::default(),
             diagnostics: Vec::new(),
+        }
+    }
+
+    /// The same collector with the `--set` keys and texts of `overrides`.
+    pub(crate) fn with_overrides(mut self, overrides: Vec<(String, String)>) -> Self {
+        self.overrides = overrides;
+        self
+    }
+
+    /// Remember where key `key` is written.
+    pub(crate) fn record(&self, key: &str, span: Option<Range<usize>>) {
+        if let Some(span) = span {
+            self.spans
+                .borrow_mut()
+                .entry(key.to_string())
+                .or_insert(span);
+        }
+    }
+
+    /// Where key `key` is written, if the reader saw it.
+    pub(crate) fn span_of(&self, key: &str) -> Option<Range<usize>> {
+        self.spans.borrow().get(key).cloned()
+    }
+
+    /// The `--set` assignment that gave `key` (or a table above it) its
+    /// value.
+    fn set_text(&self, key: &str) -> Option<String> {
+        self.overrides.iter().find_map(|(set, text)| {
+            let under = key == set
+                || key
+                    .strip_prefix(set.as_str())
+                    .is_some_and(|rest| rest.starts_with('.') || rest.starts_with('['));
+            under.then(|| text.clone())
+        })
+    }
+
+    /// A diagnostic about `key` at `span`, or where the reader saw the key
+    /// when `span` is `None` (no position when it saw neither), or at the
+    /// `--set` text that gave it.
+    pub(crate) fn diagnostic(
+        &self,
+        span: Option<Range<usize>>,
+        key: &str,
+        message: impl Into<String>,
+        help: Option<String>,
+    ) -> Diagnostic {
+        let set = self.set_text(key);
+        let span = span.or_else(|| self.span_of(key));
+        let (line, column) = match (&set, span) {
+            (None, Some(s)) => self.position(s.start),
+            _ => (0, 0),
+        };
+        Diagnostic {
+            file: self.file.clone(),
+            line,
+            column,
+            set,
+            key: key.to_string(),
+            message: message.into(),
+            help,
         }
     }
 
@@ -116,15 +191,8 @@ impl Collector {
         message: impl Into<String>,
         help: Option<String>,
     ) {
-        let (line, column) = span.map_or((0, 0), |s| self.position(s.start));
-        self.diagnostics.push(Diagnostic {
-            file: self.file.clone(),
-            line,
-            column,
-            key: key.to_string(),
-            message: message.into(),
-            help,
-        });
+        let diagnostic = self.diagnostic(span, key, message, help);
+        self.diagnostics.push(diagnostic);
     }
 }
 

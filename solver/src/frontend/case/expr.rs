@@ -67,7 +67,8 @@ pub const COORDINATES: [&str; 4] = ["x", "y", "z", "t"];
 /// Why an expression or a name was refused.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ExprError {
-    /// The text is not an expression.
+    /// The text is not an expression; `message` says why in the case
+    /// file's terms (never the parser's internals).
     #[error("cannot parse `{text}`: {message}")]
     Syntax { text: String, message: String },
     /// The expression uses a name that is neither a coordinate, a constant
@@ -245,9 +246,9 @@ impl Scope {
 
     /// Parse `text` against this scope.
     pub fn parse(&self, text: &str) -> Result<Expression, ExprError> {
-        let flat = Flat::parse(text).map_err(|e| ExprError::Syntax {
+        let flat = Flat::parse(text).map_err(|_| ExprError::Syntax {
             text: text.to_string(),
-            message: e.msg().to_string(),
+            message: syntax_problem(text, &self.names()),
         })?;
         let mut slots = Vec::with_capacity(flat.var_names().len());
         let mut constant = true;
@@ -285,6 +286,93 @@ impl Scope {
             uses_time,
         })
     }
+}
+
+/// What is wrong with `text`, which the parser refused, in the terms of a
+/// case file: the parser's own messages describe its internals ("we have
+/// 1 ops and 4 node"), so the text is examined here instead. `names` are
+/// the variables the expression could use.
+fn syntax_problem(text: &str, names: &[String]) -> String {
+    let trimmed = text.trim();
+    if trimmed.is_empty() {
+        return "the expression is empty".into();
+    }
+    // Brackets first: an unclosed one confuses every other reading.
+    let mut depth = 0i32;
+    for c in trimmed.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' if depth == 0 => return "a `)` closes no `(`".into(),
+            ')' => depth -= 1,
+            _ => {}
+        }
+    }
+    if depth > 0 {
+        return format!(
+            "{depth} `(` never closed: add the missing `)`{}",
+            if depth > 1 { "s" } else { "" }
+        );
+    }
+    // A number followed by a word: a unit (`5 W/m`), or a product written
+    // without `*` (`2x`).
+    let number_end = trimmed
+        .char_indices()
+        .find(|&(i, c)| {
+            !(c.is_ascii_digit()
+                || c == '.'
+                || (i == 0 && (c == '-' || c == '+'))
+                || ((c == 'e' || c == 'E')
+                    && trimmed[i + c.len_utf8()..]
+                        .chars()
+                        .next()
+                        .is_some_and(|d| d.is_ascii_digit() || d == '-' || d == '+')))
+        })
+        .map_or(trimmed.len(), |(i, _)| i);
+    let number = &trimmed[..number_end];
+    let rest = trimmed[number_end..].trim();
+    if number.parse::<f64>().is_ok() && !rest.is_empty() {
+        let word: String = rest
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        if !word.is_empty() && names.iter().any(|n| *n == word) {
+            return format!("`{number}{word}` is a product without `*`: write `{number}*{word}`");
+        }
+        if rest.starts_with(|c: char| c.is_alphabetic() || "µ°%Ω".contains(c)) {
+            return format!(
+                "`{trimmed}` looks like a number with a unit, but hasse has no units: write the number alone ({number}) in the units used throughout the case"
+            );
+        }
+    }
+    if let Some(c) = trimmed.chars().find(|c| "²³·×÷−".contains(*c)) {
+        let instead = match c {
+            '²' => "^2",
+            '³' => "^3",
+            '·' | '×' => "*",
+            '÷' => "/",
+            _ => "-",
+        };
+        return format!("`{c}` is not an operator here: write `{instead}`");
+    }
+    if trimmed.contains("**") {
+        return "`**` is not an operator here: write powers as x^2".into();
+    }
+    if trimmed.ends_with(['+', '-', '*', '/', '^', ',']) {
+        return "it ends with an operator: something is missing after it".into();
+    }
+    if trimmed.starts_with(['*', '/', '^', ',']) {
+        return "it starts with an operator: something is missing before it".into();
+    }
+    // Two operands side by side: `2 3`, `x y`, `x (y)`.
+    let tokens: Vec<&str> = trimmed.split_whitespace().collect();
+    let operand = |t: &str| {
+        t.chars()
+            .all(|c| c.is_alphanumeric() || c == '.' || c == '_')
+    };
+    if tokens.windows(2).any(|w| operand(w[0]) && operand(w[1])) {
+        return "two values stand side by side without an operator between them (products need `*`)".into();
+    }
+    "it is not a valid expression".into()
 }
 
 /// The candidate closest to `word`, if it is close enough to be a likely
@@ -352,6 +440,37 @@ mod tests {
             scope.parse("sin(x"),
             Err(ExprError::Syntax { .. })
         ));
+    }
+
+    #[test]
+    fn syntax_errors_are_told_in_the_case_files_terms() {
+        // Each malformed text and the words its message must contain; the
+        // parser's own wording ("ops", "node") must never reach the user.
+        let scope = Scope::new();
+        let cases = [
+            ("sin(pi*x", "`(` never closed"),
+            ("x)", "a `)` closes no `(`"),
+            ("5 W/m", "hasse has no units: write the number alone (5)"),
+            ("20 degC", "hasse has no units"),
+            ("1.5e3 Pa", "write the number alone (1.5e3)"),
+            ("2x", "write `2*x`"),
+            ("x²", "write `^2`"),
+            ("x ** 2", "write powers as x^2"),
+            ("x +", "ends with an operator"),
+            ("2 3", "side by side"),
+            ("   ", "empty"),
+        ];
+        for (text, says) in cases {
+            let Err(error) = scope.parse(text) else {
+                panic!("`{text}` parsed");
+            };
+            let message = error.to_string();
+            assert!(message.contains(says), "`{text}`: {message}");
+            assert!(
+                !message.contains(" ops ") && !message.contains("node"),
+                "`{text}`: {message}"
+            );
+        }
     }
 
     #[test]

@@ -304,6 +304,28 @@ impl Problem {
             | Problem::Coupled(_) => None,
         }
     }
+
+    /// Every coefficient K of the problem with its key: the conductivity
+    /// or permeability, or each field's conductivity.
+    pub fn coefficients(&self) -> Vec<(String, &Coefficient)> {
+        match self {
+            Problem::Diffusion(d) => vec![("problem.conductivity".into(), &d.conductivity)],
+            Problem::Heat(h) => vec![("problem.conductivity".into(), &h.conductivity)],
+            Problem::Darcy(d) => vec![("problem.permeability".into(), &d.permeability)],
+            Problem::Coupled(c) => c
+                .fields
+                .iter()
+                .enumerate()
+                .map(|(i, f)| {
+                    (
+                        format!("field[{i}].conductivity"),
+                        &f.diffusion.conductivity,
+                    )
+                })
+                .collect(),
+            Problem::Gradient(_) | Problem::Maxwell(_) | Problem::Elasticity(_) => Vec::new(),
+        }
+    }
 }
 
 /// The exact solution, when known.
@@ -428,8 +450,8 @@ impl Case {
     /// Read a case from text; `file` names it in messages and anchors
     /// relative paths (mesh files, metric files).
     pub fn from_text(file: &str, text: &str, overrides: &[String]) -> Result<Case, Diagnostics> {
-        let text = reader::apply_overrides(file, text, overrides)?;
-        Reader::read(file, &text)
+        let (text, overridden) = reader::apply_overrides(file, text, overrides)?;
+        Reader::read(file, &text, overridden)
     }
 
     /// Build the mesh and check the boundary tags against it; problems are
@@ -498,12 +520,15 @@ impl Case {
                     Some(_) => {}
                 }
             }
-            if let Some(Coefficient::Tensor(rows)) = self.problem.coefficient() {
+            for (key, coefficient) in self.problem.coefficients() {
+                let Coefficient::Tensor(rows) = coefficient else {
+                    continue;
+                };
                 let d = complex.embedding_dim();
                 if rows.len() != d {
                     collector.error(
-                        self.mesh_spans.get("@conductivity").cloned(),
-                        "problem.conductivity",
+                        None,
+                        &key,
                         format!(
                             "a {}×{} tensor, but the mesh lives in {d} dimensions",
                             rows.len(),
@@ -519,6 +544,19 @@ impl Case {
         } else {
             Err(Diagnostics(collector.diagnostics))
         }
+    }
+
+    /// A diagnostic about key `key` (e.g. `problem.source`,
+    /// `boundary[1].value`) of this case: at the line and column where the
+    /// key is written, or at the `--set` text that gave it, or at the file
+    /// when the case does not write the key (a default).
+    pub fn diagnostic(
+        &self,
+        key: &str,
+        message: impl Into<String>,
+        help: Option<String>,
+    ) -> Diagnostic {
+        self.collector.diagnostic(None, key, message, help)
     }
 
     /// The method of a diffusion or heat problem.

@@ -2,7 +2,9 @@
 //! diffusion operators and the reaction blocks as one block system; each
 //! field is written on its own cells and compared with its exact field.
 
-use super::{diffusion_problem, field_points, scalar_fn, RunError, RunResult};
+use super::{
+    diffusion_error, diffusion_problem, field_points, scalar_fn, Keys, RunError, RunResult,
+};
 use crate::frontend::case::{Case, CoupledSpec};
 use crate::frontend::output::Cochain;
 use crate::metric::mass::lumped_vertex_volumes;
@@ -11,13 +13,34 @@ use crate::physics::coupled::{Coupled, CoupledError, CoupledField, Reaction};
 use hasse_complex::Complex;
 use std::time::Instant;
 
-fn run_error(e: CoupledError) -> RunError {
-    match e {
-        CoupledError::Factorization { .. } | CoupledError::Solve(_) => RunError::Solve(format!(
-            "{e} (check solver.factorization and the coupling b: LLᵀ needs a c > b²)"
-        )),
-        other => RunError::Input(other.to_string()),
-    }
+fn run_error(case: &Case, spec: &CoupledSpec, e: CoupledError) -> RunError {
+    let message = e.to_string();
+    let located = match &e {
+        CoupledError::Factorization { .. } | CoupledError::Solve(_) => RunError::solve(
+            case,
+            message,
+            Some("check solver.factorization and the coupling b: LLᵀ needs a c > b²".into()),
+        ),
+        CoupledError::Field { name, source } => {
+            let Some(i) = spec.fields.iter().position(|f| &f.name == name) else {
+                return RunError::input(case, message).because(e);
+            };
+            let keys = Keys {
+                prefix: format!("field[{i}]"),
+                coefficient: "conductivity",
+                boundary: &spec.fields[i].diffusion.boundary,
+            };
+            return diffusion_error(case, &keys, source.clone()).because(e);
+        }
+        CoupledError::NonFinite { what, .. } => RunError::input_at(
+            case,
+            &format!("problem.{what}"),
+            message,
+            Some(super::FINITE_HELP.into()),
+        ),
+        _ => RunError::input(case, message),
+    };
+    located.because(e)
 }
 
 pub(super) fn solve(
@@ -44,7 +67,9 @@ pub(super) fn solve(
     }
     phase("assembling the block system and solving");
     let started = Instant::now();
-    let solution = problem.solve(complex).map_err(run_error)?;
+    let solution = problem
+        .solve(complex)
+        .map_err(|e| run_error(case, spec, e))?;
     let total = started.elapsed().as_secs_f64();
     let dim = match solution.location {
         Location::Nodal => 0,
@@ -107,4 +132,20 @@ pub(super) fn solve(
         notes,
         report,
     })
+}
+
+/// Each field's conductivity and source evaluated where the solve
+/// evaluates them, without solving.
+pub(super) fn check(case: &Case, spec: &CoupledSpec, complex: &Complex) -> Result<(), RunError> {
+    for (i, field) in spec.fields.iter().enumerate() {
+        let keys = Keys {
+            prefix: format!("field[{i}]"),
+            coefficient: "conductivity",
+            boundary: &field.diffusion.boundary,
+        };
+        diffusion_problem(case, &field.diffusion)
+            .check_data(complex)
+            .map_err(|e| diffusion_error(case, &keys, e))?;
+    }
+    Ok(())
 }

@@ -6,21 +6,13 @@
 use super::{check_residual, RunError, RunResult};
 use crate::frontend::case::{BoundaryKindSpec, Case, Coefficient, DarcySpec};
 use crate::frontend::output::Cochain;
-use crate::metric::fv::FluxMass;
-use crate::metric::Tensor;
+use crate::metric::{MetricError, Tensor};
 use crate::physics::darcy::{self, BoundaryConditions, DarcyError, DarcySolution};
 use crate::physics::diffusion::Errors;
+use crate::physics::{non_finite_text, point_text};
 use hasse_complex::Complex;
 use std::collections::BTreeMap;
 use std::time::Instant;
-
-fn method_name(mass: FluxMass) -> &'static str {
-    match mass {
-        FluxMass::Mimetic => "mimetic",
-        FluxMass::Dec(hasse_complex::DualKind::Circumcentric) => "dec",
-        FluxMass::Dec(hasse_complex::DualKind::Barycentric) => "dec-barycentric",
-    }
-}
 
 /// K at `x` (a scalar is K I in the first `d` dimensions).
 fn tensor_at(coefficient: &Coefficient, x: &[f64], d: usize) -> Tensor {
@@ -44,17 +36,28 @@ fn tensor_at(coefficient: &Coefficient, x: &[f64], d: usize) -> Tensor {
 }
 
 /// K at every top-cell centroid.
-fn tensors(coefficient: &Coefficient, complex: &Complex) -> Result<Vec<Tensor>, RunError> {
+fn tensors(
+    case: &Case,
+    coefficient: &Coefficient,
+    complex: &Complex,
+) -> Result<Vec<Tensor>, RunError> {
     let n = complex.dim();
     let d = complex.embedding_dim();
     let mut out = Vec::with_capacity(complex.cell_count(n));
     for c in 0..complex.cell_count(n) {
         let x = complex.centroid_of(n, c);
         let t = tensor_at(coefficient, x, d);
-        if let Some(bad) = t.iter().flatten().find(|v| !v.is_finite()) {
-            return Err(RunError::Input(format!(
-                "problem.permeability is not finite ({bad}) at cell {c}, centroid {x:?}"
-            )));
+        if let Some(&bad) = t.iter().flatten().find(|v| !v.is_finite()) {
+            return Err(RunError::input_at(
+                case,
+                "problem.permeability",
+                format!(
+                    "the permeability is not finite ({}) at {} (centroid of top cell {c})",
+                    non_finite_text(bad),
+                    point_text(x)
+                ),
+                Some(super::FINITE_HELP.into()),
+            ));
         }
         out.push(t);
     }
@@ -63,25 +66,37 @@ fn tensors(coefficient: &Coefficient, complex: &Complex) -> Result<Vec<Tensor>, 
 
 /// Face conditions from the tagged boundary conditions, later ones
 /// replacing earlier ones on shared faces (as for diffusion).
-fn conditions(spec: &DarcySpec, complex: &Complex) -> Result<BoundaryConditions, RunError> {
+fn conditions(
+    case: &Case,
+    spec: &DarcySpec,
+    complex: &Complex,
+) -> Result<BoundaryConditions, RunError> {
     let n = complex.dim();
     let on_boundary: std::collections::BTreeSet<usize> =
         darcy::boundary_faces(complex).into_iter().collect();
     let mut by_face: BTreeMap<usize, (bool, f64)> = BTreeMap::new();
     for b in &spec.boundary {
         // Tags were checked against the mesh when it was built.
+        let tag_key = format!("{}.tag", b.key);
         let Some(tag) = complex.tag(&b.tag) else {
-            return Err(RunError::Input(format!(
-                "{}.tag: no tag `{}` in the mesh",
-                b.key, b.tag
-            )));
+            return Err(RunError::input_at(
+                case,
+                &tag_key,
+                format!("no tag `{}` in the mesh", b.tag),
+                None,
+            ));
         };
         for &face in &tag.cells {
             if !on_boundary.contains(&face) {
-                return Err(RunError::Input(format!(
-                    "{}.tag: tag `{}` contains face {face}, which is interior (it lies on two cells); Darcy conditions go on boundary faces",
-                    b.key, b.tag
-                )));
+                return Err(RunError::input_at(
+                    case,
+                    &tag_key,
+                    format!(
+                        "tag `{}` contains face {face}, which is interior (it lies on two cells)",
+                        b.tag
+                    ),
+                    Some("Darcy conditions go on boundary faces".into()),
+                ));
             }
             let x = complex.centroid_of(n - 1, face);
             let (is_pressure, value) = match &b.kind {
@@ -90,17 +105,25 @@ fn conditions(spec: &DarcySpec, complex: &Complex) -> Result<BoundaryConditions,
                     (false, u.eval(x, 0.0) * complex.measure(n - 1)[face])
                 }
                 BoundaryKindSpec::Robin { .. } => {
-                    return Err(RunError::Input(format!(
-                        "{}.type: a Darcy boundary is \"pressure\" or \"flux\"",
-                        b.key
-                    )))
+                    return Err(RunError::input_at(
+                        case,
+                        &format!("{}.type", b.key),
+                        "a Darcy boundary is \"pressure\" or \"flux\"",
+                        None,
+                    ))
                 }
             };
             if !value.is_finite() {
-                return Err(RunError::Input(format!(
-                    "{}.value is not finite at face {face}, centroid {x:?}",
-                    b.key
-                )));
+                return Err(RunError::input_at(
+                    case,
+                    &format!("{}.value", b.key),
+                    format!(
+                        "the boundary value is not finite ({}) at {} (centroid of face {face})",
+                        non_finite_text(value),
+                        point_text(x)
+                    ),
+                    Some(super::FINITE_HELP.into()),
+                ));
             }
             by_face.insert(face, (is_pressure, value));
         }
@@ -116,15 +139,46 @@ fn conditions(spec: &DarcySpec, complex: &Complex) -> Result<BoundaryConditions,
     Ok(bc)
 }
 
-fn run_error(e: DarcyError) -> RunError {
-    match e {
-        DarcyError::Solve(_) => RunError::Solve(e.to_string()),
-        DarcyError::Metric(m) => RunError::Input(format!("problem.permeability: {m}")),
-        DarcyError::Incompatible { .. } => RunError::Input(format!(
-            "{e}; add a \"pressure\" boundary or make problem.source balance the boundary fluxes"
-        )),
-        other => RunError::Input(other.to_string()),
-    }
+/// The source integral of top cell `c` is `value`, not finite.
+fn source_error(case: &Case, complex: &Complex, c: usize, value: f64) -> RunError {
+    RunError::input_at(
+        case,
+        "problem.source",
+        format!(
+            "the source is not finite ({}) at {} (centroid of top cell {c})",
+            non_finite_text(value),
+            point_text(complex.centroid_of(complex.dim(), c))
+        ),
+        Some(super::FINITE_HELP.into()),
+    )
+}
+
+fn run_error(case: &Case, e: DarcyError) -> RunError {
+    let message = e.to_string();
+    let located = match &e {
+        DarcyError::Solve(_) | DarcyError::Canonical(_) | DarcyError::Block(_) => {
+            RunError::solve(case, message, None)
+        }
+        DarcyError::Metric(MetricError::NotPositive { .. } | MetricError::NonFinite { .. }) => {
+            RunError::input_at(
+                case,
+                "problem.permeability",
+                message,
+                Some("the permeability must be finite and positive (a tensor: symmetric positive definite) in every cell".into()),
+            )
+        }
+        DarcyError::Metric(_) | DarcyError::NotVolume { .. } => {
+            RunError::input_at(case, "problem.method", message, None)
+        }
+        DarcyError::Incompatible { .. } => RunError::input_at(
+            case,
+            "problem.source",
+            message,
+            Some("add a \"pressure\" boundary or make problem.source balance the boundary fluxes".into()),
+        ),
+        _ => RunError::input(case, message),
+    };
+    located.because(e)
 }
 
 pub(super) fn solve(
@@ -136,30 +190,32 @@ pub(super) fn solve(
     let n = complex.dim();
     let d = complex.embedding_dim();
     if n == 0 || n != d {
-        return Err(RunError::Input(format!(
-            "mixed Darcy needs a mesh that fills its space; this one is {n}-dimensional in R^{d}"
-        )));
+        return Err(RunError::input_at(
+            case,
+            "mesh",
+            format!(
+                "mixed Darcy needs a mesh that fills its space; this one is {n}-dimensional in R^{d}"
+            ),
+            None,
+        ));
     }
     phase("assembling");
     let started = Instant::now();
-    let permeability = tensors(&spec.permeability, complex)?;
+    let permeability = tensors(case, &spec.permeability, complex)?;
     let source = darcy::cell_integrals(complex, |x| spec.source.eval(x, 0.0));
     if let Some(c) = source.iter().position(|v| !v.is_finite()) {
-        return Err(RunError::Input(format!(
-            "problem.source is not finite at cell {c}, centroid {:?}",
-            complex.centroid_of(n, c)
-        )));
+        return Err(source_error(case, complex, c, source[c]));
     }
-    let bc = conditions(spec, complex)?;
-    let system =
-        darcy::assemble(complex, &permeability, spec.mass, &source, &bc).map_err(run_error)?;
+    let bc = conditions(case, spec, complex)?;
+    let system = darcy::assemble(complex, &permeability, spec.mass, &source, &bc)
+        .map_err(|e| run_error(case, e))?;
     let assembly_seconds = started.elapsed().as_secs_f64();
     phase("solving the saddle point");
     let solution = match case.solver.factorization {
         None => system.solve_ldlt(),
         Some(kind) => system.solve(kind),
     }
-    .map_err(run_error)?;
+    .map_err(|e| run_error(case, e))?;
     let total = started.elapsed().as_secs_f64();
     let mut warnings = Vec::new();
     check_residual(case, solution.report.relative_residual, &mut warnings)?;
@@ -239,7 +295,7 @@ pub(super) fn solve(
     ];
     Ok(RunResult {
         problem: "darcy".into(),
-        method: Some(method_name(spec.mass).into()),
+        method: Some(spec.mass.to_string()),
         unknowns: solution.flux.len() + solution.pressure.len(),
         fields,
         errors,
@@ -314,4 +370,19 @@ fn flux_error(
         sum += w * (solution.flux[f] / area - exact).powi(2);
     }
     sum.sqrt()
+}
+
+/// The permeability, the source and the boundary values evaluated where
+/// the solve evaluates them, without solving.
+pub(super) fn check(case: &Case, spec: &DarcySpec, complex: &Complex) -> Result<(), RunError> {
+    let n = complex.dim();
+    if n == 0 || n != complex.embedding_dim() {
+        return Ok(());
+    }
+    tensors(case, &spec.permeability, complex)?;
+    let source = darcy::cell_integrals(complex, |x| spec.source.eval(x, 0.0));
+    if let Some(c) = source.iter().position(|v| !v.is_finite()) {
+        return Err(source_error(case, complex, c, source[c]));
+    }
+    conditions(case, spec, complex).map(|_| ())
 }

@@ -10,7 +10,7 @@ use crate::physics::diffusion::Errors;
 use crate::physics::elasticity::{
     Coefficient, ElasticBoundary, Elasticity, ElasticityError, Material,
 };
-use crate::physics::VectorFn;
+use crate::physics::{Datum, VectorFn};
 use hasse_complex::Complex;
 use std::time::Instant;
 
@@ -55,18 +55,68 @@ fn problem(case: &Case, spec: &ElasticitySpec) -> Elasticity {
     problem
 }
 
-fn run_error(e: ElasticityError) -> RunError {
-    match e {
-        ElasticityError::Solve(_) | ElasticityError::Canonical(_) => RunError::Solve(e.to_string()),
-        ElasticityError::Lame { .. }
-        | ElasticityError::Young { .. }
-        | ElasticityError::Poisson { .. }
-        | ElasticityError::NonFiniteMaterial { .. } => {
-            RunError::Input(format!("problem (material): {e}"))
+fn run_error(case: &Case, spec: &ElasticitySpec, e: ElasticityError) -> RunError {
+    let message = e.to_string();
+    let material = |name: &str| match (name, &spec.material) {
+        ("λ", _) => "problem.lambda",
+        ("μ", _) => "problem.mu",
+        ("E", _) => "problem.young",
+        ("ν", _) => "problem.poisson",
+        (_, MaterialSpec::Lame { .. }) => "problem.lambda",
+        (_, MaterialSpec::Young { .. }) => "problem.young",
+    };
+    let help = Some(super::FINITE_HELP.to_string());
+    let located = match &e {
+        ElasticityError::Solve(_) | ElasticityError::Canonical(_) => {
+            RunError::solve(case, message, None)
         }
-        ElasticityError::RigidModes { .. } => RunError::Input(format!("boundary: {e}")),
-        other => RunError::Input(other.to_string()),
-    }
+        ElasticityError::NonFiniteMaterial { what, .. } => {
+            RunError::input_at(case, material(what), message, help)
+        }
+        ElasticityError::Lame { mu, .. } => RunError::input_at(
+            case,
+            if *mu <= 0.0 {
+                "problem.mu"
+            } else {
+                "problem.lambda"
+            },
+            message,
+            None,
+        ),
+        ElasticityError::Young { .. } => RunError::input_at(case, "problem.young", message, None),
+        ElasticityError::Poisson { .. } => {
+            RunError::input_at(case, "problem.poisson", message, None)
+        }
+        ElasticityError::NonFinite { datum, .. } => {
+            let key = match datum {
+                Datum::BoundaryValue { condition, .. } => spec
+                    .boundary
+                    .get(*condition)
+                    .map_or_else(|| "boundary".into(), |b| format!("{}.value", b.key)),
+                _ => "problem.body_force".into(),
+            };
+            RunError::input_at(case, &key, message, help)
+        }
+        ElasticityError::Component { tag, .. } => {
+            let key = spec
+                .boundary
+                .iter()
+                .find(|b| &b.tag == tag)
+                .map_or_else(|| "boundary".into(), |b| format!("{}.component", b.key));
+            RunError::input_at(case, &key, message, None)
+        }
+        ElasticityError::RigidModes { .. } => RunError::input_at(
+            case,
+            "boundary",
+            message,
+            Some(
+                "prescribe the displacement on enough of the boundary to hold every rigid motion"
+                    .into(),
+            ),
+        ),
+        _ => RunError::input(case, message),
+    };
+    located.because(e)
 }
 
 pub(super) fn solve(
@@ -79,7 +129,9 @@ pub(super) fn solve(
     let elasticity = problem(case, spec);
     phase("assembling and solving");
     let started = Instant::now();
-    let u = elasticity.solve(complex).map_err(run_error)?;
+    let u = elasticity
+        .solve(complex)
+        .map_err(|e| run_error(case, spec, e))?;
     let total = started.elapsed().as_secs_f64();
     let mut warnings = Vec::new();
     check_residual(case, u.report.relative_residual, &mut warnings)?;
@@ -92,10 +144,15 @@ pub(super) fn solve(
         .collect();
     let errors = match case.exact.as_ref().and_then(|e| e.displacement.as_ref()) {
         Some(exact) if exact.len() < d => {
-            return Err(RunError::Input(format!(
-                "exact.displacement has {} components; the mesh lives in {d} dimensions",
-                exact.len()
-            )))
+            return Err(RunError::input_at(
+                case,
+                "exact.displacement",
+                format!(
+                    "{} components, but the mesh lives in {d} dimensions",
+                    exact.len()
+                ),
+                Some(format!("give {d} expressions, one per coordinate")),
+            ))
         }
         Some(exact) => {
             let exact_fn = vector_fn(exact);
@@ -146,4 +203,12 @@ pub(super) fn solve(
         notes: Vec::new(),
         report: serde_json::Map::new(),
     })
+}
+
+/// The material and the body force evaluated where the solve evaluates
+/// them, without solving.
+pub(super) fn check(case: &Case, spec: &ElasticitySpec, complex: &Complex) -> Result<(), RunError> {
+    problem(case, spec)
+        .check_data(complex)
+        .map_err(|e| run_error(case, spec, e))
 }

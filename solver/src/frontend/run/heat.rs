@@ -2,7 +2,7 @@
 //! the case's mesh, the temperature written at every saved level, errors
 //! against an exact u(x, t) at each of them.
 
-use super::{conductivity, scalar_fn, LevelStream, RunError, RunResult};
+use super::{conductivity, diffusion_error, scalar_fn, Keys, LevelStream, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{BoundaryKindSpec, Case, HeatSpec};
 use crate::frontend::output::Cochain;
@@ -47,37 +47,33 @@ fn heat_problem(case: &Case, spec: &HeatSpec) -> Heat {
     heat
 }
 
-fn run_error(e: HeatError, theta: f64) -> RunError {
-    match e {
-        HeatError::NonFinite {
-            what: "temperature",
-            location,
-            time,
-        } => RunError::Solve(unstable(&format!("at {location:?}"), time, theta)),
-        HeatError::Solve(e) => RunError::Solve(format!(
-            "factorising M/Δt + θK: {e} (the matrix is symmetric positive definite for θ > 0 with K ≥ 0; check solver.factorization)"
-        )),
-        HeatError::Diffusion(ref d)
-            if matches!(
-                d,
-                crate::physics::diffusion::DiffusionError::Solve(_)
-                    | crate::physics::diffusion::DiffusionError::Canonical(_)
-            ) =>
-        {
-            RunError::Solve(e.to_string())
-        }
-        HeatError::TimeStep { .. } => RunError::Input(format!("time.dt: {e}")),
-        HeatError::Theta { .. } => RunError::Input(format!("time.theta: {e}")),
-        HeatError::StartTime { .. } => RunError::Input(format!("time.start: {e}")),
-        other => RunError::Input(other.to_string()),
-    }
-}
-
-/// An explicit-leaning θ < ½ with too large a step grows without bound.
-fn unstable(place: &str, t: f64, theta: f64) -> String {
-    format!(
-        "the temperature is not finite {place} at t = {t}: the θ-scheme with θ = {theta} is only conditionally stable; use θ ≥ 0.5 or a smaller time.dt"
-    )
+fn run_error(case: &Case, spec: &HeatSpec, e: HeatError) -> RunError {
+    let keys = Keys {
+        prefix: "problem".into(),
+        coefficient: "conductivity",
+        boundary: &spec.boundary,
+    };
+    let message = e.to_string();
+    let located = match e {
+        HeatError::Diffusion(d) => return diffusion_error(case, &keys, d),
+        HeatError::NonFinite { datum, .. } => RunError::input_at(
+            case,
+            &keys.of(datum),
+            message,
+            Some(super::FINITE_HELP.into()),
+        ),
+        HeatError::TimeStep { .. } => RunError::input_at(case, "time.dt", message, None),
+        HeatError::Theta { .. } => RunError::input_at(case, "time.theta", message, None),
+        HeatError::StartTime { .. } => RunError::input_at(case, "time.start", message, None),
+        HeatError::Unsupported { .. } => RunError::input_at(case, "problem.method", message, None),
+        HeatError::Overflow { .. } => RunError::solve(case, message, None),
+        HeatError::Solve(_) | HeatError::Canonical(_) => RunError::solve(
+            case,
+            format!("factorising M/Δt + θK: {message}"),
+            Some("the matrix is symmetric positive definite for θ > 0 with K ≥ 0; check solver.factorization".into()),
+        ),
+    };
+    located.because(e)
 }
 
 pub(super) fn solve(
@@ -177,15 +173,18 @@ pub(super) fn solve_streaming<'a>(
                 }
             },
         )
-        .map_err(|e| run_error(e, time.theta))?;
+        .map_err(|e| run_error(case, spec, e))?;
     let total = started.elapsed().as_secs_f64();
     for (t, field) in history.times.iter().zip(&history.fields) {
         if let Some(i) = field.iter().position(|v| !v.is_finite()) {
-            return Err(RunError::Solve(unstable(
-                &format!("at unknown {i}"),
-                *t,
-                time.theta,
-            )));
+            return Err(RunError::solve(
+                case,
+                format!(
+                    "the temperature is not finite at unknown {i} at t = {t}: the θ-scheme with θ = {} is only conditionally stable",
+                    time.theta
+                ),
+                Some("use θ ≥ 0.5 or a smaller time.dt".into()),
+            ));
         }
     }
 
@@ -272,4 +271,18 @@ fn time_json(spec: &HeatSpec, history: &History) -> serde_json::Value {
         "seconds_per_step": history.seconds_per_step,
         "solve_seconds_per_step": history.solve_seconds_per_step,
     })
+}
+
+/// The conductivity and the source at t₀ evaluated where the solve
+/// evaluates them, without solving.
+pub(super) fn check(case: &Case, spec: &HeatSpec, complex: &Complex) -> Result<(), RunError> {
+    let keys = Keys {
+        prefix: "problem".into(),
+        coefficient: "conductivity",
+        boundary: &spec.boundary,
+    };
+    heat_problem(case, spec)
+        .at(spec.time.start)
+        .check_data(complex)
+        .map_err(|e| diffusion_error(case, &keys, e))
 }

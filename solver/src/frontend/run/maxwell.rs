@@ -6,30 +6,32 @@ use super::{RunError, RunResult};
 use crate::frontend::case::{Case, MaxwellSpec};
 use crate::frontend::output::Cochain;
 use crate::la::eigen::EigenError;
+use crate::metric::Method;
 use crate::physics::maxwell::{Cavity, Mass, MaxwellError};
-use hasse_complex::{Complex, DualKind};
+use hasse_complex::Complex;
 use std::time::Instant;
 
 fn method_name(spec: &MaxwellSpec) -> String {
-    let dual = match spec.dual {
-        DualKind::Circumcentric => "dec",
-        DualKind::Barycentric => "dec-barycentric",
-    };
+    let dual = Method::Dec(spec.dual).name();
     match spec.mass {
         Mass::Hodge => dual.to_string(),
-        Mass::Whitney => format!("{dual}, whitney mass"),
+        Mass::Whitney => format!("{dual}, {} mass", Mass::Whitney.name()),
     }
 }
 
-fn run_error(e: MaxwellError) -> RunError {
-    match e {
+fn run_error(case: &Case, e: MaxwellError) -> RunError {
+    let message = e.to_string();
+    let located = match &e {
         MaxwellError::Eigen(EigenError::NotConverged { .. })
         | MaxwellError::Eigen(EigenError::Solve(_))
         | MaxwellError::Eigen(EigenError::Dense(_))
-        | MaxwellError::DependentGradients(_) => RunError::Solve(e.to_string()),
-        MaxwellError::NonPositiveStar { .. } => RunError::Input(format!("problem.method: {e}")),
-        other => RunError::Input(other.to_string()),
-    }
+        | MaxwellError::DependentGradients(_) => RunError::solve(case, message, None),
+        MaxwellError::NonPositiveStar { .. } => {
+            RunError::input_at(case, "problem.method", message, None)
+        }
+        _ => RunError::input(case, message),
+    };
+    located.because(e)
 }
 
 pub(super) fn solve(
@@ -40,22 +42,27 @@ pub(super) fn solve(
 ) -> Result<RunResult, RunError> {
     phase("assembling curl-curl and mass");
     let started = Instant::now();
-    let cavity = Cavity::new(complex, spec.dual, spec.mass).map_err(run_error)?;
+    let cavity = Cavity::new(complex, spec.dual, spec.mass).map_err(|e| run_error(case, e))?;
     let assembly_seconds = started.elapsed().as_secs_f64();
     let available = cavity.physical_count();
     if spec.modes > available {
-        return Err(RunError::Input(format!(
-            "problem.modes = {}, but this cavity has only {available} physical modes ({} interior edges minus {} gradients of interior vertices); ask for fewer or refine the mesh",
-            spec.modes,
-            cavity.unknowns(),
-            cavity.gradient_count()
-        )));
+        return Err(RunError::input_at(
+            case,
+            "problem.modes",
+            format!(
+                "{} modes asked for, but this cavity has only {available} physical modes ({} interior edges minus {} gradients of interior vertices)",
+                spec.modes,
+                cavity.unknowns(),
+                cavity.gradient_count()
+            ),
+            Some("ask for fewer or refine the mesh".into()),
+        ));
     }
     phase("shift-invert eigensolve");
     let solving = Instant::now();
     let modes = cavity
         .modes(spec.modes, &cavity.default_options())
-        .map_err(run_error)?;
+        .map_err(|e| run_error(case, e))?;
     let solve_seconds = solving.elapsed().as_secs_f64();
     let exact: &[f64] = case.exact.as_ref().map_or(&[], |e| &e.eigenvalues);
     let mut warnings = Vec::new();

@@ -2,12 +2,15 @@
 //! problem ([`crate::refine`]), each level's fields for the output, and
 //! the run result of the finest level.
 
-use super::{diffusion_problem, field_points, scalar_fn, vector_fn, RunError, RunResult};
+use super::{
+    diffusion_error, diffusion_problem, field_points, scalar_fn, vector_fn, Keys, RunError,
+    RunResult,
+};
 use crate::frontend::case::{Case, Problem};
 use crate::frontend::output::Cochain;
 use crate::metric::Location;
 use crate::physics::diffusion::Solution;
-use crate::refine::{refine_and_solve, Exact, RefineSpec, StepReport};
+use crate::refine::{refine_and_solve, Exact, RefineError, RefineSpec, StepReport};
 use hasse_complex::Complex;
 
 /// The steps of a case's refinement, every level's mesh and fields, and
@@ -51,10 +54,15 @@ pub fn refine_case(
     let problem = match &case.problem {
         Problem::Diffusion(spec) => diffusion_problem(case, spec),
         other => {
-            return Err(RunError::Input(format!(
-                "refinement re-solves diffusion problems; this case is kind = \"{}\"",
-                other.kind()
-            )))
+            return Err(RunError::input_at(
+                case,
+                "refine",
+                format!(
+                    "refinement re-solves diffusion problems; this case is kind = \"{}\"",
+                    other.kind()
+                ),
+                None,
+            ))
         }
     };
     let exact = case.exact.as_ref().and_then(|e| {
@@ -64,11 +72,23 @@ pub fn refine_case(
         })
     });
     let study = refine_and_solve(&problem, complex, spec, exact.as_ref(), phase).map_err(|e| {
-        if e.is_input() {
-            RunError::Input(e.to_string())
-        } else {
-            RunError::Solve(e.to_string())
-        }
+        let located = match &e {
+            RefineError::Refinement(message) => {
+                RunError::input_at(case, "refine.strategy", message, None)
+            }
+            RefineError::Solve(d) => {
+                let Problem::Diffusion(spec) = &case.problem else {
+                    return RunError::input(case, e.to_string());
+                };
+                let keys = Keys {
+                    prefix: "problem".into(),
+                    coefficient: "conductivity",
+                    boundary: &spec.boundary,
+                };
+                diffusion_error(case, &keys, d.clone())
+            }
+        };
+        located.because(e)
     })?;
     let levels: Vec<(Complex, Vec<Cochain>)> = study
         .levels

@@ -50,7 +50,11 @@ pub(super) fn evaluate(
     if value.is_finite() {
         Ok(value)
     } else {
-        Err(MetricError::NonFinite { cell })
+        Err(MetricError::NonFiniteSource {
+            cell,
+            point: x[..d].to_vec(),
+            value,
+        })
     }
 }
 

@@ -128,39 +128,67 @@ pub(super) fn replace_row_weights(metric: &mut BlockMetric, rows: &[(usize, f64)
 /// A load whose every entry is finite (finite values can still overflow
 /// when summed).
 pub(super) fn finite_load(rhs: Vec<f64>) -> Result<Vec<f64>, DiffusionError> {
-    if rhs.iter().any(|v| !v.is_finite()) {
+    if let Some(&value) = rhs.iter().find(|v| !v.is_finite()) {
         return Err(DiffusionError::NonFinite {
-            what: "source",
-            location: vec![],
+            datum: Datum::Source,
+            point: None,
+            value,
         });
     }
     Ok(rhs)
 }
 
-pub(super) fn evaluate(f: &ScalarFn, x: &[f64], what: &'static str) -> Result<f64, DiffusionError> {
-    let v = f(x);
-    if v.is_finite() {
-        Ok(v)
+pub(super) fn evaluate(f: &ScalarFn, x: &[f64], datum: Datum) -> Result<f64, DiffusionError> {
+    let value = f(x);
+    if value.is_finite() {
+        Ok(value)
     } else {
         Err(DiffusionError::NonFinite {
-            what,
-            location: x.to_vec(),
+            datum,
+            point: Some(x.to_vec()),
+            value,
         })
     }
 }
 
-/// α of a Robin condition at a point, which must be positive.
+/// A metric's error, with a source that is not finite at a point named as
+/// the problem's source.
+pub(super) fn source_error(error: MetricError) -> DiffusionError {
+    match error {
+        MetricError::NonFiniteSource { point, value, .. } => DiffusionError::NonFinite {
+            datum: Datum::Source,
+            point: Some(point),
+            value,
+        },
+        other => other.into(),
+    }
+}
+
+/// The datum of the value of boundary condition `k` (its kind's name).
+pub(super) fn boundary_value(bc: &BoundaryCondition, k: usize) -> Datum {
+    let kind = match bc.kind {
+        BoundaryKind::Dirichlet(_) => "Dirichlet",
+        BoundaryKind::Neumann(_) => "Neumann",
+        BoundaryKind::Robin { .. } => "Robin",
+    };
+    Datum::BoundaryValue { condition: k, kind }
+}
+
+/// α of Robin condition `k` at a point, which must be positive.
 pub(super) fn robin_alpha(
     bc: &BoundaryCondition,
+    k: usize,
     face: usize,
     alpha: &ScalarFn,
     x: &[f64],
 ) -> Result<f64, DiffusionError> {
-    let a = evaluate(alpha, x, "Robin α")?;
+    let a = evaluate(alpha, x, Datum::RobinAlpha { condition: k })?;
     if a <= 0.0 {
         return Err(DiffusionError::RobinAlpha {
+            condition: k,
             tag: bc.tag.clone(),
             face,
+            point: x.to_vec(),
             alpha: a,
         });
     }
@@ -173,6 +201,7 @@ pub(super) fn robin_alpha(
 #[allow(clippy::too_many_arguments)]
 pub(super) fn apply_at_unknown(
     bc: &BoundaryCondition,
+    k: usize,
     face: usize,
     unknown: usize,
     x: &[f64],
@@ -181,12 +210,13 @@ pub(super) fn apply_at_unknown(
     rhs: &mut [f64],
     ghosts: &mut Vec<(usize, f64, f64)>,
 ) -> Result<(), DiffusionError> {
+    let datum = boundary_value(bc, k);
     match &bc.kind {
-        BoundaryKind::Dirichlet(g) => fixed[unknown] = Some(evaluate(g, x, "Dirichlet value")?),
-        BoundaryKind::Neumann(g) => rhs[unknown] += evaluate(g, x, "Neumann value")? * weight,
+        BoundaryKind::Dirichlet(g) => fixed[unknown] = Some(evaluate(g, x, datum)?),
+        BoundaryKind::Neumann(g) => rhs[unknown] += evaluate(g, x, datum)? * weight,
         BoundaryKind::Robin { alpha, value } => {
-            let a = robin_alpha(bc, face, alpha, x)?;
-            ghosts.push((unknown, a * weight, evaluate(value, x, "Robin value")? / a));
+            let a = robin_alpha(bc, k, face, alpha, x)?;
+            ghosts.push((unknown, a * weight, evaluate(value, x, datum)? / a));
         }
     }
     Ok(())
@@ -228,6 +258,7 @@ impl Diffusion {
             .map_err(|e| match e {
                 MetricError::NotPositive { cell, .. } | MetricError::NonFinite { cell } => {
                     DiffusionError::Coefficient {
+                        cell,
                         point: complex.centroid_of(n, cell).to_vec(),
                         source: e,
                     }
@@ -296,7 +327,8 @@ impl Diffusion {
         let (incidence, metric, unknowns) = match self.method {
             Method::Fe => {
                 let (metric, load) =
-                    fe::stiffness_and_load(complex, tensors, &|x| (self.source)(x))?;
+                    fe::stiffness_and_load(complex, tensors, &|x| (self.source)(x))
+                        .map_err(source_error)?;
                 fe_load = Some(load);
                 (complex.shared_coboundary(0), metric, complex.cell_count(0))
             }
@@ -439,6 +471,38 @@ impl Diffusion {
         })
     }
 
+    /// The checks of the data that an assembly makes before it builds any
+    /// matrix: the conductivity at every cell (finite, symmetric positive
+    /// definite) and the source wherever this method's load evaluates it
+    /// (centroids, vertices or quadrature points). The errors are those
+    /// [`Diffusion::assemble`] would give, found without its cost, so that
+    /// bad data can be refused before solving.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::metric::Method;
+    /// use hasse_solver::physics::diffusion::{Diffusion, DiffusionError};
+    /// use hasse_solver::physics::{Conductivity, Datum};
+    /// use std::sync::Arc;
+    /// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let problem = Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|x| x[0].ln()));
+    /// assert!(problem.check_data(&mesh).is_ok()); // x > 0 at every centroid
+    /// let problem = Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|x| (x[0] - 0.5).ln()));
+    /// let error = problem.check_data(&mesh).unwrap_err();
+    /// assert!(matches!(error, DiffusionError::NonFinite { datum: Datum::Source, .. }));
+    /// ```
+    pub fn check_data(&self, complex: &Complex) -> Result<(), DiffusionError> {
+        let conductivity = self.cell_conductivity(complex)?;
+        self.checked_conductivity(complex, conductivity.cells())?;
+        let n = complex.dim();
+        let unknowns = match self.location() {
+            Location::Nodal => complex.cell_count(0),
+            Location::CellCentred => complex.cell_count(n),
+            Location::Hybrid => complex.cell_count(n) + complex.cell_count(n - 1),
+        };
+        self.source_load(complex, unknowns).map(|_| ())
+    }
+
     /// The source's load on the unknowns.
     pub(super) fn source_load(
         &self,
@@ -450,8 +514,10 @@ impl Diffusion {
         let cells = complex.cell_count(n);
         let mut rhs = crate::la::parallel::zeroed(unknowns);
         match self.method {
-            Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x))?,
-            Method::Dec(kind) => rhs = dec::load(complex, kind, &|x| (self.source)(x))?,
+            Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x)).map_err(source_error)?,
+            Method::Dec(kind) => {
+                rhs = dec::load(complex, kind, &|x| (self.source)(x)).map_err(source_error)?
+            }
             _ => {
                 let volume = complex.measure(n);
                 let centre = complex.centroid(n);
@@ -465,7 +531,7 @@ impl Diffusion {
                     let v = if v.is_finite() {
                         v
                     } else {
-                        evaluate(&self.source, at(c), "source")?
+                        evaluate(&self.source, at(c), Datum::Source)?
                     };
                     rhs[c] += v * volume[c];
                 }
@@ -515,11 +581,11 @@ impl Diffusion {
                     let share = area / verts.len() as f64;
                     for &v in verts {
                         let xv = complex.vertices().point(v);
-                        apply_at_unknown(bc, f, v, xv, share, &mut fixed, rhs, &mut ghosts)?;
+                        apply_at_unknown(bc, k, f, v, xv, share, &mut fixed, rhs, &mut ghosts)?;
                     }
                 }
                 Location::Hybrid => {
-                    apply_at_unknown(bc, f, cells + f, xf, area, &mut fixed, rhs, &mut ghosts)?;
+                    apply_at_unknown(bc, k, f, cells + f, xf, area, &mut fixed, rhs, &mut ghosts)?;
                 }
                 Location::CellCentred => {
                     let (cell, sign) = top
@@ -549,18 +615,18 @@ impl Diffusion {
                     let xg = foot.as_slice();
                     match &bc.kind {
                         BoundaryKind::Dirichlet(g) => {
-                            face_value[f] = sign * evaluate(g, xg, "Dirichlet value")?
+                            face_value[f] = sign * evaluate(g, xg, boundary_value(bc, k))?
                         }
                         BoundaryKind::Neumann(g) => {
                             face_weight.push((f, 0.0));
-                            let outward = evaluate(g, xf, "Neumann value")? * area;
+                            let outward = evaluate(g, xf, boundary_value(bc, k))? * area;
                             rhs[cell] += outward;
                             neumann_flux[f] = -sign * outward;
                         }
                         BoundaryKind::Robin { alpha, value } => {
-                            let a = robin_alpha(bc, f, alpha, xg)?;
+                            let a = robin_alpha(bc, k, f, alpha, xg)?;
                             face_weight.push((f, sigma * a * area / (sigma + a * area)));
-                            face_value[f] = sign * evaluate(value, xg, "Robin value")? / a;
+                            face_value[f] = sign * evaluate(value, xg, boundary_value(bc, k))? / a;
                         }
                     }
                 }

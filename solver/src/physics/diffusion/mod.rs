@@ -38,8 +38,8 @@ use crate::multigrid::{
 };
 use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use crate::physics::{
-    tagged_boundary_faces, BoundaryCondition, BoundaryKind, Conductivity, ScalarFn, TagError,
-    VectorFn,
+    non_finite_text, point_text, tagged_boundary_faces, BoundaryCondition, BoundaryKind,
+    Conductivity, Datum, ScalarFn, TagError, VectorFn,
 };
 pub use assemble::Assembled;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -141,16 +141,21 @@ pub enum Preconditioning {
 pub enum DiffusionError {
     #[error(transparent)]
     Tag(#[from] TagError),
-    #[error("Robin coefficient α = {alpha} at face {face} (tag '{tag}') must be positive")]
+    #[error("the Robin coefficient α = {alpha} of boundary condition {condition} (tag '{tag}') at {} (face {face}) must be positive", point_text(.point))]
     RobinAlpha {
+        condition: usize,
         tag: String,
         face: usize,
+        point: Vec<f64>,
         alpha: f64,
     },
-    #[error("{what} is not finite at {location:?}")]
+    /// A given function is NaN or ±∞ at a point (or, without a point, its
+    /// load overflowed).
+    #[error("{datum} is not finite ({}){}", non_finite_text(*.value), .point.as_deref().map(|x| format!(" at {}", point_text(x))).unwrap_or_else(|| " in the sum of its load".into()))]
     NonFinite {
-        what: &'static str,
-        location: Vec<f64>,
+        datum: Datum,
+        point: Option<Vec<f64>>,
+        value: f64,
     },
     #[error("pure Neumann problem with incompatible data: sources plus boundary fluxes sum to {imbalance:e} (relative {relative:e}); they must balance (∫f + ∮g = 0)")]
     IncompatibleNeumann { imbalance: f64, relative: f64 },
@@ -163,8 +168,9 @@ pub enum DiffusionError {
         unknown: usize,
         point: Vec<f64>,
     },
-    #[error("conductivity at {point:?}: {source}; check the conductivity expression there")]
+    #[error("the conductivity at {} (top cell {cell}) is {}", point_text(.point), coefficient_problem(.source))]
     Coefficient {
+        cell: usize,
         point: Vec<f64>,
         source: MetricError,
     },
@@ -188,6 +194,17 @@ pub enum DiffusionError {
     Iterative(#[from] CgError),
     #[error(transparent)]
     Multigrid(#[from] MultigridError),
+}
+
+/// What is wrong with a coefficient, in words that fit after "is".
+fn coefficient_problem(error: &MetricError) -> String {
+    match error {
+        MetricError::NonFinite { .. } => "not finite".into(),
+        MetricError::NotPositive { value, .. } => format!(
+            "not symmetric positive definite (eigenvalue estimate {value:e}); diffusion coefficients must be > 0"
+        ),
+        other => other.to_string(),
+    }
 }
 
 /// The discrete solution and how it was obtained.

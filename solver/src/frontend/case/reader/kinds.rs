@@ -4,19 +4,15 @@
 
 use super::{join, Reader, KIND_KEYS};
 use crate::frontend::case::expr::{closest, Scope};
-use crate::frontend::case::{
-    CoupledFieldSpec, CoupledSpec, DarcySpec, ElasticBoundaryKind, ElasticBoundarySpec,
-    ElasticitySpec, HeatSpec, MaterialSpec, MaxwellSpec, Problem, TimeSpec,
-};
+use crate::frontend::case::{DarcySpec, HeatSpec, MaxwellSpec, Problem, TimeSpec};
 use crate::metric::fv::FluxMass;
 use crate::metric::Method;
-use crate::physics::elasticity::PlaneModel;
 use crate::physics::maxwell::Mass;
 use hasse_complex::DualKind;
 use std::ops::Range;
 use toml_edit::{Item, TableLike, Value};
 
-const TIME_KEYS: &[&str] = &[
+pub(super) const TIME_KEYS: &[&str] = &[
     "dt",
     "steps",
     "end",
@@ -25,12 +21,12 @@ const TIME_KEYS: &[&str] = &[
     "theta",
     "save_every",
 ];
-const SCHEMES: &[&str] = &["backward-euler", "crank-nicolson"];
-const DARCY_METHODS: &[&str] = &["mimetic", "dec", "dec-barycentric"];
-const MAXWELL_METHODS: &[&str] = &["dec", "dec-barycentric"];
-const MAXWELL_MASSES: &[&str] = &["hodge", "whitney"];
+pub(super) const SCHEMES: &[&str] = &["backward-euler", "crank-nicolson"];
+pub(super) const DARCY_METHODS: &[&str] = &["mimetic", "dec", "dec-barycentric"];
+pub(super) const MAXWELL_METHODS: &[&str] = &["dec", "dec-barycentric"];
+pub(super) const MAXWELL_MASSES: &[&str] = &["hodge", "whitney"];
 /// More steps than this is almost certainly a typo in `dt` or `end`.
-const MAX_STEPS: i64 = 10_000_000;
+pub(super) const MAX_STEPS: i64 = 10_000_000;
 
 /// The kind a case's `problem.kind` names (default diffusion), read
 /// directly from the document so other tables can depend on it.
@@ -186,7 +182,7 @@ impl Reader {
     }
 
     /// The `[time]` table of a heat problem.
-    fn time(&mut self, root: &dyn TableLike) -> Option<TimeSpec> {
+    pub(super) fn time(&mut self, root: &dyn TableLike) -> Option<TimeSpec> {
         let Some((table, entry)) = self.subtable(root, "", "time") else {
             if root.get("time").is_none() {
                 self.error(
@@ -259,7 +255,7 @@ impl Reader {
     }
 
     /// `steps`, or `end` turned into a whole number of steps of `dt`.
-    fn step_count(
+    pub(super) fn step_count(
         &mut self,
         table: &dyn TableLike,
         header: Option<Range<usize>>,
@@ -346,7 +342,7 @@ impl Reader {
     }
 
     /// θ from `scheme` or `theta` (default backward Euler, θ = 1).
-    fn theta(&mut self, table: &dyn TableLike) -> Option<f64> {
+    pub(super) fn theta(&mut self, table: &dyn TableLike) -> Option<f64> {
         let scheme = self.entry(table, "time", "scheme");
         let theta = self.entry(table, "time", "theta");
         if let (Some(_), Some(t)) = (&scheme, &theta) {
@@ -399,7 +395,7 @@ impl Reader {
     }
 
     /// A string key of `problem` chosen from `choices`.
-    fn choice(
+    pub(super) fn choice(
         &mut self,
         table: &dyn TableLike,
         key: &str,
@@ -444,7 +440,7 @@ impl Reader {
     }
 
     /// `solver.factorization` if it is one of `refused`, with its span.
-    fn refused_factorization(
+    pub(super) fn refused_factorization(
         &self,
         root: &dyn TableLike,
         refused: &[&str],
@@ -629,390 +625,5 @@ impl Reader {
             ok = false;
         }
         ok.then_some(values)
-    }
-}
-
-const PLANES: &[&str] = &["strain", "stress"];
-const ELASTIC_TYPES: &[&str] = &["displacement", "traction"];
-
-impl Reader {
-    /// An array of expressions (vectors: body forces, displacements).
-    pub(super) fn expression_list(
-        &mut self,
-        entry: &super::Entry,
-        scope: &Scope,
-    ) -> Option<Vec<crate::frontend::case::expr::Expression>> {
-        let Some(array) = entry.item.as_array().filter(|a| (1..=3).contains(&a.len())) else {
-            self.type_error(entry, "an array of 1 to 3 expressions (x, y, z components)");
-            return None;
-        };
-        let mut parts = Vec::with_capacity(array.len());
-        for (i, v) in array.iter().enumerate() {
-            let item = Item::Value(v.clone());
-            parts.push(self.expression_of(&item, &format!("{}[{i}]", entry.name), v.span(), scope));
-        }
-        parts.into_iter().collect()
-    }
-
-    pub(super) fn elasticity(
-        &mut self,
-        root: &dyn TableLike,
-        table: &dyn TableLike,
-        header: Option<Range<usize>>,
-        scope: &Scope,
-    ) -> Option<Problem> {
-        let present = |key: &str| table.get(key).is_some();
-        let material = match (
-            present("lambda") || present("mu"),
-            present("young") || present("poisson"),
-        ) {
-            (true, true) => {
-                self.error(
-                    header.clone(),
-                    "problem.young",
-                    "give the material either by lambda and mu or by young and poisson, not both",
-                    None,
-                );
-                None
-            }
-            (false, false) => {
-                self.error(
-                    header.clone(),
-                    "problem.young",
-                    "missing: the material",
-                    Some("give young = E and poisson = ν, or lambda and mu".into()),
-                );
-                None
-            }
-            (true, false) => {
-                let lambda = self.required_expression(table, "lambda", header.clone(), scope);
-                let mu = self.required_expression(table, "mu", header.clone(), scope);
-                Some(MaterialSpec::Lame {
-                    lambda: lambda?,
-                    mu: mu?,
-                })
-            }
-            (false, true) => {
-                let young = self.required_expression(table, "young", header.clone(), scope);
-                let poisson = self.required_expression(table, "poisson", header.clone(), scope);
-                Some(MaterialSpec::Young {
-                    young: young?,
-                    poisson: poisson?,
-                })
-            }
-        };
-        let body_force = match self.entry(table, "problem", "body_force") {
-            Some(e) => self.expression_list(&e, scope),
-            None => scope.parse("0").ok().map(|z| vec![z.clone(), z.clone(), z]),
-        };
-        let plane = match self
-            .choice(table, "plane", PLANES, "plane model", None, Some("strain"))
-            .as_deref()
-        {
-            Some("stress") => Some(PlaneModel::Stress),
-            Some(_) => Some(PlaneModel::Strain),
-            None => None,
-        };
-        let boundary = self.elastic_boundary(root, scope);
-        Some(Problem::Elasticity(ElasticitySpec {
-            material: material?,
-            body_force: body_force?,
-            plane: plane?,
-            boundary,
-        }))
-    }
-
-    fn required_expression(
-        &mut self,
-        table: &dyn TableLike,
-        key: &str,
-        header: Option<Range<usize>>,
-        scope: &Scope,
-    ) -> Option<crate::frontend::case::expr::Expression> {
-        match self.entry(table, "problem", key) {
-            Some(_) => self.expression_at(table, "problem", key, scope),
-            None => {
-                self.error(header, &join("problem", key), "missing", None);
-                None
-            }
-        }
-    }
-
-    fn elastic_boundary(
-        &mut self,
-        root: &dyn TableLike,
-        scope: &Scope,
-    ) -> Vec<ElasticBoundarySpec> {
-        let mut out = Vec::new();
-        let Some(entry) = self.entry(root, "", "boundary") else {
-            return out;
-        };
-        let Some(array) = entry.item.as_array_of_tables() else {
-            self.error(
-                entry.span(),
-                "boundary",
-                "expected [[boundary]] tables",
-                None,
-            );
-            return out;
-        };
-        for (i, table) in array.iter().enumerate() {
-            let prefix = format!("boundary[{i}]");
-            self.check_keys(table, &prefix, super::BOUNDARY_KEYS);
-            let header = table.span();
-            if let Some(e) = self.entry(table, &prefix, "alpha") {
-                self.error(
-                    e.key_span.clone(),
-                    &e.name,
-                    "an elasticity boundary takes no alpha",
-                    None,
-                );
-            }
-            let tag_span = self.entry(table, &prefix, "tag").and_then(|e| e.span());
-            let tag = match self.entry(table, &prefix, "tag") {
-                Some(_) => self.string_at(table, &prefix, "tag"),
-                None => {
-                    self.error(
-                        header.clone(),
-                        &format!("{prefix}.tag"),
-                        "missing: the boundary region's tag",
-                        None,
-                    );
-                    None
-                }
-            };
-            let kind = match self.entry(table, &prefix, "type") {
-                None => {
-                    self.error(
-                        header.clone(),
-                        &format!("{prefix}.type"),
-                        "missing: displacement or traction",
-                        None,
-                    );
-                    None
-                }
-                Some(e) => match e.item.as_str() {
-                    Some(s) if ELASTIC_TYPES.contains(&s) => Some(s.to_string()),
-                    Some(other) => {
-                        self.error(
-                            e.span(),
-                            &e.name,
-                            format!("unknown boundary type \"{other}\""),
-                            Some("an elasticity boundary is \"displacement\" (u = value, or one `component` of it) or \"traction\" (σn = value); untagged faces are traction-free".into()),
-                        );
-                        None
-                    }
-                    None => {
-                        self.type_error(&e, "a string");
-                        None
-                    }
-                },
-            };
-            let component = match self.entry(table, &prefix, "component") {
-                None => None,
-                Some(e) => match e.item.as_integer() {
-                    Some(c @ 0..=2) if kind.as_deref() == Some("displacement") => Some(c as usize),
-                    Some(0..=2) => {
-                        self.error(
-                            e.key_span.clone(),
-                            &e.name,
-                            "only a displacement condition fixes one component",
-                            None,
-                        );
-                        None
-                    }
-                    _ => {
-                        self.error(
-                            e.span(),
-                            &e.name,
-                            "a component index 0 (x), 1 (y) or 2 (z)",
-                            None,
-                        );
-                        None
-                    }
-                },
-            };
-            let value = match self.entry(table, &prefix, "value") {
-                None => {
-                    self.error(
-                        header.clone(),
-                        &format!("{prefix}.value"),
-                        "missing: the boundary value",
-                        Some("a vector [gx, gy(, gz)], or one expression with `component`".into()),
-                    );
-                    None
-                }
-                Some(e) if component.is_some() => self
-                    .expression_of(e.item, &e.name, e.span(), scope)
-                    .map(|v| vec![v]),
-                Some(e) => self.expression_list(&e, scope),
-            };
-            let kind = match (kind.as_deref(), value) {
-                (Some("displacement"), Some(value)) => {
-                    Some(ElasticBoundaryKind::Displacement { component, value })
-                }
-                (Some("traction"), Some(value)) => Some(ElasticBoundaryKind::Traction(value)),
-                _ => None,
-            };
-            if let (Some(tag), Some(kind)) = (tag, kind) {
-                out.push(ElasticBoundarySpec {
-                    tag,
-                    kind,
-                    tag_span,
-                    key: prefix,
-                });
-            }
-        }
-        out
-    }
-}
-
-const FIELD_KEYS: &[&str] = &[
-    "name",
-    "method",
-    "conductivity",
-    "source",
-    "exact",
-    "boundary",
-];
-
-impl Reader {
-    pub(super) fn coupled(
-        &mut self,
-        root: &dyn TableLike,
-        table: &dyn TableLike,
-        header: Option<Range<usize>>,
-        scope: &Scope,
-    ) -> Option<Problem> {
-        let coefficient = |reader: &mut Self, key: &str| match reader.entry(table, "problem", key) {
-            Some(_) => reader.expression_at(table, "problem", key, scope),
-            None => {
-                reader.error(
-                    header.clone(),
-                    &join("problem", key),
-                    format!("missing: the reaction coefficient {key}"),
-                    Some("−∇·(D₁∇u) + a u − b v = f, −∇·(D₂∇v) − b u + c v = g".into()),
-                );
-                None
-            }
-        };
-        let (a, b, c) = (
-            coefficient(self, "a"),
-            coefficient(self, "b"),
-            coefficient(self, "c"),
-        );
-        for key in ["boundary", "exact"] {
-            if let Some((k, _)) = root.get_key_value(key) {
-                self.error(
-                    k.span(),
-                    key,
-                    format!("a coupled problem gives `{key}` per field"),
-                    Some(format!(
-                        "move it into the [[field]] tables ([[field.{key}]] or `exact = ...`)"
-                    )),
-                );
-            }
-        }
-        let fields = self.fields(root, scope);
-        let [first, second]: [CoupledFieldSpec; 2] = fields?.try_into().ok()?;
-        Some(Problem::Coupled(Box::new(CoupledSpec {
-            fields: [first, second],
-            a: a?,
-            b: b?,
-            c: c?,
-        })))
-    }
-
-    /// The two `[[field]]` tables of a coupled problem.
-    fn fields(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<Vec<CoupledFieldSpec>> {
-        let Some(entry) = self.entry(root, "", "field") else {
-            self.error(
-                None,
-                "field",
-                "missing: a coupled problem has two [[field]] tables",
-                Some("each with name, method, conductivity, source and [[field.boundary]]".into()),
-            );
-            return None;
-        };
-        let Some(array) = entry.item.as_array_of_tables() else {
-            self.type_error(&entry, "[[field]] tables");
-            return None;
-        };
-        if array.len() != 2 {
-            self.error(
-                entry.key_span.clone(),
-                "field",
-                format!(
-                    "a coupled problem has exactly two fields, found {}",
-                    array.len()
-                ),
-                None,
-            );
-            return None;
-        }
-        let mut out = Vec::new();
-        let mut ok = true;
-        for (i, table) in array.iter().enumerate() {
-            let prefix = format!("field[{i}]");
-            self.check_keys(table, &prefix, FIELD_KEYS);
-            let header = table.span();
-            let name = match self.entry(table, &prefix, "name") {
-                Some(_) => self.string_at(table, &prefix, "name"),
-                None => {
-                    self.error(
-                        header.clone(),
-                        &join(&prefix, "name"),
-                        "missing: the field's name (used for its output)",
-                        None,
-                    );
-                    None
-                }
-            };
-            if let Some(n) = &name {
-                let clash = out.iter().any(|f: &CoupledFieldSpec| &f.name == n);
-                if clash || n.is_empty() || !n.chars().all(|ch| ch.is_alphanumeric() || ch == '_') {
-                    let span = self.entry(table, &prefix, "name").and_then(|e| e.span());
-                    self.error(span, &join(&prefix, "name"), format!("field name \"{n}\" must be a non-empty word (letters, digits, _) and differ from the other field's"), None);
-                    ok = false;
-                }
-            }
-            let method = self.method_in(table, &prefix, header.clone());
-            if method == Some(Method::FvMimetic) {
-                let span = self.entry(table, &prefix, "method").and_then(|e| e.span());
-                self.error(
-                    span,
-                    &join(&prefix, "method"),
-                    "fv-mimetic has half-face unknowns, which the reaction terms do not act on",
-                    Some("use fe, fv, fd, dec or dec-barycentric".into()),
-                );
-                ok = false;
-            }
-            let conductivity = self.coefficient_in(table, &prefix, "conductivity", scope);
-            let source = match self.entry(table, &prefix, "source") {
-                Some(_) => self.expression_at(table, &prefix, "source", scope),
-                None => scope.parse("0").ok(),
-            };
-            let exact = match self.entry(table, &prefix, "exact") {
-                Some(_) => self.expression_at(table, &prefix, "exact", scope).map(Some),
-                None => Some(None),
-            };
-            let boundary = self.boundary_in(table, &prefix, scope, Conditions::Steady);
-            match (name, method, conductivity, source, exact) {
-                (Some(name), Some(method), Some(conductivity), Some(source), Some(exact)) => out
-                    .push(CoupledFieldSpec {
-                        name,
-                        diffusion: crate::frontend::case::DiffusionSpec {
-                            method,
-                            conductivity,
-                            source,
-                            boundary,
-                            circumcentres: false,
-                        },
-                        exact,
-                    }),
-                _ => ok = false,
-            }
-        }
-        ok.then_some(out)
     }
 }

@@ -1,0 +1,557 @@
+//! The [mesh] and [problem] tables and the boundary conditions: what a
+//! case solves and on which cells.
+
+use super::*;
+
+impl Reader {
+    pub(super) fn mesh(
+        &mut self,
+        root: &dyn TableLike,
+        text: &str,
+    ) -> (Option<MeshSpec>, BTreeMap<String, Range<usize>>) {
+        let mut spans = BTreeMap::new();
+        let Some((table, entry)) = self.subtable(root, "", "mesh") else {
+            if root.get("mesh").is_none() {
+                self.error(None, "mesh", "no [mesh] table", Some("add [mesh] with `generator = \"rectangle\"` and `n = [16, 16]`, or `file = \"mesh.msh\"`".into()));
+            }
+            return (None, spans);
+        };
+        spans.insert(String::new(), entry.span().unwrap_or(0..0));
+        let before = self.collector.diagnostics.len();
+        self.check_keys(table, "mesh", MeshSpec::keys());
+        for (key, item) in table.iter() {
+            if let Some(span) = item
+                .span()
+                .or_else(|| table.get_key_value(key).and_then(|(k, _)| k.span()))
+            {
+                spans.insert(key.to_string(), span);
+            }
+        }
+        if self.collector.diagnostics.len() > before {
+            return (None, spans);
+        }
+        // The keys are known: let serde check the types, through toml (which
+        // reports the line and column of a bad value).
+        #[derive(serde::Deserialize)]
+        struct MeshOnly {
+            mesh: MeshSpec,
+        }
+        match toml::from_str::<toml::Table>(text).map(|mut t| t.remove("mesh")) {
+            Ok(Some(value)) => {
+                let mut wrapper = toml::Table::new();
+                wrapper.insert("mesh".into(), value);
+                match toml::Value::Table(wrapper).try_into::<MeshOnly>() {
+                    Ok(m) => return (Some(m.mesh), spans),
+                    Err(e) => {
+                        // Find which key the message is about to point at it.
+                        let message = e.message().trim().to_string();
+                        let key = MeshSpec::keys().iter().find(|k| {
+                            message.contains(&format!("mesh.{k}"))
+                                || message.contains(&format!("`{k}`"))
+                        });
+                        let span = key
+                            .and_then(|k| spans.get(*k).cloned())
+                            .or_else(|| entry.span());
+                        let name = key.map_or("mesh".to_string(), |k| format!("mesh.{k}"));
+                        self.error(span, &name, message, None);
+                    }
+                }
+            }
+            _ => self.error(entry.span(), "mesh", "cannot read the [mesh] table", None),
+        }
+        (None, spans)
+    }
+
+    pub(super) fn problem(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<Problem> {
+        let Some((table, problem_entry)) = self.subtable(root, "", "problem") else {
+            if root.get("problem").is_none() {
+                self.error(
+                    None,
+                    "problem",
+                    "no [problem] table",
+                    Some("add [problem] with `method = \"fe\"` and `source = ...`".into()),
+                );
+            }
+            return None;
+        };
+        self.check_keys(table, "problem", PROBLEM_KEYS);
+        let kind = self
+            .string_at(table, "problem", "kind")
+            .unwrap_or_else(|| "diffusion".into());
+        self.check_kind_keys(root, table, &kind);
+        match kind.as_str() {
+            "diffusion" => {
+                let method = self.method(table, problem_entry.span());
+                let conductivity = self.coefficient(table, "conductivity", scope);
+                let source = match self.entry(table, "problem", "source") {
+                    Some(_) => self.expression_at(table, "problem", "source", scope),
+                    None => scope.parse("0").ok(),
+                };
+                let boundary = self.boundary(root, scope, Conditions::Steady);
+                let circumcentres = match self.string_at(table, "problem", "cell_points").as_deref()
+                {
+                    None | Some("centroids") => false,
+                    Some("circumcentres") => true,
+                    Some(other) => {
+                        let span = self
+                            .entry(table, "problem", "cell_points")
+                            .and_then(|e| e.span());
+                        self.error(span, "problem.cell_points", format!("unknown cell points \"{other}\""), Some("use \"centroids\" (default) or \"circumcentres\" (Delaunay triangulations)".into()));
+                        false
+                    }
+                };
+                if circumcentres && method.is_some_and(|m| m != Method::Fv) {
+                    let span = self
+                        .entry(table, "problem", "cell_points")
+                        .and_then(|e| e.span());
+                    self.error(span, "problem.cell_points", "only the two-point flux (method = \"fv\") places its unknowns at other cell points", None);
+                }
+                Some(Problem::Diffusion(DiffusionSpec {
+                    method: method?,
+                    conductivity: conductivity?,
+                    source: source?,
+                    boundary,
+                    circumcentres,
+                }))
+            }
+            "heat" => self.heat(root, table, problem_entry.span(), scope),
+            "darcy" => self.darcy(root, table, problem_entry.span(), scope),
+            "maxwell" => self.maxwell(root, table, problem_entry.span()),
+            "elasticity" => self.elasticity(root, table, problem_entry.span(), scope),
+            "coupled" => self.coupled(root, table, problem_entry.span(), scope),
+            "gradient" => {
+                if let Some(e) = self.entry(root, "", "boundary") {
+                    self.error(
+                        e.key_span.clone(),
+                        "boundary",
+                        "a gradient problem has no boundary conditions",
+                        None,
+                    );
+                }
+                let field = match self.entry(table, "problem", "field") {
+                    Some(_) => self.expression_at(table, "problem", "field", scope),
+                    None => {
+                        self.error(
+                            problem_entry.span(),
+                            "problem.field",
+                            "missing: the cell field whose gradient is computed",
+                            Some("e.g. field = \"sin(pi*x)\"".into()),
+                        );
+                        None
+                    }
+                };
+                let metric = self.gradient_metric(table);
+                Some(Problem::Gradient(GradientSpec {
+                    field: field?,
+                    metric: metric?,
+                }))
+            }
+            other => {
+                let span = self.entry(table, "problem", "kind").and_then(|e| e.span());
+                self.error(
+                    span,
+                    "problem.kind",
+                    format!("unknown problem kind \"{other}\""),
+                    Some(kind_help(other)),
+                );
+                None
+            }
+        }
+    }
+
+    pub(super) fn method(
+        &mut self,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+    ) -> Option<Method> {
+        self.method_in(table, "problem", header)
+    }
+
+    /// `method` of the table at `prefix` (`problem`, or `field[i]`).
+    pub(super) fn method_in(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        header: Option<Range<usize>>,
+    ) -> Option<Method> {
+        let Some(entry) = self.entry(table, prefix, "method") else {
+            self.error(
+                header,
+                &join(prefix, "method"),
+                "missing: which discretisation to use",
+                Some(format!("one of {}", METHODS.join(", "))),
+            );
+            return None;
+        };
+        let name = entry.item.as_str().map(str::to_string);
+        let method = match name.as_deref() {
+            Some("fd") => Method::Fd,
+            Some("fe") => Method::Fe,
+            Some("fv") => Method::Fv,
+            Some("fv-mimetic") => Method::FvMimetic,
+            Some("dec") => Method::Dec(DualKind::Circumcentric),
+            Some("dec-barycentric") => Method::Dec(DualKind::Barycentric),
+            Some(other) => {
+                let owned: Vec<String> = METHODS.iter().map(|s| s.to_string()).collect();
+                let help = match closest(other, &owned) {
+                    Some(s) => format!("did you mean \"{s}\"? methods: {}", METHODS.join(", ")),
+                    None => format!("methods: {}", METHODS.join(", ")),
+                };
+                self.error(
+                    entry.span(),
+                    &entry.name,
+                    format!("unknown method \"{other}\""),
+                    Some(help),
+                );
+                return None;
+            }
+            None => {
+                self.type_error(&entry, "a string");
+                return None;
+            }
+        };
+        Some(method)
+    }
+
+    /// A scalar or tensor coefficient under `problem.<key>` (default 1).
+    pub(super) fn coefficient(
+        &mut self,
+        table: &dyn TableLike,
+        key: &str,
+        scope: &Scope,
+    ) -> Option<Coefficient> {
+        self.coefficient_in(table, "problem", key, scope)
+    }
+
+    /// A scalar or tensor coefficient `<prefix>.<key>` (default 1).
+    pub(super) fn coefficient_in(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        key: &str,
+        scope: &Scope,
+    ) -> Option<Coefficient> {
+        let Some(entry) = self.entry(table, prefix, key) else {
+            return scope.parse("1").ok().map(Coefficient::Scalar);
+        };
+        let Some(Value::Array(rows)) = entry.item.as_value() else {
+            return self
+                .expression_of(entry.item, &entry.name, entry.span(), scope)
+                .map(Coefficient::Scalar);
+        };
+        let size = rows.len();
+        if !(1..=3).contains(&size) {
+            self.error(
+                entry.span(),
+                &entry.name,
+                format!("a tensor has 1 to 3 rows, found {size}"),
+                None,
+            );
+            return None;
+        }
+        let mut tensor = Vec::with_capacity(size);
+        let mut ok = true;
+        for (i, row) in rows.iter().enumerate() {
+            let name = format!("{}[{i}]", entry.name);
+            let Value::Array(cols) = row else {
+                self.error(
+                    row.span(),
+                    &name,
+                    "expected a row (an array)",
+                    Some("write the tensor as [[kxx, kxy], [kxy, kyy]]".into()),
+                );
+                ok = false;
+                continue;
+            };
+            if cols.len() != size {
+                self.error(
+                    row.span(),
+                    &name,
+                    format!(
+                        "row has {} entries; the tensor is {size}×{size}",
+                        cols.len()
+                    ),
+                    None,
+                );
+                ok = false;
+                continue;
+            }
+            let mut parsed = Vec::with_capacity(size);
+            for (j, v) in cols.iter().enumerate() {
+                let item = Item::Value(v.clone());
+                match self.expression_of(&item, &format!("{name}[{j}]"), v.span(), scope) {
+                    Some(e) => parsed.push(e),
+                    None => ok = false,
+                }
+            }
+            tensor.push(parsed);
+        }
+        if !ok {
+            return None;
+        }
+        // Symmetry can be checked textually for constant entries here; entries
+        // that vary are checked where they are evaluated.
+        for (i, row) in tensor.iter().enumerate() {
+            for (j, a) in row.iter().enumerate().take(i) {
+                let b = &tensor[j][i];
+                if a.is_constant() && b.is_constant() && a.eval(&[], 0.0) != b.eval(&[], 0.0) {
+                    self.error(entry.span(), &entry.name, format!("the tensor is not symmetric: entry [{i}][{j}] = {} but [{j}][{i}] = {}", a.text(), b.text()), Some("a diffusion or permeability tensor is symmetric positive definite".into()));
+                    return None;
+                }
+            }
+        }
+        Some(Coefficient::Tensor(tensor))
+    }
+
+    pub(super) fn boundary(
+        &mut self,
+        root: &dyn TableLike,
+        scope: &Scope,
+        conditions: Conditions,
+    ) -> Vec<BoundarySpec> {
+        self.boundary_in(root, "", scope, conditions)
+    }
+
+    /// The `[[boundary]]` tables under `parent` (the document, or a
+    /// `[[field]]` of a coupled problem).
+    pub(super) fn boundary_in(
+        &mut self,
+        parent: &dyn TableLike,
+        parent_prefix: &str,
+        scope: &Scope,
+        conditions: Conditions,
+    ) -> Vec<BoundarySpec> {
+        let names = conditions.names();
+        let mut out = Vec::new();
+        let Some(entry) = self.entry(parent, parent_prefix, "boundary") else {
+            return out;
+        };
+        let Some(array) = entry.item.as_array_of_tables() else {
+            self.error(
+                entry.span(),
+                "boundary",
+                "expected [[boundary]] tables",
+                Some(
+                    "write each condition as a [[boundary]] table with tag, type and value".into(),
+                ),
+            );
+            return out;
+        };
+        for (i, table) in array.iter().enumerate() {
+            let prefix = format!("{}[{i}]", join(parent_prefix, "boundary"));
+            self.check_keys(table, &prefix, BOUNDARY_KEYS);
+            let header = table.span();
+            let tag_entry = self.entry(table, &prefix, "tag");
+            let tag_span = tag_entry.as_ref().and_then(|e| e.span());
+            let tag = match tag_entry {
+                Some(_) => self.string_at(table, &prefix, "tag"),
+                None => {
+                    self.error(header.clone(), &format!("{prefix}.tag"), "missing: the boundary region's tag", Some("generated meshes tag \"boundary\" and each side (\"xmin\", \"xmax\", ...)".into()));
+                    None
+                }
+            };
+            let kind_name = match self.entry(table, &prefix, "type") {
+                Some(_) => self.string_at(table, &prefix, "type"),
+                None => {
+                    self.error(
+                        header.clone(),
+                        &format!("{prefix}.type"),
+                        format!("missing: {}", names.join(", ")),
+                        None,
+                    );
+                    None
+                }
+            };
+            let value = match self.entry(table, &prefix, "value") {
+                Some(_) => self.expression_at(table, &prefix, "value", scope),
+                None => {
+                    self.error(
+                        header.clone(),
+                        &format!("{prefix}.value"),
+                        "missing: the boundary value (a number or an expression)",
+                        None,
+                    );
+                    None
+                }
+            };
+            let kind = match (conditions, kind_name.as_deref()) {
+                (Conditions::Steady | Conditions::Transient, Some("dirichlet"))
+                | (Conditions::Darcy, Some("pressure")) => value.map(BoundaryKindSpec::Dirichlet),
+                (Conditions::Steady | Conditions::Transient, Some("neumann"))
+                | (Conditions::Darcy, Some("flux")) => value.map(BoundaryKindSpec::Neumann),
+                (Conditions::Steady | Conditions::Transient, Some("robin")) => {
+                    let alpha = match self.entry(table, &prefix, "alpha") {
+                        Some(_) => self.expression_at(table, &prefix, "alpha", scope),
+                        None => {
+                            self.error(
+                                header.clone(),
+                                &format!("{prefix}.alpha"),
+                                "missing: a Robin condition K∇u·n + α u = g needs α",
+                                None,
+                            );
+                            None
+                        }
+                    };
+                    if conditions == Conditions::Transient
+                        && alpha.as_ref().is_some_and(|a| a.uses_time())
+                    {
+                        let span = self.entry(table, &prefix, "alpha").and_then(|e| e.span());
+                        self.error(span, &format!("{prefix}.alpha"), "a Robin coefficient α enters the matrix, which is factorised once: it may not depend on t", Some("the value g may depend on t".into()));
+                    }
+                    match (alpha, value) {
+                        (Some(alpha), Some(value)) => {
+                            Some(BoundaryKindSpec::Robin { alpha, value })
+                        }
+                        _ => None,
+                    }
+                }
+                (_, Some(other)) => {
+                    let span = self.entry(table, &prefix, "type").and_then(|e| e.span());
+                    let kinds: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+                    let help = closest(other, &kinds).map_or_else(
+                        || conditions.help().to_string(),
+                        |s| format!("did you mean \"{s}\"? {}", conditions.help()),
+                    );
+                    self.error(
+                        span,
+                        &format!("{prefix}.type"),
+                        format!("unknown boundary type \"{other}\""),
+                        Some(help),
+                    );
+                    None
+                }
+                (_, None) => None,
+            };
+            if let Some(e) = self.entry(table, &prefix, "component") {
+                self.error(
+                    e.key_span.clone(),
+                    &e.name,
+                    "only an elasticity displacement condition takes component",
+                    None,
+                );
+            }
+            if kind_name.as_deref() != Some("robin") || conditions == Conditions::Darcy {
+                if let Some(e) = self.entry(table, &prefix, "alpha") {
+                    self.error(
+                        e.key_span.clone(),
+                        &e.name,
+                        "only a robin condition takes alpha",
+                        None,
+                    );
+                }
+            }
+            if let (Some(tag), Some(kind)) = (tag, kind) {
+                out.push(BoundarySpec {
+                    tag,
+                    kind,
+                    tag_span,
+                    key: prefix,
+                });
+            }
+        }
+        out
+    }
+
+    pub(super) fn gradient_metric(&mut self, table: &dyn TableLike) -> Option<GradientMetric> {
+        let Some((metric, entry)) = self.subtable(table, "problem", "metric") else {
+            if table.get("metric").is_none() {
+                self.error(
+                    None,
+                    "problem.metric",
+                    "missing: the face metric Ω",
+                    Some("e.g. metric = { type = \"diagonal\", value = 0.2 }".into()),
+                );
+            }
+            return None;
+        };
+        self.check_keys(metric, "problem.metric", METRIC_KEYS);
+        let kind = self.string_at(metric, "problem.metric", "type");
+        match kind.as_deref() {
+            Some("diagonal") => match self.number_at(metric, "problem.metric", "value") {
+                Some(v) if v.is_finite() => Some(GradientMetric::Diagonal(v)),
+                Some(v) => {
+                    self.error(
+                        entry.span(),
+                        "problem.metric.value",
+                        format!("not finite: {v}"),
+                        None,
+                    );
+                    None
+                }
+                None => {
+                    if metric.get("value").is_none() {
+                        self.error(
+                            entry.span(),
+                            "problem.metric.value",
+                            "missing: the diagonal value σ of Ω = σ I",
+                            None,
+                        );
+                    }
+                    None
+                }
+            },
+            Some("file") => {
+                let scale = self
+                    .number_at(metric, "problem.metric", "scale")
+                    .unwrap_or(1.0);
+                let file = self.string_at(metric, "problem.metric", "file");
+                let Some(file) = file else {
+                    if metric.get("file").is_none() {
+                        self.error(
+                            entry.span(),
+                            "problem.metric.file",
+                            "missing: the file of `row column value` lines",
+                            None,
+                        );
+                    }
+                    return None;
+                };
+                let path = self.relative(&file);
+                if !path.is_file() {
+                    let span = self
+                        .entry(metric, "problem.metric", "file")
+                        .and_then(|e| e.span());
+                    self.error(
+                        span,
+                        "problem.metric.file",
+                        format!("no such file: {}", path.display()),
+                        Some("paths are relative to the case file".into()),
+                    );
+                    return None;
+                }
+                Some(GradientMetric::File { path, scale })
+            }
+            Some("two-point") => Some(GradientMetric::TwoPoint),
+            Some(other) => {
+                let span = self
+                    .entry(metric, "problem.metric", "type")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "problem.metric.type",
+                    format!("unknown metric type \"{other}\""),
+                    Some("use \"diagonal\", \"file\" or \"two-point\"".into()),
+                );
+                None
+            }
+            None => {
+                if metric.get("type").is_none() {
+                    self.error(
+                        entry.span(),
+                        "problem.metric.type",
+                        "missing: \"diagonal\", \"file\" or \"two-point\"",
+                        None,
+                    );
+                }
+                None
+            }
+        }
+    }
+
+    pub(super) fn relative(&self, file: &str) -> PathBuf {
+        Path::new(&self.file)
+            .parent()
+            .unwrap_or(Path::new("."))
+            .join(file)
+    }
+}
