@@ -138,19 +138,34 @@ fn run_on_bad_input_exits_2_and_writes_nothing() {
 
 #[test]
 fn problems_found_only_while_solving_also_exit_2() {
-    let file = "tests/bad-input/singular-source.toml";
+    // Incompatible pure-Neumann data show only in the assembled system:
+    // check passes, run refuses.
+    let file = "tests/bad-input/incompatible-neumann.toml";
     assert_eq!(hasse(&["check", file]).status.code(), Some(0));
-    let dir = scratch("singular");
+    let dir = scratch("incompatible");
     let stem = dir.join("out");
     let out = hasse(&["run", file, "-o", stem.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
-    assert!(
-        stderr.contains("source is not finite at [0.125, "),
-        "{stderr}"
-    );
+    assert!(stderr.contains("incompatible data"), "{stderr}");
     assert!(stderr.contains("no output written"), "{stderr}");
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0);
+}
+
+#[test]
+fn data_that_are_not_finite_are_refused_by_check_before_any_solve() {
+    // 1/(…) singular at the centroids (0.125, ·): evaluation alone shows
+    // it, so check refuses it with the key's line and the point, as run.
+    let file = "tests/bad-input/singular-source.toml";
+    let out = hasse(&["check", file]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.starts_with(&format!(
+            "error: {file}:11:10: `problem.source`: the source is not finite (NaN) at (0.125, "
+        )),
+        "{stderr}"
+    );
 }
 
 #[test]

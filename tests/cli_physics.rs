@@ -673,7 +673,10 @@ fn bad_problem_kind_input_names_the_key() {
         "modes",
         cavity,
         2,
-        &["problem.modes = 50", "only 15 physical modes"],
+        &[
+            "modes.toml:7:9: `problem.modes`: 50 modes asked for",
+            "only 15 physical modes",
+        ],
     );
     refused(
         "cavity-boundary",

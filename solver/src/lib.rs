@@ -1,8 +1,62 @@
 //! # hasse-solver
 //!
-//! The canonical form δΩ∂ = Aᵀ Ω A on cell complexes: the operator type,
-//! the metrics Ω of FD, FE, FV and DEC, boundary conditions, faer solves,
-//! case files, output and the `hasse` command line.
+//! Every operator of hasse is the canonical form **M = Aᵀ Ω A** (δΩ∂): A
+//! an exact integer incidence matrix of a cell complex (pure topology), Ω
+//! a metric that carries every length, material and method. Finite
+//! differences, finite elements, finite volumes and DEC are different Ω on
+//! the same A; a problem with several fields is a block system of such
+//! operators.
+//!
+//! ```
+//! use hasse_complex::generate::rectangle;
+//! use hasse_solver::metric::{fe, fv};
+//! use hasse_solver::operator::Canonical;
+//! let k = rectangle(8, 8, [0.0, 1.0], [0.0, 1.0]).unwrap();
+//! // Nodal Q1 elements: A = δ⁰ (edges × vertices), Ω one block per cell.
+//! let stiffness = Canonical::new(k.coboundary(0), fe::stiffness_metric(&k, &[1.0; 64]).unwrap()).unwrap();
+//! // Cell-centred two-point finite volumes: A = ∂₂ (edges × cells), Ω diagonal.
+//! let tpfa = Canonical::new(k.shared_boundary(2), fv::two_point(&k, &[1.0; 64]).unwrap()).unwrap();
+//! // The FE rows of A are differences along edges: constants are the
+//! // kernel of the (Neumann) operator.
+//! assert!(stiffness.apply(&vec![1.0; 81]).iter().all(|v| v.abs() < 1e-12));
+//! // ∂₂ keeps the 32 boundary edges as rows: a ghost value 0 behind each,
+//! // with σ = |F| / (h/2) = 2, so a constant 1 loses 2 through each of them.
+//! let loss: f64 = tpfa.apply(&vec![1.0; 64]).iter().sum();
+//! assert!((loss - 64.0).abs() < 1e-12);
+//! ```
+//!
+//! ## Layers
+//!
+//! The crate is layered; each layer may use the layers before it and
+//! never one after it:
+//!
+//! ```text
+//! la  ←  multigrid, operator  ←  metric  ←  physics  ←  refine, study  ←  frontend
+//! ```
+//!
+//! - [`la`]: linear algebra: direct factorisations (faer) and their
+//!   orderings, conjugate gradients on row-stored matrices, eigenpairs,
+//!   and [`la::fixed`], the one place where unknowns held at known values
+//!   are eliminated and lifted back.
+//! - [`multigrid`]: V-cycles and smoothed aggregation as CG
+//!   preconditioners; only its transfers know the complex.
+//! - [`operator`]: [`operator::Canonical`] (the pattern of Aᵀ Ω A built
+//!   once, values many times; coupling blocks Aᵀ Ω B; sums), the Ω storage
+//!   [`operator::BlockMetric`], and [`operator::block::BlockSystem`].
+//! - [`metric`]: one module per method (FD, FE, FV, DEC) building Ω, the
+//!   methods' names ([`metric::Method`]) and the one check of the
+//!   coefficients.
+//! - [`physics`]: each problem as canonical operators plus its data:
+//!   diffusion, transient heat, mixed Darcy, Maxwell cavities, linear
+//!   elasticity, coupled fields, normal gradients.
+//! - [`refine`] (re-solving on SPLIT-refined meshes) and [`study`]
+//!   (convergence orders and their tables).
+//! - [`frontend`]: case files, running them, output files, and the
+//!   `hasse` command line (`main.rs`); nothing in the library depends on
+//!   it.
+//!
+//! The rule is checked by the test `tests/layers.rs`: it fails when a
+//! lower layer names a higher one.
 
 pub mod frontend;
 pub mod la;

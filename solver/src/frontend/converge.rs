@@ -165,7 +165,8 @@ impl Study {
     /// `progress` is called once per level with the rows just solved.
     ///
     /// ```
-    /// use hasse_solver::study::{Norm, Refinement, Study};
+    /// use hasse_solver::frontend::converge::Study;
+    /// use hasse_solver::study::{Norm, Refinement};
     /// use hasse_solver::metric::Method;
     /// let case = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../cases/box-3d.toml"));
     /// let study = Study { levels: 2, refinement: Refinement::Uniform, methods: vec![Method::Fv] };

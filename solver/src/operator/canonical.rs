@@ -204,7 +204,7 @@ impl Canonical {
     /// ```
     /// use hasse_complex::generate::interval;
     /// use hasse_solver::operator::{BlockMetric, Canonical};
-    /// let k = interval(2, [0.0, 1.0]).unwrap();
+    /// let k = interval(2, 0.0, 1.0).unwrap();
     /// let stiffness = Canonical::new(k.coboundary(0), BlockMetric::diagonal(&[2.0, 2.0])).unwrap();
     /// let mass = Canonical::new(sprs::CsMat::<i8>::eye(3), BlockMetric::diagonal(&[0.25, 0.5, 0.25])).unwrap();
     /// let step = Canonical::sum(&[(4.0, &mass), (0.5, &stiffness)]).unwrap();

@@ -87,8 +87,12 @@ pub enum HeatError {
     },
     /// The temperature itself overflowed: an unstable scheme (θ < ½ with
     /// a step above the stability limit), not a wrong datum.
-    #[error("the temperature is not finite at {} at t = {time}: the scheme is unstable (θ < ½ needs Δt below about h²/(2K) per dimension); use θ ≥ ½ or a smaller step", point_text(.point))]
-    Overflow { point: Vec<f64>, time: f64 },
+    #[error("the temperature is not finite at {} at t = {time}: the θ-scheme with θ = {theta} is only conditionally stable (θ < ½ needs Δt below about h²/(2K) per dimension); use θ ≥ ½ or a smaller time step", point_text(.point))]
+    Overflow {
+        point: Vec<f64>,
+        time: f64,
+        theta: f64,
+    },
     #[error("the {method} method has no mass matrix here: transient heat needs nodal or cell-centred unknowns")]
     Unsupported { method: &'static str },
     #[error(transparent)]
@@ -447,6 +451,7 @@ impl Heat {
                 HeatError::Overflow {
                     point: points[i * d..(i + 1) * d].to_vec(),
                     time: t,
+                    theta,
                 }
             };
             if rhs.iter().any(|v| !v.is_finite()) {
