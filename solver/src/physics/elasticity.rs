@@ -113,6 +113,24 @@ pub enum PlaneModel {
     Stress,
 }
 
+impl PlaneModel {
+    /// Both models, in the order help texts list them.
+    pub const ALL: [PlaneModel; 2] = [PlaneModel::Strain, PlaneModel::Stress];
+
+    /// The name case files use (`problem.plane`).
+    ///
+    /// ```
+    /// use hasse_solver::physics::elasticity::PlaneModel;
+    /// assert_eq!(PlaneModel::ALL.map(|p| p.name()), ["strain", "stress"]);
+    /// ```
+    pub fn name(&self) -> &'static str {
+        match self {
+            PlaneModel::Strain => "strain",
+            PlaneModel::Stress => "stress",
+        }
+    }
+}
+
 /// A boundary condition's kind and data.
 #[derive(Clone)]
 pub enum ElasticBoundary {

@@ -316,8 +316,8 @@ impl FluxMass {
     pub fn name(&self) -> &'static str {
         match self {
             FluxMass::Mimetic => "mimetic",
-            FluxMass::Dec(DualKind::Circumcentric) => "dec",
-            FluxMass::Dec(DualKind::Barycentric) => "dec-barycentric",
+            // The DEC masses are named as the DEC methods of their dual.
+            FluxMass::Dec(kind) => crate::metric::Method::Dec(*kind).name(),
         }
     }
 }

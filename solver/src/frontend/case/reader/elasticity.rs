@@ -9,7 +9,6 @@ use crate::physics::elasticity::PlaneModel;
 use std::ops::Range;
 use toml_edit::{Item, TableLike};
 
-pub(super) const PLANES: &[&str] = &["strain", "stress"];
 pub(super) const ELASTIC_TYPES: &[&str] = &["displacement", "traction"];
 
 impl Reader {
@@ -82,14 +81,15 @@ impl Reader {
             Some(e) => self.expression_list(&e, scope),
             None => scope.parse("0").ok().map(|z| vec![z.clone(), z.clone(), z]),
         };
-        let plane = match self
-            .choice(table, "plane", PLANES, "plane model", None, Some("strain"))
-            .as_deref()
-        {
-            Some("stress") => Some(PlaneModel::Stress),
-            Some(_) => Some(PlaneModel::Strain),
-            None => None,
-        };
+        let plane = self.choice(
+            table,
+            "plane",
+            &PlaneModel::ALL,
+            PlaneModel::name,
+            "plane model",
+            None,
+            Some(PlaneModel::Strain),
+        );
         let boundary = self.elastic_boundary(root, scope);
         Some(Problem::Elasticity(ElasticitySpec {
             material: material?,

@@ -22,9 +22,6 @@ pub(super) const TIME_KEYS: &[&str] = &[
     "save_every",
 ];
 pub(super) const SCHEMES: &[&str] = &["backward-euler", "crank-nicolson"];
-pub(super) const DARCY_METHODS: &[&str] = &["mimetic", "dec", "dec-barycentric"];
-pub(super) const MAXWELL_METHODS: &[&str] = &["dec", "dec-barycentric"];
-pub(super) const MAXWELL_MASSES: &[&str] = &["hodge", "whitney"];
 /// More steps than this is almost certainly a typo in `dt` or `end`.
 pub(super) const MAX_STEPS: i64 = 10_000_000;
 
@@ -395,43 +392,51 @@ impl Reader {
     }
 
     /// A string key of `problem` chosen from `choices`.
-    pub(super) fn choice(
+    /// The value of `problem.<key>` among `values`, read by the names
+    /// `name` gives them (the enum's own names: one mapping from names to
+    /// values); `default` when the key is absent, or an error naming the
+    /// choices.
+    pub(super) fn choice<T: Copy>(
         &mut self,
         table: &dyn TableLike,
         key: &str,
-        choices: &[&str],
+        values: &[T],
+        name: impl Fn(&T) -> &'static str,
         what: &str,
         header: Option<Range<usize>>,
-        default: Option<&'static str>,
-    ) -> Option<String> {
-        let name = join("problem", key);
+        default: Option<T>,
+    ) -> Option<T> {
+        let names: Vec<&str> = values.iter().map(&name).collect();
+        let entry_name = join("problem", key);
         let Some(entry) = self.entry(table, "problem", key) else {
             if default.is_none() {
                 self.error(
                     header,
-                    &name,
+                    &entry_name,
                     format!("missing: the {what}"),
-                    Some(format!("one of {}", choices.join(", "))),
+                    Some(format!("one of {}", names.join(", "))),
                 );
             }
-            return default.map(str::to_string);
+            return default;
         };
         match entry.item.as_str() {
-            Some(s) if choices.contains(&s) => Some(s.to_string()),
-            Some(other) => {
-                let owned: Vec<String> = choices.iter().map(|s| s.to_string()).collect();
-                let help = match closest(other, &owned) {
-                    Some(s) => format!("did you mean \"{s}\"? choices: {}", choices.join(", ")),
-                    None => format!("choices: {}", choices.join(", ")),
-                };
-                self.error(
-                    entry.span(),
-                    &name,
-                    format!("unknown {what} \"{other}\""),
-                    Some(help),
-                );
-                None
-            }
+            Some(s) => match values.iter().find(|v| name(v) == s) {
+                Some(&value) => Some(value),
+                None => {
+                    let owned: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+                    let help = match closest(s, &owned) {
+                        Some(c) => format!("did you mean \"{c}\"? choices: {}", names.join(", ")),
+                        None => format!("choices: {}", names.join(", ")),
+                    };
+                    self.error(
+                        entry.span(),
+                        &entry_name,
+                        format!("unknown {what} \"{s}\""),
+                        Some(help),
+                    );
+                    None
+                }
+            },
             None => {
                 self.type_error(&entry, "a string");
                 None
@@ -460,20 +465,15 @@ impl Reader {
         header: Option<Range<usize>>,
         scope: &Scope,
     ) -> Option<Problem> {
-        let mass = self
-            .choice(
-                table,
-                "method",
-                DARCY_METHODS,
-                "flux mass method",
-                header,
-                None,
-            )
-            .map(|m| match m.as_str() {
-                "mimetic" => FluxMass::Mimetic,
-                "dec-barycentric" => FluxMass::Dec(DualKind::Barycentric),
-                _ => FluxMass::Dec(DualKind::Circumcentric),
-            });
+        let mass = self.choice(
+            table,
+            "method",
+            &FluxMass::ALL,
+            FluxMass::name,
+            "flux mass method",
+            header,
+            None,
+        );
         let permeability = self.coefficient(table, "permeability", scope);
         let source = match self.entry(table, "problem", "source") {
             Some(_) => self.expression_at(table, "problem", "source", scope),
@@ -502,32 +502,26 @@ impl Reader {
         table: &dyn TableLike,
         header: Option<Range<usize>>,
     ) -> Option<Problem> {
-        let dual = self
-            .choice(
-                table,
-                "method",
-                MAXWELL_METHODS,
-                "Hodge star (dual)",
-                header.clone(),
-                None,
-            )
-            .map(|m| match m.as_str() {
-                "dec-barycentric" => DualKind::Barycentric,
-                _ => DualKind::Circumcentric,
-            });
-        let mass = self
-            .choice(
-                table,
-                "mass",
-                MAXWELL_MASSES,
-                "edge mass",
-                None,
-                Some("hodge"),
-            )
-            .map(|m| match m.as_str() {
-                "whitney" => Mass::Whitney,
-                _ => Mass::Hodge,
-            });
+        // The dual of the Hodge stars, named as the DEC methods are.
+        let duals = [DualKind::Circumcentric, DualKind::Barycentric];
+        let dual = self.choice(
+            table,
+            "method",
+            &duals,
+            |&kind| Method::Dec(kind).name(),
+            "Hodge star (dual)",
+            header.clone(),
+            None,
+        );
+        let mass = self.choice(
+            table,
+            "mass",
+            &Mass::ALL,
+            Mass::name,
+            "edge mass",
+            None,
+            Some(Mass::Hodge),
+        );
         let modes = match self.entry(table, "problem", "modes") {
             None => {
                 self.error(

@@ -14,7 +14,6 @@ use crate::la::ordering::Ordering;
 use crate::metric::Method;
 use crate::multigrid::CellProlongation;
 use crate::refine::{RefineSpec, Strategy};
-use hasse_complex::DualKind;
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -26,6 +25,8 @@ mod kinds;
 mod overrides;
 mod problem;
 mod sections;
+#[cfg(test)]
+mod tests;
 
 use kinds::{kind_help, problem_kind, Conditions};
 pub(in crate::frontend::case) use overrides::apply_overrides;
@@ -103,7 +104,6 @@ pub(super) const STRATEGIES: &[&str] = &[
     "divide-shortest-wall",
 ];
 pub(super) const METRIC_KEYS: &[&str] = &["type", "value", "file", "scale"];
-pub(super) const METHODS: &[&str] = &["fd", "fe", "fv", "fv-mimetic", "dec", "dec-barycentric"];
 
 /// Walks the parsed document and records what it finds.
 pub(super) struct Reader {

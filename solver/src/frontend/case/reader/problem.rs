@@ -174,43 +174,37 @@ impl Reader {
         prefix: &str,
         header: Option<Range<usize>>,
     ) -> Option<Method> {
+        let methods = Method::names().join(", ");
         let Some(entry) = self.entry(table, prefix, "method") else {
             self.error(
                 header,
                 &join(prefix, "method"),
                 "missing: which discretisation to use",
-                Some(format!("one of {}", METHODS.join(", "))),
+                Some(format!("one of {methods}")),
             );
             return None;
         };
-        let name = entry.item.as_str().map(str::to_string);
-        let method = match name.as_deref() {
-            Some("fd") => Method::Fd,
-            Some("fe") => Method::Fe,
-            Some("fv") => Method::Fv,
-            Some("fv-mimetic") => Method::FvMimetic,
-            Some("dec") => Method::Dec(DualKind::Circumcentric),
-            Some("dec-barycentric") => Method::Dec(DualKind::Barycentric),
-            Some(other) => {
-                let owned: Vec<String> = METHODS.iter().map(|s| s.to_string()).collect();
-                let help = match closest(other, &owned) {
-                    Some(s) => format!("did you mean \"{s}\"? methods: {}", METHODS.join(", ")),
-                    None => format!("methods: {}", METHODS.join(", ")),
+        let Some(name) = entry.item.as_str() else {
+            self.type_error(&entry, "a string");
+            return None;
+        };
+        match name.parse::<Method>() {
+            Ok(method) => Some(method),
+            Err(_) => {
+                let owned: Vec<String> = Method::names().iter().map(|s| s.to_string()).collect();
+                let help = match closest(name, &owned) {
+                    Some(s) => format!("did you mean \"{s}\"? methods: {methods}"),
+                    None => format!("methods: {methods}"),
                 };
                 self.error(
                     entry.span(),
                     &entry.name,
-                    format!("unknown method \"{other}\""),
+                    format!("unknown method \"{name}\""),
                     Some(help),
                 );
-                return None;
+                None
             }
-            None => {
-                self.type_error(&entry, "a string");
-                return None;
-            }
-        };
-        Some(method)
+        }
     }
 
     /// A scalar or tensor coefficient under `problem.<key>` (default 1).
