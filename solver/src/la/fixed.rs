@@ -13,29 +13,6 @@
 //! side. A canonical operator Aᵀ Ω A reduces the same way by dropping the
 //! fixed columns of A ([`FixedSplit::restrict_columns`]): (A E)ᵀ Ω (A E) =
 //! M_ff with E the selection of the free unknowns.
-//!
-//! ```
-//! use faer::sparse::{SparseColMat, Triplet};
-//! use hasse_solver::la::fixed::FixedSplit;
-//! // tridiag(−1, 2, −1) on 4 unknowns with x₀ = 1 and x₃ = 4 held: the
-//! // free block [[2, −1], [−1, 2]] and b_f = (0, 0) + (1, 4).
-//! let mut t = Vec::new();
-//! for i in 0..4 {
-//!     t.push(Triplet::new(i, i, 2.0));
-//!     if i + 1 < 4 {
-//!         t.push(Triplet::new(i, i + 1, -1.0));
-//!         t.push(Triplet::new(i + 1, i, -1.0));
-//!     }
-//! }
-//! let m = SparseColMat::<usize, f64>::try_new_from_triplets(4, 4, &t).unwrap();
-//! let fixed = [Some(1.0), None, None, Some(4.0)];
-//! let split = FixedSplit::new(&fixed);
-//! assert_eq!(split.free(), &[1, 2]);
-//! assert_eq!(split.free_block(&m).to_dense()[(0, 1)], -1.0);
-//! assert_eq!(split.reduced_rhs(&m, &[0.0; 4], &fixed), vec![1.0, 4.0]);
-//! // The free solution of [[2, −1], [−1, 2]] x = (1, 4) is (2, 3).
-//! assert_eq!(split.lift(&[2.0, 3.0], &fixed), vec![1.0, 2.0, 3.0, 4.0]);
-//! ```
 
 use crate::la::parallel::{ranges, split_at_ranges};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -46,6 +23,29 @@ use sprs::CsMat;
 /// position of each among them. The values of the fixed unknowns are
 /// given where they are needed (they may change while the split stays,
 /// as Dirichlet data in time do).
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::la::fixed::FixedSplit;
+/// // tridiag(−1, 2, −1) on 4 unknowns with x₀ = 1 and x₃ = 4 held: the
+/// // free block [[2, −1], [−1, 2]] and b_f = (0, 0) + (1, 4).
+/// let mut t = Vec::new();
+/// for i in 0..4 {
+///     t.push(Triplet::new(i, i, 2.0));
+///     if i + 1 < 4 {
+///         t.push(Triplet::new(i, i + 1, -1.0));
+///         t.push(Triplet::new(i + 1, i, -1.0));
+///     }
+/// }
+/// let m = SparseColMat::<usize, f64>::try_new_from_triplets(4, 4, &t).unwrap();
+/// let fixed = [Some(1.0), None, None, Some(4.0)];
+/// let split = FixedSplit::new(&fixed);
+/// assert_eq!(split.free(), &[1, 2]);
+/// assert_eq!(split.free_block(&m).to_dense()[(0, 1)], -1.0);
+/// assert_eq!(split.reduced_rhs(&m, &[0.0; 4], &fixed), vec![1.0, 4.0]);
+/// // The free solution of [[2, −1], [−1, 2]] x = (1, 4) is (2, 3).
+/// assert_eq!(split.lift(&[2.0, 3.0], &fixed), vec![1.0, 2.0, 3.0, 4.0]);
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FixedSplit {
     free: Vec<usize>,
@@ -61,7 +61,7 @@ impl FixedSplit {
     }
 
     /// The split from one flag per unknown, `true` for a fixed one.
-    pub fn from_mask(fixed: impl IntoIterator<Item = bool>) -> Self {
+    pub(crate) fn from_mask(fixed: impl IntoIterator<Item = bool>) -> Self {
         let mut free = Vec::new();
         let index = fixed
             .into_iter()
@@ -79,7 +79,7 @@ impl FixedSplit {
     }
 
     /// Number of unknowns, free and fixed.
-    pub fn unknowns(&self) -> usize {
+    pub(crate) fn unknowns(&self) -> usize {
         self.index.len()
     }
 
@@ -90,17 +90,17 @@ impl FixedSplit {
 
     /// The position of unknown `i` among the free ones, `None` if it is
     /// fixed.
-    pub fn free_index(&self, i: usize) -> Option<usize> {
+    pub(crate) fn free_index(&self, i: usize) -> Option<usize> {
         self.index.get(i).copied().filter(|&k| k != usize::MAX)
     }
 
     /// Whether unknown `i` is fixed.
-    pub fn is_fixed(&self, i: usize) -> bool {
+    pub(crate) fn is_fixed(&self, i: usize) -> bool {
         self.free_index(i).is_none()
     }
 
     /// Whether no unknown is fixed.
-    pub fn all_free(&self) -> bool {
+    pub(crate) fn all_free(&self) -> bool {
         self.free.len() == self.index.len()
     }
 
@@ -180,7 +180,7 @@ impl FixedSplit {
     /// in free rows and fixed columns, column after column, to move new
     /// fixed values to the right-hand side without the matrix
     /// ([`FixedSplit::lift_into`]).
-    pub fn coupling(&self, matrix: &SparseColMat<usize, f64>) -> Vec<(usize, usize, f64)> {
+    pub(crate) fn coupling(&self, matrix: &SparseColMat<usize, f64>) -> Vec<(usize, usize, f64)> {
         let mut entries = Vec::new();
         for j in (0..matrix.ncols()).filter(|&j| self.is_fixed(j)) {
             let range = matrix.col_range(j);
@@ -198,14 +198,18 @@ impl FixedSplit {
 
     /// rhs_f −= M_fd g for the entries of [`FixedSplit::coupling`] and the
     /// values `fixed` (a fixed unknown without a value counts as 0).
-    pub fn lift_into(coupling: &[(usize, usize, f64)], fixed: &[Option<f64>], rhs: &mut [f64]) {
+    pub(crate) fn lift_into(
+        coupling: &[(usize, usize, f64)],
+        fixed: &[Option<f64>],
+        rhs: &mut [f64],
+    ) {
         for &(k, j, v) in coupling {
             rhs[k] -= v * fixed[j].unwrap_or(0.0);
         }
     }
 
     /// v_f: the free entries of `v`.
-    pub fn restrict(&self, v: &[f64]) -> Vec<f64> {
+    pub(crate) fn restrict(&self, v: &[f64]) -> Vec<f64> {
         self.free.iter().map(|&i| v[i]).collect()
     }
 
@@ -244,7 +248,7 @@ impl FixedSplit {
 
     /// Eᵀ A: the rows of a matrix (unknowns × anything) at the free
     /// unknowns, renumbered.
-    pub fn restrict_rows(&self, a: &CsMat<i8>) -> CsMat<i8> {
+    pub(crate) fn restrict_rows(&self, a: &CsMat<i8>) -> CsMat<i8> {
         let a = if a.is_csr() { a } else { &a.to_csr() };
         let mut indptr = Vec::with_capacity(self.free.len() + 1);
         let mut indices = Vec::new();
@@ -263,7 +267,7 @@ impl FixedSplit {
     /// E as an incidence matrix (unknowns × free): column k is the k-th
     /// free unknown. Eᵀ W E is W on the free unknowns; E₁ᵀ W E₂ couples
     /// the free unknowns of two splits through the same rows.
-    pub fn selection(&self) -> CsMat<i8> {
+    pub(crate) fn selection(&self) -> CsMat<i8> {
         let mut indptr = Vec::with_capacity(self.unknowns() + 1);
         let mut indices = Vec::with_capacity(self.free.len());
         indptr.push(0);
