@@ -98,11 +98,24 @@ impl SquareBlocks {
 /// The metric Ω as a sum of dense blocks over rows of A.
 ///
 /// ```
-/// use hasse_solver::operator::BlockMetric;
-/// let mut omega = BlockMetric::new(3);
-/// omega.push_symmetric(&[0, 2], &[2.0, -1.0, -1.0, 2.0]);
-/// omega.push_block(&[1], &[1], &[5.0]);
-/// assert_eq!(omega.apply(&[1.0, 1.0, 1.0]), vec![1.0, 5.0, 1.0]);
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::fe;
+/// use hasse_solver::operator::Canonical;
+/// // Q1 on one unit square: one dense 4×4 block over the square's edges.
+/// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let omega = fe::stiffness_metric(&k, &[1.0]).unwrap();
+/// assert_eq!((omega.size(), omega.block_count()), (4, 1));
+/// let (rows, cols, values) = omega.block(0);
+/// assert_eq!((rows.len(), cols, values.len()), (4, rows, 16));
+/// assert!(omega.is_symmetric(1e-14));
+/// // δ⁰ᵀ Ω δ⁰ is the Q1 stiffness matrix: 2/3 on the diagonal, −1/6 along
+/// // an edge, −1/3 across the diagonal.
+/// let m = Canonical::new(k.coboundary(0), omega).unwrap().assemble().to_dense();
+/// let mut row: Vec<f64> = (0..4).map(|j| m[(0, j)]).collect();
+/// row.sort_by(f64::total_cmp);
+/// for (a, b) in row.iter().zip([-1.0 / 3.0, -1.0 / 6.0, -1.0 / 6.0, 2.0 / 3.0]) {
+///     assert!((a - b).abs() < 1e-14);
+/// }
 /// ```
 #[derive(Clone, Debug, Default)]
 pub struct BlockMetric {
@@ -144,7 +157,7 @@ impl PartialEq for BlockMetric {
 
 impl BlockMetric {
     /// An empty metric (Ω = 0) over `size` rows.
-    pub fn new(size: usize) -> Self {
+    pub(crate) fn new(size: usize) -> Self {
         Self {
             size,
             ..Self::default()
@@ -152,12 +165,12 @@ impl BlockMetric {
     }
 
     /// Ω = diag(values).
-    pub fn diagonal(values: &[f64]) -> Self {
+    pub(crate) fn diagonal(values: &[f64]) -> Self {
         Self::from_weights(values.to_vec())
     }
 
     /// Ω = diag(weights), taking the vector.
-    pub fn from_weights(weights: Vec<f64>) -> Self {
+    pub(crate) fn from_weights(weights: Vec<f64>) -> Self {
         Self {
             size: weights.len(),
             blocks: Vec::new(),
@@ -172,26 +185,14 @@ impl BlockMetric {
 
     /// The weights w when Ω = diag(w) with block b the 1×1 block (b, b)
     /// for b < w.len() (rows beyond have no block); `None` for any other
-    /// layout of blocks. [`Canonical`] assembles such an Ω column by
-    /// column, from A stored by columns.
-    ///
-    /// ```
-    /// use hasse_solver::operator::BlockMetric;
-    /// let mut omega = BlockMetric::from_weights(vec![2.0, 3.0]);
-    /// omega.add_rows(1);
-    /// omega.push_block(&[2], &[2], &[4.0]);
-    /// assert_eq!(omega.diagonal_weights(), Some(&[2.0, 3.0, 4.0][..]));
-    /// // A block off the diagonal (or out of row order) ends the layout.
-    /// omega.push_block(&[0], &[1], &[1.0]);
-    /// assert_eq!(omega.diagonal_weights(), None);
-    /// assert_eq!(omega.block(1), (&[1][..], &[1][..], &[3.0][..]));
-    /// ```
-    pub fn diagonal_weights(&self) -> Option<&[f64]> {
+    /// layout of blocks. [`Canonical`](super::Canonical) assembles such an
+    /// Ω column by column, from A stored by columns.
+    pub(crate) fn diagonal_weights(&self) -> Option<&[f64]> {
         (self.blocks.is_empty() && self.square.is_none()).then_some(&self.values[..])
     }
 
     /// Ω from entries (row, column, value); repeated positions add up.
-    pub fn from_triplets(size: usize, entries: &[(usize, usize, f64)]) -> Self {
+    pub(crate) fn from_triplets(size: usize, entries: &[(usize, usize, f64)]) -> Self {
         let mut m = Self::new(size);
         for &(r, s, v) in entries {
             m.push_block(&[r], &[s], &[v]);
@@ -203,16 +204,8 @@ impl BlockMetric {
     /// after those of the one before (see [`Canonical::sum`]); a list of
     /// diagonal metrics stays diagonal.
     ///
-    /// ```
-    /// use hasse_solver::operator::BlockMetric;
-    /// let mut dense = BlockMetric::new(2);
-    /// dense.push_symmetric(&[0, 1], &[2.0, -1.0, -1.0, 2.0]);
-    /// let both = BlockMetric::stacked(&[(2.0, &BlockMetric::diagonal(&[1.0])), (0.5, &dense)]);
-    /// assert_eq!(both.to_dense(), vec![vec![2.0, 0.0, 0.0], vec![0.0, 1.0, -0.5], vec![0.0, -0.5, 1.0]]);
-    /// ```
-    ///
     /// [`Canonical::sum`]: super::Canonical::sum
-    pub fn stacked(parts: &[(f64, &BlockMetric)]) -> Self {
+    pub(crate) fn stacked(parts: &[(f64, &BlockMetric)]) -> Self {
         let size = parts.iter().map(|(_, m)| m.size).sum();
         let diagonal: Option<Vec<f64>> = parts
             .iter()
@@ -246,18 +239,18 @@ impl BlockMetric {
 
     /// Ω from square blocks over the same rows and columns, laid out back
     /// to back: block b covers the rows `indices[ptr[b]..ptr[b + 1]]` and
-    /// its values (m_b × m_b row-major, m_b = ptr[b + 1] − ptr[b]) are
+    /// its values (m_b × m_b row-major, m_b = `ptr[b + 1] − ptr[b]`) are
     /// `values[value_ptr[b]..value_ptr[b + 1]]`, following those of block
     /// b − 1. Builders that know their block sizes in advance write them in
     /// place (and in parallel) this way. `per_cell` says that block b is
     /// over the edges of top cell b of a complex, for every b
-    /// ([`Canonical::with_cell_blocks`]).
+    /// ([`Canonical::with_cell_blocks`](super::Canonical::with_cell_blocks)).
     ///
     /// The caller guarantees that every block is exactly symmetric and
     /// finite (the FE builders mirror each block and reject a cell with a
     /// non-finite one), so [`BlockMetric::is_symmetric`] and the finiteness
-    /// check of [`Canonical`] need not read the values; debug builds check
-    /// it here.
+    /// check of [`Canonical`](super::Canonical) need not read the values;
+    /// debug builds check it here.
     pub(crate) fn from_symmetric_blocks(
         size: usize,
         ptr: Vec<usize>,
@@ -318,7 +311,7 @@ impl BlockMetric {
     }
 
     /// Add the block W (|rows| × |cols|, row-major) at rows × cols.
-    pub fn push_block(&mut self, rows: &[usize], cols: &[usize], values: &[f64]) {
+    pub(crate) fn push_block(&mut self, rows: &[usize], cols: &[usize], values: &[f64]) {
         self.per_cell = false;
         self.exact = false;
         if let Some(square) = self.square.take() {
@@ -367,12 +360,12 @@ impl BlockMetric {
     }
 
     /// Add a square block over the same rows and columns.
-    pub fn push_symmetric(&mut self, rows: &[usize], values: &[f64]) {
+    pub(crate) fn push_symmetric(&mut self, rows: &[usize], values: &[f64]) {
         self.push_block(rows, rows, values);
     }
 
     /// Append `count` rows (and columns) with no blocks yet.
-    pub fn add_rows(&mut self, count: usize) {
+    pub(crate) fn add_rows(&mut self, count: usize) {
         self.size += count;
     }
 
@@ -390,7 +383,8 @@ impl BlockMetric {
         }
     }
 
-    /// Rows, columns and values of block `b`.
+    /// Rows, columns and values of block `b`, the values row-major
+    /// (|rows| × |cols|).
     pub fn block(&self, b: usize) -> (&[usize], &[usize], &[f64]) {
         if let Some(square) = &self.square {
             let rows = square.rows(&self.indices, b);
@@ -432,7 +426,7 @@ impl BlockMetric {
     }
 
     /// Mutable values of block `b` (row-major).
-    pub fn block_values_mut(&mut self, b: usize) -> &mut [f64] {
+    pub(crate) fn block_values_mut(&mut self, b: usize) -> &mut [f64] {
         self.exact = false;
         if let Some(square) = &self.square {
             return &mut self.values[square.value_ptr[b]..square.value_ptr[b + 1]];

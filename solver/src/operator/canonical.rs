@@ -10,15 +10,16 @@ use sprs::CsMat;
 use std::sync::{Arc, OnceLock};
 
 /// M = Aᵀ Ω A with its assembly pattern, or, for a block that couples two
-/// sets of unknowns, M = Aᵀ Ω B with a second incidence matrix B over the
-/// same rows ([`Canonical::coupling`]).
+/// sets of unknowns (the flux–pressure block of mixed Darcy flow), M =
+/// Aᵀ Ω B with a second incidence matrix B over the same rows.
 ///
 /// ```
-/// use hasse_solver::operator::{BlockMetric, Canonical};
+/// use hasse_solver::metric::fd;
+/// use hasse_solver::operator::Canonical;
 /// // A = ∂_1ᵀ of a path of 3 vertices (2 edges), Ω = identity:
 /// // Aᵀ A is the graph Laplacian tridiag(−1, 2, −1) without the end rows.
 /// let a = sprs::CsMat::new((2, 3), vec![0, 2, 4], vec![0, 1, 1, 2], vec![-1i8, 1, -1, 1]);
-/// let op = Canonical::new(a, BlockMetric::diagonal(&[1.0, 1.0])).unwrap();
+/// let op = Canonical::new(a, fd::from_face_values(&[1.0, 1.0])).unwrap();
 /// let m = op.assemble();
 /// assert_eq!(m.to_dense()[(1, 1)], 2.0);
 /// assert_eq!(m.to_dense()[(0, 1)], -1.0);
@@ -149,27 +150,7 @@ impl Canonical {
     /// mean-value constraint. A and B are exact integer incidence matrices
     /// with as many rows as Ω; the pattern is built once, as for
     /// [`Canonical::new`].
-    ///
-    /// ```
-    /// use hasse_complex::generate::rectangle;
-    /// use hasse_solver::operator::{BlockMetric, Canonical};
-    /// // Two squares: ∂₂ is 7 edges × 2 cells. With A = I on the edges and
-    /// // Ω = −I, Aᵀ Ω ∂₂ = −∂₂, the flux–pressure block of mixed Darcy.
-    /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
-    /// let edges = k.cell_count(1);
-    /// let b = Canonical::coupling(
-    ///     sprs::CsMat::<i8>::eye(edges),
-    ///     BlockMetric::diagonal(&vec![-1.0; edges]),
-    ///     k.shared_boundary(2),
-    /// )
-    /// .unwrap();
-    /// let m = b.assemble().to_dense();
-    /// assert_eq!((m.nrows(), m.ncols()), (7, 2));
-    /// for (v, (e, c)) in k.boundary(2).iter() {
-    ///     assert_eq!(m[(e, c)], -f64::from(*v));
-    /// }
-    /// ```
-    pub fn coupling(
+    pub(crate) fn coupling(
         left: impl Into<Arc<CsMat<i8>>>,
         metric: BlockMetric,
         right: impl Into<Arc<CsMat<i8>>>,
@@ -200,19 +181,7 @@ impl Canonical {
     /// the A_k stacked row block after row block and Ω the c_k Ω_k placed
     /// along the diagonal, so the sum is again Aᵀ Ω A. A transient step
     /// matrix M/Δt + θK is the sum of a mass (A = I) and a stiffness.
-    ///
-    /// ```
-    /// use hasse_complex::generate::interval;
-    /// use hasse_solver::operator::{BlockMetric, Canonical};
-    /// let k = interval(2, [0.0, 1.0]).unwrap();
-    /// let stiffness = Canonical::new(k.coboundary(0), BlockMetric::diagonal(&[2.0, 2.0])).unwrap();
-    /// let mass = Canonical::new(sprs::CsMat::<i8>::eye(3), BlockMetric::diagonal(&[0.25, 0.5, 0.25])).unwrap();
-    /// let step = Canonical::sum(&[(4.0, &mass), (0.5, &stiffness)]).unwrap();
-    /// let m = step.assemble().to_dense();
-    /// // 4·0.5 + 0.5·(2 + 2) at the middle vertex, 0.5·(−2) beside it.
-    /// assert_eq!((m[(1, 1)], m[(0, 1)]), (4.0, -1.0));
-    /// ```
-    pub fn sum(terms: &[(f64, &Canonical)]) -> Result<Self, CanonicalError> {
+    pub(crate) fn sum(terms: &[(f64, &Canonical)]) -> Result<Self, CanonicalError> {
         let unknowns = terms.first().map_or(0, |(_, op)| op.unknowns());
         if let Some((_, op)) = terms
             .iter()
@@ -295,7 +264,7 @@ impl Canonical {
 
     /// Number of unknowns M acts on: its columns, the columns of A (of B
     /// for a coupling block).
-    pub fn unknowns(&self) -> usize {
+    pub(crate) fn unknowns(&self) -> usize {
         self.right().cols()
     }
 
@@ -305,12 +274,12 @@ impl Canonical {
     }
 
     /// The incidence matrix A.
-    pub fn incidence(&self) -> &CsMat<i8> {
+    pub(crate) fn incidence(&self) -> &CsMat<i8> {
         &self.incidence
     }
 
     /// B of a coupling block Aᵀ Ω B; A itself for Aᵀ Ω A.
-    pub fn right(&self) -> &CsMat<i8> {
+    pub(crate) fn right(&self) -> &CsMat<i8> {
         self.right.as_deref().unwrap_or(&self.incidence)
     }
 
@@ -336,7 +305,7 @@ impl Canonical {
     }
 
     /// Number of stored entries of M.
-    pub fn nonzeros(&self) -> usize {
+    pub(crate) fn nonzeros(&self) -> usize {
         self.nonzeros
     }
 
@@ -356,10 +325,11 @@ impl Canonical {
     ///
     /// ```
     /// use hasse_complex::generate::rectangle;
-    /// use hasse_solver::operator::{BlockMetric, Canonical};
+    /// use hasse_solver::metric::fd;
+    /// use hasse_solver::operator::Canonical;
     /// let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
     /// let faces = k.cell_count(1);
-    /// let mut op = Canonical::new(k.shared_boundary(2), BlockMetric::diagonal(&vec![1.0; faces])).unwrap();
+    /// let mut op = Canonical::new(k.shared_boundary(2), fd::from_face_values(&vec![1.0; faces])).unwrap();
     /// let last = op.assemble_owned();
     /// // A later assembly builds the same pattern again.
     /// let again = op.assemble();
@@ -377,7 +347,7 @@ impl Canonical {
 
     /// A u (B u for a coupling block): the differences of `u` across every
     /// metric row.
-    pub fn difference(&self, u: &[f64]) -> Vec<f64> {
+    pub(crate) fn difference(&self, u: &[f64]) -> Vec<f64> {
         self.right()
             .outer_iterator()
             .map(|r| r.iter().map(|(j, &x)| f64::from(x) * u[j]).sum())
@@ -396,7 +366,7 @@ impl Canonical {
     }
 
     /// The flux cochain Ω A u (Ω B u for a coupling block).
-    pub fn flux(&self, u: &[f64]) -> Vec<f64> {
+    pub(crate) fn flux(&self, u: &[f64]) -> Vec<f64> {
         self.metric.apply(&self.difference(u))
     }
 
