@@ -35,7 +35,7 @@ pub enum Method {
 
 impl Method {
     /// Every method, in the order help texts list them.
-    pub const ALL: [Method; 6] = [
+    pub(crate) const ALL: [Method; 6] = [
         Method::Fd,
         Method::Fe,
         Method::Fv,
@@ -57,12 +57,12 @@ impl Method {
     }
 
     /// Every method's name, in the order of [`Method::ALL`].
-    pub fn names() -> Vec<&'static str> {
+    pub(crate) fn names() -> Vec<&'static str> {
         Self::ALL.iter().map(Method::name).collect()
     }
 
     /// Where this method's unknowns live.
-    pub fn location(&self) -> Location {
+    pub(crate) fn location(&self) -> Location {
         match self {
             Method::Fe | Method::Dec(_) => Location::Nodal,
             Method::Fd | Method::Fv => Location::CellCentred,
@@ -100,6 +100,18 @@ impl FromStr for Method {
 }
 
 /// Where the unknowns of a method live.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::mass::lumped;
+/// use hasse_solver::metric::Location;
+/// // A 2×1 grid of unit squares: 6 vertices, 2 cells of area 1.
+/// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// assert_eq!(lumped(&k, Location::Nodal).unwrap().len(), 6);
+/// assert_eq!(lumped(&k, Location::CellCentred), Some(vec![1.0, 1.0]));
+/// // Face unknowns stand for no volume.
+/// assert_eq!(lumped(&k, Location::Hybrid), None);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Location {
     /// On vertices (0-cells).

@@ -191,24 +191,13 @@ pub fn load(
     Ok(sum_shares(complex, characteristic, &shares))
 }
 
-/// [`stiffness_metric`] and [`load`] together, equal to them bit for bit:
+/// [`stiffness_metric`] and [`load()`] together, equal to them bit for bit:
 /// when every cell is a Q1 or virtual element, one pass over the cells
 /// finds each cell's element (its tensor order and, for Q1, the
 /// isoparametric map at the Gauss points) once for both. On a bad
 /// cell or a non-finite f the two are computed apart, so the error is the
 /// one they report.
-///
-/// ```
-/// use hasse_complex::generate::rectangle;
-/// use hasse_solver::metric::{fe, isotropic};
-/// let k = rectangle(3, 2, [0.0, 3.0], [0.0, 1.0]).unwrap();
-/// let tensors = vec![isotropic(1.0); 6];
-/// let f = |x: &[f64]| 1.0 + x[0];
-/// let (omega, b) = fe::stiffness_and_load(&k, &tensors, &f).unwrap();
-/// assert_eq!(omega, fe::stiffness_metric(&k, &tensors).unwrap());
-/// assert_eq!(b, fe::load(&k, &f).unwrap());
-/// ```
-pub fn stiffness_and_load<'a>(
+pub(crate) fn stiffness_and_load<'a>(
     complex: &Complex,
     tensors: impl Into<CellTensors<'a>>,
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
