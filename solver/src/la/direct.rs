@@ -9,9 +9,9 @@
 //!
 //! The symmetric factorisations take a fill-reducing [`Ordering`]: faer's
 //! AMD, or METIS nested dissection ([`crate::la::ordering`]) passed to faer as a
-//! custom permutation, or nested dissection from the unknowns' positions
-//! ([`crate::la::ordering::coordinate_dissection`]); [`Ordering::Automatic`]
-//! picks one (measured, see there). LU keeps faer's COLAMD column ordering.
+//! custom permutation, or nested dissection from the unknowns' positions;
+//! [`Ordering::Automatic`] picks one (measured, see there). LU keeps faer's
+//! COLAMD column ordering.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::solvers::Solve;
@@ -29,6 +29,24 @@ use std::time::Instant;
 use crate::la::ordering::{self, Ordering, OrderingError, UnknownPoints, ND_MIN_FILL_PER_UNKNOWN};
 
 /// Which factorisation to use.
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::la::direct::{solve, Factorization, SolveError};
+/// // [[0, 1], [1, 0]]: symmetric and indefinite, with a zero leading minor.
+/// let m = SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &[
+///     Triplet::new(0, 0, 0.0), Triplet::new(1, 0, 1.0),
+///     Triplet::new(0, 1, 1.0), Triplet::new(1, 1, 0.0),
+/// ]).unwrap();
+/// let b = [2.0, 3.0];
+/// assert_eq!(solve(&m, &b, Factorization::Llt).unwrap_err(), SolveError::NotPositiveDefinite);
+/// assert!(matches!(solve(&m, &b, Factorization::Ldlt), Err(SolveError::Singular { .. })));
+/// // A 2×2 pivot block (LBLᵀ) or a row exchange (LU) solves it: x = (3, 2).
+/// for kind in [Factorization::Lblt, Factorization::Lu] {
+///     let (x, _) = solve(&m, &b, kind).unwrap();
+///     assert!((x[0] - 3.0).abs() < 1e-15 && (x[1] - 2.0).abs() < 1e-15, "{kind}");
+/// }
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Factorization {
     /// Cholesky LLᵀ: symmetric positive definite matrices.
@@ -60,18 +78,42 @@ impl std::fmt::Display for Factorization {
 /// Why a solve failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SolveError {
+    /// The matrix is not square, so it has no factorisation to solve with.
     #[error("the matrix is {rows}×{cols}; a direct solve needs a square matrix")]
-    NotSquare { rows: usize, cols: usize },
+    NotSquare {
+        /// Rows of the matrix.
+        rows: usize,
+        /// Columns of the matrix.
+        cols: usize,
+    },
+    /// The right-hand side does not have one entry per unknown.
     #[error("right-hand side has {found} entries for {expected} unknowns")]
-    RhsSize { expected: usize, found: usize },
+    RhsSize {
+        /// Unknowns of the factorised matrix.
+        expected: usize,
+        /// Entries of the right-hand side.
+        found: usize,
+    },
+    /// LLᵀ met a pivot ≤ 0. For a discretised diffusion problem this
+    /// usually means a floating part of the domain (pure Neumann without a
+    /// mean constraint) or a coefficient that is not positive.
     #[error("LLᵀ failed: the matrix is not positive definite (a pivot was ≤ 0). The system is singular or indefinite: check that every connected part of the domain has a Dirichlet or Robin boundary, or that the coefficients are positive")]
     NotPositiveDefinite,
+    /// A zero pivot (or, for LBLᵀ, a pivot block at rounding level), or a
+    /// solution with non-finite entries: the matrix is singular to working
+    /// precision.
     #[error("{method} factorisation failed: the matrix is singular (a zero pivot). Check the boundary conditions and coefficients")]
-    Singular { method: &'static str },
+    Singular {
+        /// The factorisation that failed: "LLᵀ", "LDLᵀ", "LBLᵀ" or "LU".
+        method: &'static str,
+    },
+    /// faer's symbolic analysis rejected the pattern (its message).
     #[error("symbolic analysis failed: {0}")]
     Symbolic(String),
+    /// The factor's values or faer's scratch memory could not be allocated.
     #[error("out of memory while factorising")]
     OutOfMemory,
+    /// The fill-reducing ordering could not be computed.
     #[error("fill-reducing ordering: {0}")]
     Ordering(#[from] OrderingError),
 }
@@ -96,6 +138,22 @@ impl Analysis {
 
 /// The symbolic phase of a factorisation, reusable for every matrix with
 /// the same sparsity pattern.
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::la::direct::{DirectSolver, Factorization};
+/// // [[a, −1], [−1, a]] for two values of a: one analysis, two factorisations.
+/// let m = |a: f64| SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &[
+///     Triplet::new(0, 0, a), Triplet::new(1, 0, -1.0),
+///     Triplet::new(0, 1, -1.0), Triplet::new(1, 1, a),
+/// ]).unwrap();
+/// let solver = DirectSolver::analyse(m(2.0).as_ref(), Factorization::Llt).unwrap();
+/// for a in [2.0, 3.0] {
+///     let x = solver.factorize(m(a).as_ref()).unwrap().solve(&[1.0, 1.0]).unwrap();
+///     // Both rows read (a − 1) x = 1.
+///     assert!((x[0] - 1.0 / (a - 1.0)).abs() < 1e-15 && (x[1] - x[0]).abs() < 1e-15);
+/// }
+/// ```
 pub struct DirectSolver {
     kind: Factorization,
     analysis: Analysis,
@@ -105,13 +163,31 @@ pub struct DirectSolver {
     pub symbolic_seconds: f64,
 }
 
-/// A numeric factorisation, ready to solve.
+/// A numeric factorisation, ready to solve any number of right-hand sides.
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::la::direct::{DirectSolver, Factorization};
+/// let m = SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &[
+///     Triplet::new(0, 0, 2.0), Triplet::new(1, 0, -1.0),
+///     Triplet::new(0, 1, -1.0), Triplet::new(1, 1, 2.0),
+/// ]).unwrap();
+/// let factor = DirectSolver::analyse(m.as_ref(), Factorization::Llt)
+///     .unwrap()
+///     .factorize(m.as_ref())
+///     .unwrap();
+/// // The columns of M⁻¹ = ⅓ [[2, 1], [1, 2]], one solve each.
+/// let x0 = factor.solve(&[1.0, 0.0]).unwrap();
+/// let x1 = factor.solve(&[0.0, 1.0]).unwrap();
+/// assert!((x0[0] - 2.0 / 3.0).abs() < 1e-15 && (x0[1] - 1.0 / 3.0).abs() < 1e-15);
+/// assert!((x1[0] - 1.0 / 3.0).abs() < 1e-15 && (x1[1] - 2.0 / 3.0).abs() < 1e-15);
+/// ```
 pub struct Factor {
     kind: Factorization,
     inner: Numeric,
     size: usize,
     /// Seconds spent in the numeric factorisation.
-    pub numeric_seconds: f64,
+    pub(crate) numeric_seconds: f64,
 }
 
 enum Numeric {
@@ -213,22 +289,32 @@ fn largest_entry(matrix: SparseColMatRef<'_, usize, f64>) -> f64 {
 /// Figures of one solve, for the user's report.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolveReport {
+    /// The factorisation used.
     pub factorization: Factorization,
     /// The fill-reducing ordering of a symmetric factorisation made by
     /// [`DirectSolver`]; `None` for LU (COLAMD), an iterative solve, or a
     /// caller's own ordering.
     pub ordering: Option<Ordering>,
+    /// Size n of the n×n system.
     pub unknowns: usize,
+    /// Stored entries of the matrix (both triangles of a symmetric one).
     pub nonzeros: usize,
+    /// Seconds of the symbolic analysis, the ordering included.
     pub symbolic_seconds: f64,
+    /// Seconds of the numeric factorisation.
     pub numeric_seconds: f64,
+    /// Seconds of the forward and back substitution.
     pub solve_seconds: f64,
     /// ‖b − M x‖₂ / ‖b‖₂ (0 when b = 0 and x = 0).
     pub relative_residual: f64,
-    /// Values the factor stores and its work Σ c_j², for a symmetric
-    /// factorisation made by [`DirectSolver`] ([`DirectSolver::factor_entries`],
-    /// [`DirectSolver::factor_flops`]); `None` otherwise.
+    /// Values the factor stores, for a symmetric factorisation made by
+    /// [`DirectSolver`] ([`DirectSolver::factor_entries`]); `None`
+    /// otherwise.
     pub factor_entries: Option<usize>,
+    /// Work of that factorisation, Σ_j c_j² with c_j the values stored in
+    /// column j of the factor (supernode padding included): orderings are
+    /// compared by it, as it follows the factorisation's time more closely
+    /// than the factor's size. `None` where `factor_entries` is.
     pub factor_flops: Option<f64>,
 }
 
@@ -277,21 +363,6 @@ impl DirectSolver {
     /// reads values, so it can run before (or while) they are computed,
     /// when the pattern is known from topology. Every matrix later
     /// factorised must have exactly this pattern.
-    ///
-    /// ```
-    /// use faer::sparse::{SparseColMat, Triplet};
-    /// use hasse_solver::la::direct::{DirectSolver, Factorization};
-    /// use hasse_solver::la::ordering::Ordering;
-    ///
-    /// let a = SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &[
-    ///     Triplet::new(0, 0, 2.0), Triplet::new(1, 0, -1.0),
-    ///     Triplet::new(0, 1, -1.0), Triplet::new(1, 1, 2.0),
-    /// ]).unwrap();
-    /// let solver =
-    ///     DirectSolver::analyse_pattern(a.symbolic(), Factorization::Llt, Ordering::Amd).unwrap();
-    /// let x = solver.factorize(a.as_ref()).unwrap().solve(&[1.0, 1.0]).unwrap();
-    /// assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 1.0).abs() < 1e-14);
-    /// ```
     pub fn analyse_pattern(
         matrix: SymbolicSparseColMatRef<'_, usize>,
         kind: Factorization,
@@ -303,33 +374,6 @@ impl DirectSolver {
     /// [`DirectSolver::analyse_pattern`] for unknowns at `points`, which
     /// [`Ordering::Geometric`] needs and [`Ordering::Automatic`] uses for
     /// LLᵀ (see there).
-    ///
-    /// ```
-    /// use faer::sparse::{SparseColMat, Triplet};
-    /// use hasse_solver::la::direct::{DirectSolver, Factorization};
-    /// use hasse_solver::la::ordering::Ordering;
-    /// use hasse_solver::la::ordering::UnknownPoints;
-    /// // tridiag(−1, 2, −1) on 100 unknowns at x = 0, 1, …, 99.
-    /// let n = 100;
-    /// let mut t = Vec::new();
-    /// for i in 0..n {
-    ///     t.push(Triplet::new(i, i, 2.0));
-    ///     if i + 1 < n {
-    ///         t.push(Triplet::new(i + 1, i, -1.0));
-    ///         t.push(Triplet::new(i, i + 1, -1.0));
-    ///     }
-    /// }
-    /// let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
-    /// let x: Vec<f64> = (0..n).map(|i| i as f64).collect();
-    /// let points = UnknownPoints { coordinates: &x, dimension: 1 };
-    /// let solver = DirectSolver::analyse_pattern_at(
-    ///     a.symbolic(), Factorization::Llt, Ordering::Geometric, Some(points),
-    /// ).unwrap();
-    /// assert_eq!(solver.ordering(), Some(Ordering::Geometric));
-    /// let u = solver.factorize(a.as_ref()).unwrap().solve(&vec![1.0; n]).unwrap();
-    /// // u_i = (i + 1)(n − i)/2, the discrete solution of −u'' = 1.
-    /// assert!((u[49] - 50.0 * 51.0 / 2.0).abs() < 1e-9);
-    /// ```
     pub fn analyse_pattern_at(
         matrix: SymbolicSparseColMatRef<'_, usize>,
         kind: Factorization,
@@ -643,7 +687,8 @@ impl Factor {
     }
 }
 
-/// ‖b − M x‖₂ / ‖b‖₂.
+/// ‖b − M x‖₂ / ‖b‖₂, or ‖b − M x‖₂ when b = 0 (M may be rectangular; x
+/// has one entry per column, b one per row).
 pub fn relative_residual(matrix: SparseColMatRef<'_, usize, f64>, x: &[f64], rhs: &[f64]) -> f64 {
     let mut r = rhs.to_vec();
     for (j, &xj) in x.iter().enumerate().take(matrix.ncols()) {
@@ -665,6 +710,22 @@ pub fn relative_residual(matrix: SparseColMatRef<'_, usize, f64>, x: &[f64], rhs
 
 /// Analyse, factorise and solve once with the automatic ordering, and
 /// report.
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::la::direct::{solve, Factorization};
+/// use hasse_solver::la::ordering::Ordering;
+/// // tridiag(−1, 2, −1) x = (1, 0, 1) has x = (1, 1, 1).
+/// let t = [(0, 0, 2.0), (1, 1, 2.0), (2, 2, 2.0), (0, 1, -1.0), (1, 0, -1.0), (1, 2, -1.0), (2, 1, -1.0)];
+/// let t: Vec<_> = t.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+/// let m = SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &t).unwrap();
+/// let (x, report) = solve(&m, &[1.0, 0.0, 1.0], Factorization::Llt).unwrap();
+/// assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-15));
+/// assert_eq!((report.unknowns, report.nonzeros), (3, 7));
+/// // Three unknowns fill little: the automatic rule keeps AMD.
+/// assert_eq!(report.ordering, Some(Ordering::Amd));
+/// assert!(report.relative_residual < 1e-15);
+/// ```
 pub fn solve(
     matrix: &SparseColMat<usize, f64>,
     rhs: &[f64],
@@ -674,7 +735,7 @@ pub fn solve(
 }
 
 /// Analyse with `ordering`, factorise and solve once, and report.
-pub fn solve_with(
+pub(crate) fn solve_with(
     matrix: &SparseColMat<usize, f64>,
     rhs: &[f64],
     kind: Factorization,
@@ -1230,5 +1291,63 @@ mod tests {
             .unwrap();
             assert!(matches!(error, SolveError::Ordering(_)), "{error}");
         }
+    }
+
+    #[test]
+    fn a_pattern_alone_is_analysed_before_the_values() {
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(
+            2,
+            2,
+            &[
+                Triplet::new(0, 0, 2.0),
+                Triplet::new(1, 0, -1.0),
+                Triplet::new(0, 1, -1.0),
+                Triplet::new(1, 1, 2.0),
+            ],
+        )
+        .unwrap();
+        let solver =
+            DirectSolver::analyse_pattern(a.symbolic(), Factorization::Llt, Ordering::Amd).unwrap();
+        let x = solver
+            .factorize(a.as_ref())
+            .unwrap()
+            .solve(&[1.0, 1.0])
+            .unwrap();
+        assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 1.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn the_geometric_ordering_solves_the_1d_laplacian_exactly() {
+        // tridiag(−1, 2, −1) on 100 unknowns at x = 0, 1, …, 99.
+        let n = 100;
+        let mut t = Vec::new();
+        for i in 0..n {
+            t.push(Triplet::new(i, i, 2.0));
+            if i + 1 < n {
+                t.push(Triplet::new(i + 1, i, -1.0));
+                t.push(Triplet::new(i, i + 1, -1.0));
+            }
+        }
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
+        let x: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let points = UnknownPoints {
+            coordinates: &x,
+            dimension: 1,
+        };
+        let solver = DirectSolver::analyse_pattern_at(
+            a.symbolic(),
+            Factorization::Llt,
+            Ordering::Geometric,
+            Some(points),
+        )
+        .unwrap();
+        assert_eq!(solver.ordering(), Some(Ordering::Geometric));
+        let u = solver
+            .factorize(a.as_ref())
+            .unwrap()
+            .solve(&vec![1.0; n])
+            .unwrap();
+        // u_i = (i + 1)(n − i)/2, the discrete solution of −u'' = 1.
+        assert!((u[49] - 50.0 * 51.0 / 2.0).abs() < 1e-9);
     }
 }

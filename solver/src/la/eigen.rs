@@ -33,28 +33,53 @@ use faer::{Mat, Side};
 /// Why an eigensolve failed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum EigenError {
+    /// More eigenpairs were asked for than the (projected) space has.
     #[error("{requested} modes requested, but the problem has only {available}")]
-    TooManyModes { requested: usize, available: usize },
+    TooManyModes {
+        /// Eigenpairs asked for.
+        requested: usize,
+        /// Dimension of the space they live in: the unknowns, or the range
+        /// of the projection that removes a known null space.
+        available: usize,
+    },
+    /// Zero eigenpairs were asked for.
     #[error("no modes requested: ask for at least one")]
     NoModes,
+    /// K and M are not square matrices of one size.
     #[error("K is {k}×{k} but M is {m}×{m}; the pencil needs matrices of one size")]
-    SizeMismatch { k: usize, m: usize },
+    SizeMismatch {
+        /// Rows of K.
+        k: usize,
+        /// Rows of M.
+        m: usize,
+    },
+    /// The shift σ ([`Options::shift`]) is NaN or infinite.
     #[error("the shift σ = {0} is not finite")]
     BadShift(f64),
+    /// The basis reached [`Options::max_basis`] before every wanted pair
+    /// reached [`Options::tolerance`].
     #[error("not converged: {converged} of {requested} eigenpairs reached the tolerance with a basis of {basis} vectors (worst relative residual {worst:e}); raise max_basis or the block size, or move the shift closer to the wanted eigenvalues")]
     NotConverged {
+        /// Pairs that reached the tolerance.
         converged: usize,
+        /// Pairs asked for.
         requested: usize,
+        /// Size of the basis when the iteration stopped.
         basis: usize,
+        /// Largest relative residual among the pairs asked for.
         worst: f64,
     },
+    /// faer's dense self-adjoint eigensolver failed on the projected
+    /// matrix Qᵀ K Q (its message).
     #[error("the dense Rayleigh–Ritz eigenproblem failed: {0}")]
     Dense(String),
+    /// K − σM could not be factorised, e.g. because σ is an eigenvalue.
     #[error("factorising K − σM: {0}")]
     Solve(#[from] SolveError),
 }
 
-/// Settings of [`smallest`].
+/// Settings of [`smallest`] (and of
+/// [`Cavity::modes`](crate::physics::maxwell::Cavity::modes), which calls it).
 ///
 /// ```
 /// let o = hasse_solver::la::eigen::Options::default();

@@ -13,29 +13,6 @@
 //! side. A canonical operator Aᵀ Ω A reduces the same way by dropping the
 //! fixed columns of A ([`FixedSplit::restrict_columns`]): (A E)ᵀ Ω (A E) =
 //! M_ff with E the selection of the free unknowns.
-//!
-//! ```
-//! use faer::sparse::{SparseColMat, Triplet};
-//! use hasse_solver::la::fixed::FixedSplit;
-//! // tridiag(−1, 2, −1) on 4 unknowns with x₀ = 1 and x₃ = 4 held: the
-//! // free block [[2, −1], [−1, 2]] and b_f = (0, 0) + (1, 4).
-//! let mut t = Vec::new();
-//! for i in 0..4 {
-//!     t.push(Triplet::new(i, i, 2.0));
-//!     if i + 1 < 4 {
-//!         t.push(Triplet::new(i, i + 1, -1.0));
-//!         t.push(Triplet::new(i + 1, i, -1.0));
-//!     }
-//! }
-//! let m = SparseColMat::<usize, f64>::try_new_from_triplets(4, 4, &t).unwrap();
-//! let fixed = [Some(1.0), None, None, Some(4.0)];
-//! let split = FixedSplit::new(&fixed);
-//! assert_eq!(split.free(), &[1, 2]);
-//! assert_eq!(split.free_block(&m).to_dense()[(0, 1)], -1.0);
-//! assert_eq!(split.reduced_rhs(&m, &[0.0; 4], &fixed), vec![1.0, 4.0]);
-//! // The free solution of [[2, −1], [−1, 2]] x = (1, 4) is (2, 3).
-//! assert_eq!(split.lift(&[2.0, 3.0], &fixed), vec![1.0, 2.0, 3.0, 4.0]);
-//! ```
 
 use crate::la::parallel::{ranges, split_at_ranges};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
@@ -46,6 +23,29 @@ use sprs::CsMat;
 /// position of each among them. The values of the fixed unknowns are
 /// given where they are needed (they may change while the split stays,
 /// as Dirichlet data in time do).
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::la::fixed::FixedSplit;
+/// // tridiag(−1, 2, −1) on 4 unknowns with x₀ = 1 and x₃ = 4 held: the
+/// // free block [[2, −1], [−1, 2]] and b_f = (0, 0) + (1, 4).
+/// let mut t = Vec::new();
+/// for i in 0..4 {
+///     t.push(Triplet::new(i, i, 2.0));
+///     if i + 1 < 4 {
+///         t.push(Triplet::new(i, i + 1, -1.0));
+///         t.push(Triplet::new(i + 1, i, -1.0));
+///     }
+/// }
+/// let m = SparseColMat::<usize, f64>::try_new_from_triplets(4, 4, &t).unwrap();
+/// let fixed = [Some(1.0), None, None, Some(4.0)];
+/// let split = FixedSplit::new(&fixed);
+/// assert_eq!(split.free(), &[1, 2]);
+/// assert_eq!(split.free_block(&m).to_dense()[(0, 1)], -1.0);
+/// assert_eq!(split.reduced_rhs(&m, &[0.0; 4], &fixed), vec![1.0, 4.0]);
+/// // The free solution of [[2, −1], [−1, 2]] x = (1, 4) is (2, 3).
+/// assert_eq!(split.lift(&[2.0, 3.0], &fixed), vec![1.0, 2.0, 3.0, 4.0]);
+/// ```
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct FixedSplit {
     free: Vec<usize>,

@@ -6,23 +6,30 @@
 //! the transferred coarse solution) and where a factorisation would be too
 //! big. Convergence is measured by the relative residual ‖b − Mx‖₂ / ‖b‖₂,
 //! the same figure the direct solvers report.
-//!
-//! ```
-//! use faer::sparse::{SparseColMat, Triplet};
-//! use hasse_solver::la::iterative::{conjugate_gradient, CgOptions};
-//! // tridiag(−1, 2, −1) x = (1, 0, 1) has x = (1, 1, 1).
-//! let t = [(0, 0, 2.0), (1, 1, 2.0), (2, 2, 2.0), (0, 1, -1.0), (1, 0, -1.0), (1, 2, -1.0), (2, 1, -1.0)];
-//! let triplets: Vec<_> = t.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
-//! let m = SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &triplets).unwrap();
-//! let (x, report) = conjugate_gradient(&m, &[1.0, 0.0, 1.0], None, &CgOptions::default()).unwrap();
-//! assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-10));
-//! assert!(report.iterations <= 3);
-//! ```
 
 use faer::sparse::SparseColMat;
 use rayon::prelude::*;
 
-/// Stopping rule of [`conjugate_gradient`].
+/// Stopping rule of conjugate gradients.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::la::iterative::{CgError, CgOptions};
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::{Diffusion, DiffusionError, Iterative};
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// let mesh = rectangle(16, 16, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let mut problem = Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)));
+/// let options = CgOptions { tolerance: 1e-10, max_iterations: 3 };
+/// problem.iterative = Some(Iterative { options, ..Default::default() });
+/// // Three iterations are far too few for 256 unknowns.
+/// match problem.solve(&mesh) {
+///     Err(DiffusionError::Iterative(CgError::NotConverged { iterations, .. })) => assert_eq!(iterations, 3),
+///     other => panic!("{:?}", other.map(|_| ())),
+/// }
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CgOptions {
     /// Stop when ‖b − Mx‖₂ ≤ tolerance · ‖b‖₂.
@@ -43,36 +50,78 @@ impl Default for CgOptions {
 /// How an iterative solve went.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CgReport {
+    /// Conjugate-gradient iterations (one preconditioner application each).
     pub iterations: usize,
     /// ‖b − Mx‖₂ / ‖b‖₂ at the returned x (recomputed, not the recurrence's).
     pub relative_residual: f64,
     /// The relative residual of the initial guess.
     pub initial_residual: f64,
+    /// Wall-clock seconds of the iteration (setup of a preconditioner not
+    /// included).
     pub seconds: f64,
 }
 
 /// Why an iterative solve failed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CgError {
+    /// The matrix is not square, or the right-hand side or the initial
+    /// guess does not have one entry per unknown.
     #[error("conjugate gradients: matrix is {rows}×{cols}, right-hand side has {rhs} entries, initial guess {guess}")]
     Size {
+        /// Rows of the matrix.
         rows: usize,
+        /// Columns of the matrix.
         cols: usize,
+        /// Entries of the right-hand side.
         rhs: usize,
+        /// Entries of the initial guess (`rhs` when there is none).
         guess: usize,
     },
+    /// A diagonal entry is ≤ 0 or NaN, which no symmetric positive definite
+    /// matrix has (found while building the Jacobi preconditioner).
     #[error("conjugate gradients: diagonal entry {index} is {value}, not positive: the matrix is not symmetric positive definite")]
-    NotPositive { index: usize, value: f64 },
+    NotPositive {
+        /// Row of the entry.
+        index: usize,
+        /// The entry.
+        value: f64,
+    },
+    /// A search direction p has pᵀMp ≤ 0: M is not positive definite
+    /// (e.g. singular on a floating part of the domain).
     #[error("conjugate gradients: direction {iteration} has pᵀMp = {curvature:e} ≤ 0: the matrix is not positive definite")]
-    Breakdown { iteration: usize, curvature: f64 },
+    Breakdown {
+        /// Iteration at which it happened.
+        iteration: usize,
+        /// pᵀMp.
+        curvature: f64,
+    },
+    /// A residual r has rᵀBr ≤ 0 for the preconditioner B: B is not
+    /// positive definite, and conjugate gradients need it to be.
     #[error("preconditioned conjugate gradients: rᵀBr = {value:e} at iteration {iteration}: the preconditioner is not positive definite")]
-    Preconditioner { iteration: usize, value: f64 },
+    Preconditioner {
+        /// Iteration at which it happened.
+        iteration: usize,
+        /// rᵀBr.
+        value: f64,
+    },
+    /// Row pointers or column indices of a [`RowMatrix`] are out of range,
+    /// or there are more columns than 32-bit indices address.
     #[error("sparse matrix of {rows}×{cols}: row pointers or column indices out of range (at most 2³² columns)")]
-    Layout { rows: usize, cols: usize },
+    Layout {
+        /// Rows of the matrix.
+        rows: usize,
+        /// Columns of the matrix.
+        cols: usize,
+    },
+    /// The iteration limit ([`CgOptions::max_iterations`]) was reached
+    /// before the tolerance.
     #[error("conjugate gradients did not converge: relative residual {relative_residual:e} after {iterations} iterations (tolerance {tolerance:e}); raise the iteration limit or use a direct solver")]
     NotConverged {
+        /// Iterations made.
         iterations: usize,
+        /// ‖b − Mx‖₂ / ‖b‖₂ at the last iterate.
         relative_residual: f64,
+        /// The tolerance asked for.
         tolerance: f64,
     },
 }
@@ -171,10 +220,12 @@ impl RowMatrix {
         Self::new(n, matrix.nrows(), ptr, idx, val)
     }
 
+    /// Number of rows.
     pub fn nrows(&self) -> usize {
         self.nrows
     }
 
+    /// Number of columns.
     pub fn ncols(&self) -> usize {
         self.ncols
     }
@@ -185,7 +236,7 @@ impl RowMatrix {
     }
 
     /// Stored entries of row `i`.
-    pub fn row_len(&self, i: usize) -> usize {
+    pub(crate) fn row_len(&self, i: usize) -> usize {
         self.ptr[i + 1] - self.ptr[i]
     }
 
@@ -196,7 +247,7 @@ impl RowMatrix {
     }
 
     /// Row `i` times `x`, summed in storage order.
-    pub fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
+    pub(crate) fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
         let (c, v) = self.row(i);
         c.iter().zip(v).map(|(&j, &a)| a * x[j as usize]).sum()
     }
@@ -229,7 +280,7 @@ impl RowMatrix {
 
     /// y = M x and xᵀy in one pass, the inner product summed as [`dot`]
     /// sums it (the same bits as `multiply` followed by `dot(x, y)`).
-    pub fn multiply_dot(&self, x: &[f64], y: &mut [f64]) -> f64 {
+    pub(crate) fn multiply_dot(&self, x: &[f64], y: &mut [f64]) -> f64 {
         let partial: Vec<f64> = y
             .par_chunks_mut(DOT_CHUNK)
             .enumerate()
@@ -302,7 +353,7 @@ impl RowMatrix {
     /// the rows. Entry by entry the same numbers as forming self · P with
     /// [`RowMatrix::product`] and then subtracting: P's pattern joined with
     /// the product's, an entry of the product alone is 0 − s·(AP)_ij.
-    pub fn smoothed(&self, p: &RowMatrix, scale: &[f64]) -> RowMatrix {
+    pub(crate) fn smoothed(&self, p: &RowMatrix, scale: &[f64]) -> RowMatrix {
         self.gustavson(p, Some(scale))
     }
 
@@ -470,7 +521,7 @@ pub(crate) const DOT_CHUNK: usize = 8192;
 
 /// aᵀb, summed in fixed chunks so the result is bit-identical for any
 /// number of threads.
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     let partial: Vec<f64> = a
         .par_chunks(DOT_CHUNK)
         .zip(b.par_chunks(DOT_CHUNK))
@@ -482,6 +533,31 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// A symmetric positive definite approximation B ≈ M⁻¹ applied to a
 /// residual. For conjugate gradients B must be symmetric positive definite
 /// and the same operator at every call.
+///
+/// ```
+/// use hasse_solver::la::iterative::{Preconditioner, RowMatrix};
+/// use hasse_solver::multigrid::{Multigrid, MultigridOptions};
+/// // tridiag(−1, 2, −1) on 5 unknowns; no more than `coarse_size` unknowns
+/// // make a single level, factorised, so the "cycle" is B = M⁻¹ exactly.
+/// let n = 5;
+/// let rows = (0..n)
+///     .map(|i| {
+///         let mut row = vec![(i, 2.0)];
+///         if i > 0 { row.insert(0, (i - 1, -1.0)); }
+///         if i + 1 < n { row.push((i + 1, -1.0)); }
+///         row
+///     })
+///     .collect();
+/// let m = RowMatrix::from_rows(n, rows).unwrap();
+/// let b = Multigrid::algebraic(m.clone(), &MultigridOptions::default()).unwrap();
+/// let x = [1.0, -2.0, 0.5, 3.0, 0.0];
+/// let mut r = vec![0.0; n];
+/// m.multiply(&x, &mut r);
+/// let mut z = vec![0.0; n];
+/// b.apply(&r, &mut z);
+/// assert!(z.iter().zip(&x).all(|(z, x)| (z - x).abs() < 1e-12));
+/// assert_eq!(b.name(), "multigrid V-cycle");
+/// ```
 pub trait Preconditioner: Sync {
     /// z = B r.
     fn apply(&self, r: &[f64], z: &mut [f64]);
@@ -563,14 +639,6 @@ fn check_sizes(
 /// `initial` (zero if `None`). Every vector operation is parallel over
 /// entries and every inner product is summed in fixed chunks, so the
 /// iterates do not depend on the number of threads.
-///
-/// ```
-/// use hasse_solver::la::iterative::{preconditioned_cg, CgOptions, Jacobi, RowMatrix};
-/// let m = RowMatrix::from_rows(2, vec![vec![(0, 4.0), (1, 1.0)], vec![(0, 1.0), (1, 3.0)]]).unwrap();
-/// let jacobi = Jacobi::new(&m).unwrap();
-/// let (x, report) = preconditioned_cg(&m, &[1.0, 2.0], None, &CgOptions::default(), &jacobi).unwrap();
-/// assert!((4.0 * x[0] + x[1] - 1.0).abs() < 1e-12 && report.iterations <= 2);
-/// ```
 pub fn preconditioned_cg(
     matrix: &RowMatrix,
     rhs: &[f64],
@@ -741,5 +809,35 @@ mod tests {
             conjugate_gradient(&laplacian(100), &vec![1.0; 100], None, &options),
             Err(CgError::NotConverged { iterations: 3, .. })
         ));
+    }
+
+    #[test]
+    fn jacobi_cg_solves_a_small_laplacian_in_at_most_n_steps() {
+        // tridiag(−1, 2, −1) x = (1, 0, 1) has x = (1, 1, 1).
+        let t = [
+            (0, 0, 2.0),
+            (1, 1, 2.0),
+            (2, 2, 2.0),
+            (0, 1, -1.0),
+            (1, 0, -1.0),
+            (1, 2, -1.0),
+            (2, 1, -1.0),
+        ];
+        let triplets: Vec<_> = t.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+        let m = SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &triplets).unwrap();
+        let (x, report) =
+            conjugate_gradient(&m, &[1.0, 0.0, 1.0], None, &CgOptions::default()).unwrap();
+        assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-10));
+        assert!(report.iterations <= 3);
+    }
+
+    #[test]
+    fn preconditioned_cg_takes_any_preconditioner() {
+        let m = RowMatrix::from_rows(2, vec![vec![(0, 4.0), (1, 1.0)], vec![(0, 1.0), (1, 3.0)]])
+            .unwrap();
+        let jacobi = Jacobi::new(&m).unwrap();
+        let (x, report) =
+            preconditioned_cg(&m, &[1.0, 2.0], None, &CgOptions::default(), &jacobi).unwrap();
+        assert!((4.0 * x[0] + x[1] - 1.0).abs() < 1e-12 && report.iterations <= 2);
     }
 }

@@ -1,6 +1,8 @@
 //! Linear algebra: direct factorisations and their orderings, the
 //! row-stored matrix and conjugate gradients, eigenpairs.
 
+#![warn(missing_docs)]
+
 pub mod direct;
 pub mod eigen;
 pub mod fixed;

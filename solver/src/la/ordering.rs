@@ -5,12 +5,11 @@
 //! three-dimensional meshes it leaves much more fill than nested dissection,
 //! which splits the graph by small vertex separators and numbers the
 //! separators last, so the factor's fill stays inside the separator blocks.
-//! [`nested_dissection`] computes that ordering with METIS
-//! (`METIS_NodeND`, built from source by the `metis-sys` crate) and returns
-//! it as a faer [`Perm`], ready for
-//! `SymmetricOrdering::Custom` (see [`crate::la::ordering::Ordering`]).
+//! METIS (`METIS_NodeND`, built from source by the `metis-sys` crate)
+//! computes that ordering ([`Ordering::NestedDissection`]), returned as a
+//! faer [`Perm`] ready for `SymmetricOrdering::Custom`.
 //!
-//! [`coordinate_dissection`] is nested dissection from the unknowns'
+//! [`Ordering::Geometric`] is nested dissection from the unknowns'
 //! positions instead: each part is cut at the median of its longest axis,
 //! and the vertices on one side of the cut that touch the other side are
 //! the separator. It needs no graph partitioner, costs a few passes over the
@@ -58,11 +57,17 @@ use std::sync::atomic::Ordering::Relaxed;
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Ordering {
-    /// For LLᵀ with the unknowns' positions ([`UnknownPoints`], which
-    /// [`crate::physics::diffusion`] gives): geometric nested dissection. Without
-    /// them: AMD, or METIS nested dissection for LLᵀ systems on which AMD
-    /// fills at least [`ND_MIN_FILL_PER_UNKNOWN`] entries per unknown (3D
-    /// meshes from a few 10⁴ unknowns; see there). LDLᵀ and LBLᵀ: AMD.
+    /// For LLᵀ with the unknowns' positions (which
+    /// [`crate::physics::diffusion`] gives): geometric nested dissection.
+    /// Without them: AMD, or METIS nested dissection for LLᵀ systems on
+    /// which AMD fills at least 300 factor entries per unknown (3D meshes
+    /// from a few 10⁴ unknowns), keeping whichever factor is smaller. LDLᵀ
+    /// and LBLᵀ: AMD, whose pivot order [`crate::physics::darcy`] relies on.
+    ///
+    /// The threshold is measured, not derived: on the 2D and Delaunay
+    /// graphs measured AMD fills at most 68 entries per unknown and METIS's
+    /// own time outweighs its smaller factor; on 3D grids from 40³ AMD fills
+    /// 414 or more and nested dissection halves the factorisation time.
     ///
     /// Why the positions win, measured on whole `Diffusion::solve` runs
     /// (`HASSE_BENCH_ORDERING=amd|nd|geometric cargo bench --bench
@@ -77,14 +82,15 @@ pub enum Ordering {
     /// | 3D 60³ seven-point FV (`3d-60 solve`) | — | 1.44 + 2.42 | 0.23 + 2.89 |
     /// | 3D 60³ Q1 (`3d-60 q1-solve`) | — | 2.22 + 4.54 | 0.36 + 4.86 |
     ///
-    /// The table predates the diagonal cuts of
-    /// [`crate::la::ordering::coordinate_dissection`]. With them, two runs on
+    /// The table predates the diagonal cuts of the geometric ordering. With
+    /// them, two runs on
     /// a slower day gave 0.87 + 1.14 and 0.88 + 1.29 s on the five-point
     /// grid (factor 44.4 M entries instead of 68.4 M), against plain
     /// faer's AMD analysis and factorisation of 2.68 and 3.08 s in
     /// between, and 0.39 + 2.37 and 0.37 + 1.84 s on the seven-point one.
     ///
-    /// Factorisation work Σ c_j² ([`DirectSolver::factor_flops`]) against
+    /// Factorisation work Σ c_j²
+    /// ([`SolveReport::factor_flops`](crate::la::direct::SolveReport::factor_flops)) against
     /// AMD: 0.53× on the five-point grid, 0.35× on the nine-point one; on
     /// 3D grids 0.51× METIS's (seven-point) and 1.0× (Q1). The analysis
     /// costs a third to a tenth of AMD's or METIS's, which is what the
@@ -93,11 +99,14 @@ pub enum Ordering {
     Automatic,
     /// faer's approximate minimum degree.
     Amd,
-    /// METIS nested dissection ([`crate::la::ordering::nested_dissection`]).
+    /// METIS nested dissection of the matrix graph. Fails for graphs beyond
+    /// METIS's 32-bit indices ([`OrderingError::TooLarge`]).
     NestedDissection,
-    /// Nested dissection from the unknowns' positions
-    /// ([`crate::la::ordering::coordinate_dissection`]); needs
-    /// [`UnknownPoints`] ([`DirectSolver::analyse_pattern_at`]).
+    /// Nested dissection from the unknowns' positions: each part is cut at
+    /// the median of its widest axis or, where that gives a smaller
+    /// separator, of its widest diagonal. Needs the positions, which the
+    /// physics layer passes for nodal and cell-centred unknowns
+    /// ([`OrderingError::NoPoints`] otherwise).
     Geometric,
 }
 
@@ -106,7 +115,9 @@ pub enum Ordering {
 /// unknowns, a point inside each cell for cell-centred ones).
 #[derive(Clone, Copy, Debug)]
 pub struct UnknownPoints<'a> {
+    /// `dimension` coordinates per unknown, unknown after unknown.
     pub coordinates: &'a [f64],
+    /// Coordinates per point (the embedding dimension).
     pub dimension: usize,
 }
 
@@ -158,29 +169,58 @@ pub const ND_MIN_FILL_PER_UNKNOWN: usize = 300;
 
 /// Largest adjacency (sum of vertex degrees) METIS can index: the vendored
 /// METIS uses 32-bit `idx_t`.
-pub const METIS_MAX_ENTRIES: usize = i32::MAX as usize;
+pub(crate) const METIS_MAX_ENTRIES: usize = i32::MAX as usize;
 
 /// Why an ordering could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum OrderingError {
+    /// The pattern is not square, so it is not the graph of a symmetric
+    /// matrix.
     #[error("the pattern is {rows}×{cols}; a symmetric ordering needs a square pattern")]
-    NotSquare { rows: usize, cols: usize },
+    NotSquare {
+        /// Rows of the pattern.
+        rows: usize,
+        /// Columns of the pattern.
+        cols: usize,
+    },
+    /// The graph is too large for METIS's 32-bit indices; AMD has no such
+    /// limit.
     #[error("the matrix graph has {vertices} vertices and {entries} adjacency entries; METIS indexes with 32-bit integers and takes at most {limit} of each. Use the AMD ordering for systems this large")]
     TooLarge {
+        /// Vertices of the graph (unknowns).
         vertices: usize,
+        /// Adjacency entries (twice the edges) counted when the limit was
+        /// passed; 0 when the vertices alone pass it.
         entries: usize,
+        /// The largest count METIS takes, 2³¹ − 1.
         limit: usize,
     },
+    /// METIS returned an error code or a permutation that is not one (which
+    /// of them).
     #[error("METIS nested dissection failed: {0}")]
     Metis(&'static str),
+    /// The positions of the geometric ordering are not one point per
+    /// unknown.
     #[error("{found} coordinates given for {unknowns} unknowns in R^{dimension}; coordinate dissection needs one point per unknown")]
     PointCount {
+        /// Coordinates given.
         found: usize,
+        /// Unknowns of the pattern.
         unknowns: usize,
+        /// Coordinates per point.
         dimension: usize,
     },
+    /// A position of the geometric ordering is NaN or infinite.
     #[error("coordinate {index} of the unknowns' points is {value}; coordinate dissection needs finite positions")]
-    NonFinitePoint { index: usize, value: f64 },
+    NonFinitePoint {
+        /// Index of the coordinate in the flat list (point × dimension +
+        /// axis).
+        index: usize,
+        /// The coordinate.
+        value: f64,
+    },
+    /// [`Ordering::Geometric`] was asked for a system whose unknowns have
+    /// no positions (e.g. the face unknowns of the hybrid mimetic method).
     #[error("the geometric ordering needs the unknowns' positions, and this solve has none; use the \"auto\", \"amd\" or \"nested-dissection\" ordering")]
     NoPoints,
 }
@@ -673,7 +713,7 @@ fn diagonals_of(dimension: usize) -> &'static [[i8; 3]] {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Direction {
     Axis(usize),
-    /// Σ signs[a] x_a over the axes (zeros past the dimension).
+    /// Σ_a `signs[a]` x_a over the axes (zeros past the dimension).
     Diagonal([i8; 3]),
 }
 
@@ -737,7 +777,7 @@ fn partition(part: &mut [u32], keep: impl Fn(&u32) -> bool) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+    use faer::sparse::{SparseColMat, SymbolicSparseColMat, Triplet};
 
     /// A symbolic pattern from (row, col) pairs.
     fn pattern(n: usize, entries: &[(usize, usize)]) -> SymbolicSparseColMat<usize> {
@@ -1087,5 +1127,66 @@ mod tests {
             nested_dissection(a.symbolic()).unwrap_err(),
             OrderingError::NotSquare { rows: 2, cols: 3 }
         );
+    }
+
+    #[test]
+    fn the_adjacency_of_a_lower_triangle_is_symmetric() {
+        // Lower triangle of tridiag(−1, 2, −1), n = 3.
+        let t = [
+            (0, 0, 2.0),
+            (1, 0, -1.0),
+            (1, 1, 2.0),
+            (2, 1, -1.0),
+            (2, 2, 2.0),
+        ];
+        let t: Vec<_> = t.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &t).unwrap();
+        let g = Adjacency::of_pattern(a.symbolic()).unwrap();
+        assert_eq!(g.xadj, [0, 1, 3, 4]);
+        assert_eq!(g.adjncy, [1, 0, 2, 1]);
+    }
+
+    #[test]
+    fn nested_dissection_is_a_permutation_of_a_grid() {
+        // The five-point Laplacian's pattern on a 20×20 grid.
+        let m = 20;
+        let mut t = Vec::new();
+        for j in 0..m * m {
+            t.push(Triplet::new(j, j, 4.0));
+            if j % m + 1 < m {
+                t.push(Triplet::new(j + 1, j, -1.0));
+            }
+            if j + m < m * m {
+                t.push(Triplet::new(j + m, j, -1.0));
+            }
+        }
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(m * m, m * m, &t).unwrap();
+        let perm = nested_dissection(a.symbolic()).unwrap();
+        let (forward, inverse) = perm.arrays();
+        assert!((0..m * m).all(|k| inverse[forward[k]] == k));
+    }
+
+    #[test]
+    fn coordinate_dissection_numbers_the_diagonal_separator_last() {
+        // The five-point pattern of a 9×9 grid, vertex i + 9 j at (i, j).
+        let m = 9;
+        let mut t = Vec::new();
+        let mut points = Vec::new();
+        for j in 0..m * m {
+            t.push(Triplet::new(j, j, 4.0));
+            if j % m + 1 < m {
+                t.push(Triplet::new(j + 1, j, -1.0));
+            }
+            if j + m < m * m {
+                t.push(Triplet::new(j + m, j, -1.0));
+            }
+            points.extend([(j % m) as f64, (j / m) as f64]);
+        }
+        let a = SparseColMat::<usize, f64>::try_new_from_triplets(m * m, m * m, &t).unwrap();
+        let perm = coordinate_dissection(a.symbolic(), &points, 2).unwrap();
+        // The diagonal x + y = 8 separates with as few points (9) as the line
+        // x = 4; ties go to the diagonal, numbered last.
+        let (forward, _) = perm.arrays();
+        assert!(forward[m * m - m..].iter().all(|&v| v % m + v / m == 8));
     }
 }

@@ -18,20 +18,20 @@ pub fn isotropic(lambda: f64) -> Tensor {
 /// tensor per cell. Slices and vectors of either convert with `into()`, so
 /// every metric takes `&tensors` for a `Vec<Tensor>` or a `Vec<f64>`.
 ///
-/// A value remembers that it passed [`CellTensors::checked`] for a number
-/// of cells and a dimension: a metric given such a value does not check it
-/// again.
+/// A value remembers that it passed the check of [`check_tensors`] for a
+/// number of cells and a dimension: the problem layer checks once per
+/// assembly, and a metric given such a value does not check it again.
 ///
 /// ```
 /// use hasse_complex::generate::rectangle;
-/// use hasse_solver::metric::{fv, isotropic, CellTensors};
+/// use hasse_solver::metric::{check_tensors, fv, isotropic, CellTensors};
 /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
 /// // The same two-point fluxes from scalars and from the tensors λ·I.
 /// let from_scalars = fv::two_point(&k, &vec![2.0, 3.0]).unwrap();
 /// let from_tensors = fv::two_point(&k, &vec![isotropic(2.0), isotropic(3.0)]).unwrap();
 /// assert_eq!(from_scalars, from_tensors);
 /// // A check names the first bad cell.
-/// let bad = CellTensors::from(&[1.0, -1.0][..]).checked(2, 2).unwrap_err();
+/// let bad = check_tensors(CellTensors::from(&[1.0, -1.0][..]), 2, 2).unwrap_err();
 /// assert!(bad.to_string().contains("top cell 1"));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -181,8 +181,22 @@ impl<'a, const N: usize> From<&'a [f64; N]> for CellTensors<'a> {
     }
 }
 
-/// Check one tensor per top cell, symmetric positive definite in R^d (see
-/// [`CellTensors::checked`]).
+/// Check that there is one coefficient per each of `cells` top cells and
+/// that each is symmetric positive definite in R^`d` (its leading d×d
+/// block, by Sylvester's criterion on the symmetric part); the first bad
+/// cell in cell order is reported. Every metric makes this check itself,
+/// once per assembly.
+///
+/// ```
+/// use hasse_solver::metric::{check_tensors, isotropic, MetricError};
+/// // [[1, 2], [2, 1]] has eigenvalues 3 and −1: not positive definite.
+/// let bad = [[1.0, 2.0, 0.0], [2.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// assert!(check_tensors(&vec![isotropic(1.0), isotropic(2.0)], 2, 2).is_ok());
+/// let error = check_tensors(&vec![isotropic(1.0), bad], 2, 2).unwrap_err();
+/// assert!(matches!(error, MetricError::NotPositive { cell: 1, .. }));
+/// // In R¹ only the leading 1×1 block counts.
+/// assert!(check_tensors(&vec![bad], 1, 1).is_ok());
+/// ```
 pub fn check_tensors<'a>(
     tensors: impl Into<CellTensors<'a>>,
     cells: usize,

@@ -100,6 +100,18 @@ impl FromStr for Method {
 }
 
 /// Where the unknowns of a method live.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::mass::lumped;
+/// use hasse_solver::metric::Location;
+/// // A 2×1 grid of unit squares: 6 vertices, 2 cells of area 1.
+/// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// assert_eq!(lumped(&k, Location::Nodal).unwrap().len(), 6);
+/// assert_eq!(lumped(&k, Location::CellCentred), Some(vec![1.0, 1.0]));
+/// // Face unknowns stand for no volume.
+/// assert_eq!(lumped(&k, Location::Hybrid), None);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Location {
     /// On vertices (0-cells).

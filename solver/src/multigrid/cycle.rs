@@ -23,7 +23,9 @@ pub(super) const ROW_CHUNK: usize = 4096;
 /// Sizes of one level, for reports.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LevelInfo {
+    /// Unknowns of the level (rows of its operator).
     pub unknowns: usize,
+    /// Stored entries of the level's operator.
     pub nonzeros: usize,
     /// Whether the prolongation to this level came from aggregation.
     pub algebraic: bool,
@@ -66,14 +68,46 @@ struct Scratch {
     e: Vec<f64>,
 }
 
-/// A multigrid hierarchy, ready to be applied as a preconditioner.
+/// A multigrid hierarchy, ready to be applied as a preconditioner: one
+/// V-cycle per [`Preconditioner::apply`].
+///
+/// ```
+/// use hasse_solver::la::iterative::{Preconditioner, RowMatrix};
+/// use hasse_solver::multigrid::{Multigrid, MultigridOptions};
+/// // The 1D Dirichlet Laplacian tridiag(−1, 2, −1) on 200 unknowns.
+/// let n = 200;
+/// let rows = (0..n)
+///     .map(|i| {
+///         let mut row = vec![(i, 2.0)];
+///         if i > 0 { row.insert(0, (i - 1, -1.0)); }
+///         if i + 1 < n { row.push((i + 1, -1.0)); }
+///         row
+///     })
+///     .collect();
+/// let m = RowMatrix::from_rows(n, rows).unwrap();
+/// let options = MultigridOptions { coarse_size: 10, ..Default::default() };
+/// let mg = Multigrid::algebraic(m, &options).unwrap();
+/// let levels = mg.levels();
+/// assert!(levels.len() >= 3 && levels[0].unknowns == n && levels[1].algebraic);
+/// // The same smoother before and after the coarse correction makes the
+/// // cycle a symmetric operator B, as conjugate gradients need: eᵢᵀ B eⱼ = eⱼᵀ B eᵢ.
+/// let column = |j: usize| {
+///     let mut e = vec![0.0; n];
+///     e[j] = 1.0;
+///     let mut z = vec![0.0; n];
+///     mg.apply(&e, &mut z);
+///     z
+/// };
+/// let (b3, b70) = (column(3), column(70));
+/// assert!((b3[70] - b70[3]).abs() < 1e-12 * b3[3].abs());
+/// ```
 pub struct Multigrid {
     levels: Vec<Level>,
     coarse: Coarse,
     smoother: Smoother,
     work: Mutex<Vec<Work>>,
     /// Seconds spent building the hierarchy.
-    pub setup_seconds: f64,
+    pub(crate) setup_seconds: f64,
 }
 
 fn inverse_diagonal(matrix: &RowMatrix, level: usize) -> Result<Vec<f64>, MultigridError> {
@@ -209,9 +243,9 @@ fn largest_ritz(alphas: &[f64], betas: &[f64]) -> f64 {
 impl Multigrid {
     /// Build the hierarchy of `matrix` (symmetric positive definite) from
     /// `prolongations` (finest first, already restricted to the unknowns
-    /// of `matrix`, see [`restrict_to_free`]), continued by smoothed
-    /// aggregation while the coarsest level is larger than
-    /// `options.coarse_size`.
+    /// of `matrix`, see [`restrict_to_free`](super::restrict_to_free)),
+    /// continued by smoothed aggregation while the coarsest level is larger
+    /// than `options.coarse_size`.
     pub fn new(
         matrix: RowMatrix,
         prolongations: Vec<Prolongation>,
@@ -347,7 +381,7 @@ impl Multigrid {
     }
 
     /// The operator of the finest level.
-    pub fn matrix(&self) -> &RowMatrix {
+    pub(crate) fn matrix(&self) -> &RowMatrix {
         self.levels
             .first()
             .map_or(&self.coarse.matrix, |l| &l.matrix)

@@ -46,30 +46,8 @@
 //! runs in parallel over rows with rayon, and every inner product sums in
 //! fixed chunks: the result has the same bits for any number of threads.
 //! The coarsest level is factorised (faer sparse LLᵀ, sequential).
-//!
-//! ```
-//! use hasse_solver::la::iterative::{CgOptions, RowMatrix};
-//! use hasse_solver::multigrid::{Hierarchy, Multigrid, MultigridOptions};
-//! // The 1D Dirichlet Laplacian on 64 cells (cell-centred, ghost at both ends).
-//! let n = 64;
-//! let rows = (0..n)
-//!     .map(|i| {
-//!         let mut row = vec![(i, if i == 0 || i == n - 1 { 3.0 } else { 2.0 })];
-//!         if i > 0 { row.push((i - 1, -1.0)); }
-//!         if i + 1 < n { row.push((i + 1, -1.0)); }
-//!         row.sort_by_key(|e| e.0);
-//!         row
-//!     })
-//!     .collect();
-//! let m = RowMatrix::from_rows(n, rows).unwrap();
-//! let options = MultigridOptions { coarse_size: 4, ..Default::default() };
-//! let p = Hierarchy::Grid { cells: vec![n] }.prolongations(n).unwrap();
-//! let mg = Multigrid::new(m, p, &options).unwrap();
-//! assert!(mg.levels().len() > 3);
-//! let cg = CgOptions { tolerance: 1e-10, max_iterations: 50 };
-//! let (_, report) = mg.solve(&vec![1.0; n], None, &cg).unwrap();
-//! assert!(report.iterations < 15);
-//! ```
+
+#![warn(missing_docs)]
 
 use crate::la::iterative::CgError;
 
@@ -86,32 +64,76 @@ pub use transfer::{
 };
 
 /// The smoother of every level but the coarsest.
+///
+/// ```
+/// use hasse_solver::la::iterative::RowMatrix;
+/// use hasse_solver::multigrid::{Multigrid, MultigridError, MultigridOptions, Smoother};
+/// let m = RowMatrix::from_rows(2, vec![vec![(0, 2.0), (1, -1.0)], vec![(0, -1.0), (1, 2.0)]]).unwrap();
+/// // The damping ω of Jacobi must lie in (0, 2).
+/// let options = MultigridOptions {
+///     smoother: Smoother::Jacobi { omega: 2.5, sweeps: 1 },
+///     ..Default::default()
+/// };
+/// let error = Multigrid::algebraic(m, &options).err().unwrap();
+/// assert!(matches!(error, MultigridError::Option { option: "smoother", .. }));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Smoother {
     /// `sweeps` steps of x ← x + ω D⁻¹(b − M x) before and after the
     /// coarse correction.
-    Jacobi { omega: f64, sweeps: usize },
+    Jacobi {
+        /// The damping ω, in (0, 2).
+        omega: f64,
+        /// Steps before and after the coarse correction, at least one.
+        sweeps: usize,
+    },
     /// The Chebyshev polynomial of `degree` in D⁻¹M that is smallest on
-    /// [λ/ratio, λ], λ an upper bound of the spectrum of D⁻¹M (estimated by
-    /// power iteration, widened by 10 %, capped by Gershgorin's bound); the
-    /// modes below λ/ratio are left to the coarse levels.
-    Chebyshev { degree: usize, ratio: f64 },
+    /// [λ/ratio, λ], λ an upper bound of the spectrum of D⁻¹M (the largest
+    /// Ritz value of a few Lanczos steps, widened by 10 %, capped by
+    /// Gershgorin's bound); the modes below λ/ratio are left to the coarse
+    /// levels.
+    Chebyshev {
+        /// Degree of the polynomial (products with M per smoothing), at
+        /// least 1.
+        degree: usize,
+        /// λ_max / λ_min of the interval smoothed, above 1.
+        ratio: f64,
+    },
 }
 
 /// How cell-centred (piecewise-constant) prolongations are used; see the
 /// module documentation.
+///
+/// ```
+/// use hasse_solver::la::iterative::RowMatrix;
+/// use hasse_solver::multigrid::{CellProlongation, Multigrid, MultigridError, MultigridOptions};
+/// let m = RowMatrix::from_rows(1, vec![vec![(0, 1.0)]]).unwrap();
+/// // The factor of the coarse correction must lie in (0, 2.5).
+/// let options = MultigridOptions {
+///     cell_prolongation: CellProlongation::Constant { correction: 3.0 },
+///     ..Default::default()
+/// };
+/// assert!(matches!(
+///     Multigrid::algebraic(m, &options),
+///     Err(MultigridError::Option { option: "cell_prolongation", .. })
+/// ));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CellProlongation {
     /// P = (I − ω D⁻¹ M) P₀, ω = 4/(3λ): mesh-independent V-cycle counts.
     Smoothed,
     /// P₀ as is, the coarse correction multiplied by `correction` (about
     /// 2 undoes the stiffness of the Galerkin operator; 1 is plain).
-    Constant { correction: f64 },
+    Constant {
+        /// The factor of the coarse correction, in (0, 2.5).
+        correction: f64,
+    },
 }
 
 /// Settings of a multigrid hierarchy.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MultigridOptions {
+    /// The smoother of every level but the coarsest.
     pub smoother: Smoother,
     /// Levels with at most this many unknowns are factorised directly.
     pub coarse_size: usize,
@@ -120,6 +142,7 @@ pub struct MultigridOptions {
     /// Strength of connection of the algebraic levels: j is a strong
     /// neighbour of i when a_ij² ≥ θ² |a_ii a_jj|.
     pub strength: f64,
+    /// How cell-centred prolongations of a geometric hierarchy are used.
     pub cell_prolongation: CellProlongation,
 }
 
@@ -141,27 +164,58 @@ impl Default for MultigridOptions {
 /// Why a multigrid setup or solve failed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MultigridError {
+    /// A prolongation does not fit the level it prolongs to (a hierarchy
+    /// built for another mesh, or refinements listed out of order).
     #[error("multigrid level {level}: the prolongation has {found} rows but the level has {expected} unknowns")]
     Size {
+        /// The level, 0 the finest.
         level: usize,
+        /// Unknowns of the level.
         expected: usize,
+        /// Rows of the prolongation.
         found: usize,
     },
+    /// The hierarchy's mesh does not say what the system's unknowns are:
+    /// it has neither as many vertices nor as many top cells as the system
+    /// has unknowns (or, after refinements, as many of both).
     #[error("the multigrid hierarchy does not fit the system with {unknowns} unknowns: {detail}")]
-    Mismatch { unknowns: usize, detail: String },
-    #[error("multigrid level {level}: diagonal entry {index} is {value}, not positive: the matrix is not symmetric positive definite")]
-    NotPositive {
-        level: usize,
-        index: usize,
-        value: f64,
-    },
-    #[error("multigrid coarsest level ({size} unknowns): {detail}")]
-    Coarse { size: usize, detail: String },
-    #[error("multigrid option {option}: {detail}")]
-    Option {
-        option: &'static str,
+    Mismatch {
+        /// Unknowns of the system.
+        unknowns: usize,
+        /// What the hierarchy has instead.
         detail: String,
     },
+    /// A level's operator has a diagonal entry ≤ 0 or NaN, which no
+    /// symmetric positive definite matrix has.
+    #[error("multigrid level {level}: diagonal entry {index} is {value}, not positive: the matrix is not symmetric positive definite")]
+    NotPositive {
+        /// The level, 0 the finest.
+        level: usize,
+        /// Row of the entry.
+        index: usize,
+        /// The entry.
+        value: f64,
+    },
+    /// The coarsest level could not be factorised (LLᵀ), e.g. because the
+    /// system is singular.
+    #[error("multigrid coarsest level ({size} unknowns): {detail}")]
+    Coarse {
+        /// Unknowns of the coarsest level.
+        size: usize,
+        /// What failed.
+        detail: String,
+    },
+    /// An option is out of its range: a field of [`MultigridOptions`], or
+    /// the cell counts of a [`Hierarchy::Grid`].
+    #[error("multigrid option {option}: {detail}")]
+    Option {
+        /// The field, or "grid cells" for the cell counts of a grid
+        /// hierarchy.
+        option: &'static str,
+        /// The range and the value given.
+        detail: String,
+    },
+    /// The conjugate gradients that the V-cycle preconditions failed.
     #[error(transparent)]
     Cg(#[from] CgError),
 }
@@ -204,6 +258,32 @@ fn check_options(options: &MultigridOptions) -> Result<(), MultigridError> {
 }
 
 /// How to solve a symmetric positive definite system.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::multigrid::{Hierarchy, SolverChoice};
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// let mesh = rectangle(16, 16, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let problem = |choice| {
+///     Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+///         .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+///         .with_solver(choice, 1e-10, &mesh)
+///         .solve(&mesh)
+///         .unwrap()
+/// };
+/// // A 2D problem: the automatic rule factorises, so there are no CG iterations.
+/// let direct = problem(SolverChoice::Auto(None));
+/// assert!(direct.iterations.is_none());
+/// let grid = Hierarchy::Grid { cells: vec![16, 16] };
+/// let multigrid = problem(SolverChoice::Multigrid(grid));
+/// assert!(multigrid.iterations.unwrap().relative_residual <= 1e-10);
+/// for (a, b) in direct.values.iter().zip(&multigrid.values) {
+///     assert!((a - b).abs() < 1e-8);
+/// }
+/// ```
 #[derive(Clone, Debug)]
 pub enum SolverChoice {
     /// Sparse LLᵀ.

@@ -1,7 +1,7 @@
 //! Tests of the multigrid hierarchy and cycle.
 
 use super::cycle::spectral_bound;
-use super::transfer::grid_prolongation;
+use super::transfer::{grid_prolongation, grid_prolongations, Transfer};
 use super::*;
 use crate::la::fixed::FixedSplit;
 use crate::la::iterative::RowMatrix;
@@ -119,4 +119,45 @@ fn the_spectral_bound_covers_the_spectrum() {
     let lambda = spectral_bound(&m, &vec![0.5; n]);
     let top = 1.0 - (n as f64 * std::f64::consts::PI / (n + 1) as f64).cos();
     assert!(lambda >= top && lambda <= 2.0, "{lambda} vs {top}");
+}
+
+#[test]
+fn a_grid_hierarchy_solves_the_1d_laplacian_in_few_iterations() {
+    use crate::la::iterative::CgOptions;
+    // The 1D Dirichlet Laplacian on 64 cells (cell-centred, ghost at both ends).
+    let n = 64;
+    let rows = (0..n)
+        .map(|i| {
+            let mut row = vec![(i, if i == 0 || i == n - 1 { 3.0 } else { 2.0 })];
+            if i > 0 {
+                row.push((i - 1, -1.0));
+            }
+            if i + 1 < n {
+                row.push((i + 1, -1.0));
+            }
+            row.sort_by_key(|e| e.0);
+            row
+        })
+        .collect();
+    let m = RowMatrix::from_rows(n, rows).unwrap();
+    let options = MultigridOptions {
+        coarse_size: 4,
+        ..Default::default()
+    };
+    let p = Hierarchy::Grid { cells: vec![n] }.prolongations(n).unwrap();
+    let mg = Multigrid::new(m, p, &options).unwrap();
+    assert!(mg.levels().len() > 3);
+    let cg = CgOptions {
+        tolerance: 1e-10,
+        max_iterations: 50,
+    };
+    let (_, report) = mg.solve(&vec![1.0; n], None, &cg).unwrap();
+    assert!(report.iterations < 15);
+}
+
+#[test]
+fn grid_prolongations_stop_before_an_axis_of_one_cell() {
+    let p = grid_prolongations(&[8, 4], Transfer::Nodal).unwrap();
+    assert_eq!(p.len(), 1); // 8×4 → 4×2, then stop: 2×1 would have an axis of one cell
+    assert_eq!((p[0].matrix.nrows(), p[0].matrix.ncols()), (45, 15));
 }

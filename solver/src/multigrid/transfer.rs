@@ -23,16 +23,47 @@ pub enum Transfer {
 /// One prolongation P (fine × coarse) of a hierarchy.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Prolongation {
+    /// P, fine unknowns × coarse unknowns.
     pub matrix: RowMatrix,
+    /// What the unknowns are, which decides how fixed ones carry over to
+    /// the coarse level.
     pub transfer: Transfer,
 }
 
 /// Where the prolongations of a multigrid come from.
+///
+/// The hierarchy describes the whole mesh; whether its levels carry nodal
+/// or cell unknowns is read from the size of the system it is used for.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::multigrid::{Hierarchy, MultigridError, SolverChoice};
+/// use hasse_solver::physics::diffusion::{Diffusion, DiffusionError};
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// let mesh = rectangle(16, 16, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// // A hierarchy of the wrong grid: 8×8 has 64 cells and 81 vertices, the
+/// // system 256 cell unknowns.
+/// let wrong = Hierarchy::Grid { cells: vec![8, 8] };
+/// let result = Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+///     .with_solver(SolverChoice::Multigrid(wrong), 1e-8, &mesh)
+///     .solve(&mesh);
+/// assert!(matches!(
+///     result,
+///     Err(DiffusionError::Multigrid(MultigridError::Mismatch { unknowns: 256, .. }))
+/// ));
+/// ```
 #[derive(Clone, Debug)]
 pub enum Hierarchy {
     /// A structured grid from `generate::grid`/`rectangle`/`box3` with
     /// `cells[a]` cells along axis a, numbered x fastest.
-    Grid { cells: Vec<usize> },
+    Grid {
+        /// Cells along each axis, x first. Every axis is halved as long as
+        /// every count is even and the halves keep at least 2 cells.
+        cells: Vec<usize>,
+    },
     /// The SPLIT refinements that made the mesh, in the order they were
     /// applied (the first one refines the coarsest mesh). Compose several
     /// SPLITs of one refinement step into one with [`Refinement::compose`].
@@ -99,13 +130,6 @@ impl Hierarchy {
 /// Prolongations of a structured grid with `cells[a]` cells per axis (x
 /// fastest), finest first, halving every axis while all counts are even
 /// and at least 2 after halving.
-///
-/// ```
-/// use hasse_solver::multigrid::{grid_prolongations, Transfer};
-/// let p = grid_prolongations(&[8, 4], Transfer::Nodal).unwrap();
-/// assert_eq!(p.len(), 1); // 8×4 → 4×2, then stop: 2×1 would have an axis of one cell
-/// assert_eq!((p[0].matrix.nrows(), p[0].matrix.ncols()), (45, 15));
-/// ```
 pub fn grid_prolongations(
     cells: &[usize],
     transfer: Transfer,

@@ -18,6 +18,29 @@ use crate::operator::Canonical;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 
 /// Whether the block matrix is symmetric (upper blocks given, mirrored).
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_solver::la::direct::Factorization;
+/// use hasse_solver::operator::block::{BlockError, BlockSystem, Symmetry};
+/// let m = |e: &[(usize, usize, f64)]| {
+///     let t: Vec<_> = e.iter().map(|&(i, j, v)| Triplet::new(i, j, v)).collect();
+///     SparseColMat::<usize, f64>::try_new_from_triplets(1, 1, &t).unwrap()
+/// };
+/// // [[1, 2], [3, 4]] over two fields of one unknown: every block given.
+/// let blocks = vec![
+///     (0, 0, m(&[(0, 0, 1.0)]).into()),
+///     (0, 1, m(&[(0, 0, 2.0)]).into()),
+///     (1, 0, m(&[(0, 0, 3.0)]).into()),
+///     (1, 1, m(&[(0, 0, 4.0)]).into()),
+/// ];
+/// let mut system = BlockSystem::new(&[1, 1], Symmetry::General, blocks).unwrap();
+/// // A general system has no symmetric factorisation; LU solves it:
+/// // x = M⁻¹ (3, 7) = (1, 1).
+/// assert!(matches!(system.factorize(Factorization::Llt), Err(BlockError::NeedsSymmetric { .. })));
+/// let x = system.solve(Factorization::Lu, &[3.0, 7.0]).unwrap();
+/// assert!((x[0] - 1.0).abs() < 1e-14 && (x[1] - 1.0).abs() < 1e-14);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Symmetry {
     /// Blocks (i, j) with i ≤ j are given; (j, i) is the transpose of (i, j).
@@ -27,6 +50,23 @@ pub enum Symmetry {
 }
 
 /// The values of one block.
+///
+/// ```
+/// use faer::sparse::{SparseColMat, Triplet};
+/// use hasse_complex::generate::interval;
+/// use hasse_solver::metric::fd;
+/// use hasse_solver::operator::block::{Block, BlockSystem, Symmetry};
+/// use hasse_solver::operator::Canonical;
+/// // Two blocks at the same place add up: I + Aᵀ Ω A with A = δ⁰ of a
+/// // path of three vertices and Ω = diag(2, 2).
+/// let k = interval(2, 0.0, 1.0).unwrap();
+/// let stiffness = Canonical::new(k.coboundary(0), fd::from_face_values(&[2.0, 2.0])).unwrap();
+/// let identity: Vec<_> = (0..3).map(|i| Triplet::new(i, i, 1.0)).collect();
+/// let identity = SparseColMat::<usize, f64>::try_new_from_triplets(3, 3, &identity).unwrap();
+/// let blocks = vec![(0, 0, Block::Sparse(identity)), (0, 0, Block::Canonical(stiffness))];
+/// let m = BlockSystem::new(&[3], Symmetry::Symmetric, blocks).unwrap().matrix().to_dense();
+/// assert_eq!((m[(0, 0)], m[(1, 1)], m[(0, 1)]), (3.0, 5.0, -2.0));
+/// ```
 #[derive(Clone, Debug)]
 pub enum Block {
     /// A sparse matrix, used as it is.
@@ -59,41 +99,90 @@ impl From<Canonical> for Block {
 /// Why a block system could not be built or solved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BlockError {
+    /// A block is placed at a field the system does not have.
     #[error("block {block} is placed at field ({row_field}, {col_field}), but there are only {fields} fields")]
     FieldOutOfRange {
+        /// The block, in the order given.
         block: usize,
+        /// Its row field.
         row_field: usize,
+        /// Its column field.
         col_field: usize,
+        /// Fields of the system.
         fields: usize,
     },
+    /// A block's shape is not (unknowns of its row field) × (unknowns of
+    /// its column field).
     #[error("block {block} at ({row_field}, {col_field}) is {rows}×{cols}, but fields {row_field} and {col_field} have {expected_rows} and {expected_cols} unknowns")]
     SizeMismatch {
+        /// The block, in the order given.
         block: usize,
+        /// Its row field.
         row_field: usize,
+        /// Its column field.
         col_field: usize,
+        /// Its rows.
         rows: usize,
+        /// Its columns.
         cols: usize,
+        /// Unknowns of the row field.
         expected_rows: usize,
+        /// Unknowns of the column field.
         expected_cols: usize,
     },
+    /// A symmetric system was given a block below the block diagonal; only
+    /// the upper ones are given, each mirrored.
     #[error("block {block} sits below the diagonal at ({row_field}, {col_field}) of a symmetric system; give the block at ({col_field}, {row_field}) instead (it is mirrored)")]
     LowerBlock {
+        /// The block, in the order given.
         block: usize,
+        /// Its row field.
         row_field: usize,
+        /// Its column field, smaller than the row field.
         col_field: usize,
     },
+    /// A diagonal block of a symmetric system differs from its transpose by
+    /// more than 10⁻¹² of its largest entry.
     #[error(
         "block {block} on the diagonal of a symmetric system (field {field}) is not symmetric"
     )]
-    NotSymmetric { block: usize, field: usize },
+    NotSymmetric {
+        /// The block, in the order given.
+        block: usize,
+        /// The field it sits on.
+        field: usize,
+    },
+    /// A block holds NaN or ±∞.
     #[error("block {block} has a non-finite value")]
-    NonFinite { block: usize },
+    NonFinite {
+        /// The block, in the order given.
+        block: usize,
+    },
+    /// New values of a block ([`BlockSystem::set_block`]) have another
+    /// sparsity pattern than the block was placed with, so they have no
+    /// place in the system's pattern.
     #[error("new values of block {block} do not have the sparsity pattern it was placed with")]
-    PatternChanged { block: usize },
+    PatternChanged {
+        /// The block.
+        block: usize,
+    },
+    /// [`BlockSystem::set_block`] was given a block number the system
+    /// does not have.
     #[error("there is no block {block} (the system has {count})")]
-    NoSuchBlock { block: usize, count: usize },
+    NoSuchBlock {
+        /// The block number given.
+        block: usize,
+        /// Blocks of the system.
+        count: usize,
+    },
+    /// A symmetric factorisation (LLᵀ, LDLᵀ, LBLᵀ) was asked for a
+    /// [`Symmetry::General`] system.
     #[error("{factorization} needs a symmetric system; use Factorization::Lu for a general one")]
-    NeedsSymmetric { factorization: Factorization },
+    NeedsSymmetric {
+        /// The factorisation asked for.
+        factorization: Factorization,
+    },
+    /// The analysis, factorisation or solve failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
 }

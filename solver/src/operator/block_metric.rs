@@ -98,11 +98,24 @@ impl SquareBlocks {
 /// The metric Ω as a sum of dense blocks over rows of A.
 ///
 /// ```
-/// use hasse_solver::operator::BlockMetric;
-/// let mut omega = BlockMetric::new(3);
-/// omega.push_symmetric(&[0, 2], &[2.0, -1.0, -1.0, 2.0]);
-/// omega.push_block(&[1], &[1], &[5.0]);
-/// assert_eq!(omega.apply(&[1.0, 1.0, 1.0]), vec![1.0, 5.0, 1.0]);
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::fe;
+/// use hasse_solver::operator::Canonical;
+/// // Q1 on one unit square: one dense 4×4 block over the square's edges.
+/// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let omega = fe::stiffness_metric(&k, &[1.0]).unwrap();
+/// assert_eq!((omega.size(), omega.block_count()), (4, 1));
+/// let (rows, cols, values) = omega.block(0);
+/// assert_eq!((rows.len(), cols, values.len()), (4, rows, 16));
+/// assert!(omega.is_symmetric(1e-14));
+/// // δ⁰ᵀ Ω δ⁰ is the Q1 stiffness matrix: 2/3 on the diagonal, −1/6 along
+/// // an edge, −1/3 across the diagonal.
+/// let m = Canonical::new(k.coboundary(0), omega).unwrap().assemble().to_dense();
+/// let mut row: Vec<f64> = (0..4).map(|j| m[(0, j)]).collect();
+/// row.sort_by(f64::total_cmp);
+/// for (a, b) in row.iter().zip([-1.0 / 3.0, -1.0 / 6.0, -1.0 / 6.0, 2.0 / 3.0]) {
+///     assert!((a - b).abs() < 1e-14);
+/// }
 /// ```
 #[derive(Clone, Debug, Default)]
 pub struct BlockMetric {
@@ -172,8 +185,8 @@ impl BlockMetric {
 
     /// The weights w when Ω = diag(w) with block b the 1×1 block (b, b)
     /// for b < w.len() (rows beyond have no block); `None` for any other
-    /// layout of blocks. [`Canonical`] assembles such an Ω column by
-    /// column, from A stored by columns.
+    /// layout of blocks. [`Canonical`](super::Canonical) assembles such an
+    /// Ω column by column, from A stored by columns.
     ///
     /// ```
     /// use hasse_solver::operator::BlockMetric;
@@ -203,6 +216,8 @@ impl BlockMetric {
     /// after those of the one before (see [`Canonical::sum`]); a list of
     /// diagonal metrics stays diagonal.
     ///
+    /// [`Canonical::sum`]: super::Canonical::sum
+    ///
     /// ```
     /// use hasse_solver::operator::BlockMetric;
     /// let mut dense = BlockMetric::new(2);
@@ -210,8 +225,6 @@ impl BlockMetric {
     /// let both = BlockMetric::stacked(&[(2.0, &BlockMetric::diagonal(&[1.0])), (0.5, &dense)]);
     /// assert_eq!(both.to_dense(), vec![vec![2.0, 0.0, 0.0], vec![0.0, 1.0, -0.5], vec![0.0, -0.5, 1.0]]);
     /// ```
-    ///
-    /// [`Canonical::sum`]: super::Canonical::sum
     pub fn stacked(parts: &[(f64, &BlockMetric)]) -> Self {
         let size = parts.iter().map(|(_, m)| m.size).sum();
         let diagonal: Option<Vec<f64>> = parts
@@ -246,18 +259,18 @@ impl BlockMetric {
 
     /// Ω from square blocks over the same rows and columns, laid out back
     /// to back: block b covers the rows `indices[ptr[b]..ptr[b + 1]]` and
-    /// its values (m_b × m_b row-major, m_b = ptr[b + 1] − ptr[b]) are
+    /// its values (m_b × m_b row-major, m_b = `ptr[b + 1] − ptr[b]`) are
     /// `values[value_ptr[b]..value_ptr[b + 1]]`, following those of block
     /// b − 1. Builders that know their block sizes in advance write them in
     /// place (and in parallel) this way. `per_cell` says that block b is
     /// over the edges of top cell b of a complex, for every b
-    /// ([`Canonical::with_cell_blocks`]).
+    /// ([`Canonical::with_cell_blocks`](super::Canonical::with_cell_blocks)).
     ///
     /// The caller guarantees that every block is exactly symmetric and
     /// finite (the FE builders mirror each block and reject a cell with a
     /// non-finite one), so [`BlockMetric::is_symmetric`] and the finiteness
-    /// check of [`Canonical`] need not read the values; debug builds check
-    /// it here.
+    /// check of [`Canonical`](super::Canonical) need not read the values;
+    /// debug builds check it here.
     pub(crate) fn from_symmetric_blocks(
         size: usize,
         ptr: Vec<usize>,
@@ -390,7 +403,8 @@ impl BlockMetric {
         }
     }
 
-    /// Rows, columns and values of block `b`.
+    /// Rows, columns and values of block `b`, the values row-major
+    /// (|rows| × |cols|).
     pub fn block(&self, b: usize) -> (&[usize], &[usize], &[f64]) {
         if let Some(square) = &self.square {
             let rows = square.rows(&self.indices, b);
@@ -432,7 +446,7 @@ impl BlockMetric {
     }
 
     /// Mutable values of block `b` (row-major).
-    pub fn block_values_mut(&mut self, b: usize) -> &mut [f64] {
+    pub(crate) fn block_values_mut(&mut self, b: usize) -> &mut [f64] {
         self.exact = false;
         if let Some(square) = &self.square {
             return &mut self.values[square.value_ptr[b]..square.value_ptr[b + 1]];

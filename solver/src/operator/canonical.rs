@@ -10,15 +10,16 @@ use sprs::CsMat;
 use std::sync::{Arc, OnceLock};
 
 /// M = Aᵀ Ω A with its assembly pattern, or, for a block that couples two
-/// sets of unknowns, M = Aᵀ Ω B with a second incidence matrix B over the
-/// same rows ([`Canonical::coupling`]).
+/// sets of unknowns (the flux–pressure block of mixed Darcy flow), M =
+/// Aᵀ Ω B with a second incidence matrix B over the same rows.
 ///
 /// ```
-/// use hasse_solver::operator::{BlockMetric, Canonical};
+/// use hasse_solver::metric::fd;
+/// use hasse_solver::operator::Canonical;
 /// // A = ∂_1ᵀ of a path of 3 vertices (2 edges), Ω = identity:
 /// // Aᵀ A is the graph Laplacian tridiag(−1, 2, −1) without the end rows.
 /// let a = sprs::CsMat::new((2, 3), vec![0, 2, 4], vec![0, 1, 1, 2], vec![-1i8, 1, -1, 1]);
-/// let op = Canonical::new(a, BlockMetric::diagonal(&[1.0, 1.0])).unwrap();
+/// let op = Canonical::new(a, fd::from_face_values(&[1.0, 1.0])).unwrap();
 /// let m = op.assemble();
 /// assert_eq!(m.to_dense()[(1, 1)], 2.0);
 /// assert_eq!(m.to_dense()[(0, 1)], -1.0);
@@ -356,10 +357,11 @@ impl Canonical {
     ///
     /// ```
     /// use hasse_complex::generate::rectangle;
-    /// use hasse_solver::operator::{BlockMetric, Canonical};
+    /// use hasse_solver::metric::fd;
+    /// use hasse_solver::operator::Canonical;
     /// let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
     /// let faces = k.cell_count(1);
-    /// let mut op = Canonical::new(k.shared_boundary(2), BlockMetric::diagonal(&vec![1.0; faces])).unwrap();
+    /// let mut op = Canonical::new(k.shared_boundary(2), fd::from_face_values(&vec![1.0; faces])).unwrap();
     /// let last = op.assemble_owned();
     /// // A later assembly builds the same pattern again.
     /// let again = op.assemble();

@@ -21,6 +21,8 @@
 //! `pattern` builds the sparsity of M once, `values` forms M's values, and
 //! [`block`] places several operators in one block system.
 
+#![warn(missing_docs)]
+
 pub mod block;
 mod block_metric;
 mod canonical;
@@ -36,27 +38,58 @@ pub(crate) use pattern::{clique_pattern, diagonal_pattern};
 /// Errors in building a canonical operator.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CanonicalError {
+    /// Ω is not square over the rows of A: A and Ω were built for
+    /// different cells (e.g. a metric of the edges with an incidence
+    /// matrix of the faces).
     #[error("metric has size {metric} but the incidence matrix has {rows} rows")]
-    SizeMismatch { metric: usize, rows: usize },
+    SizeMismatch {
+        /// Rows (and columns) of Ω.
+        metric: usize,
+        /// Rows of A.
+        rows: usize,
+    },
+    /// A block of Ω refers to a row that A does not have.
     #[error("metric block {block} refers to row {row}, beyond the {size} rows of A")]
     RowOutOfRange {
+        /// The block, in the order the metric holds them.
         block: usize,
+        /// The row it refers to.
         row: usize,
+        /// Rows of A (and of Ω).
         size: usize,
     },
+    /// A block of Ω does not have |rows| · |cols| values.
     #[error("metric block {block} has {found} values for a {rows}×{cols} block")]
     BlockShape {
+        /// The block.
         block: usize,
+        /// Its rows.
         rows: usize,
+        /// Its columns.
         cols: usize,
+        /// Values given.
         found: usize,
     },
+    /// A block of Ω holds NaN or ±∞, typically from a degenerate cell or a
+    /// coefficient that is not finite.
     #[error("metric block {block} has a non-finite value")]
-    NonFinite { block: usize },
+    NonFinite {
+        /// The first such block.
+        block: usize,
+    },
+    /// [`Canonical::set_metric`] was given an Ω whose blocks sit elsewhere
+    /// than those the assembly pattern was built for.
     #[error("new metric values do not have the pattern the operator was built with")]
     PatternChanged,
+    /// A sum of operators mixed unknowns: the terms must all be Aᵀ Ω A
+    /// over the same number of unknowns (not coupling blocks Aᵀ Ω B).
     #[error(
         "a sum of operators needs square terms over the same unknowns: {unknowns} and {found}"
     )]
-    SumMismatch { unknowns: usize, found: usize },
+    SumMismatch {
+        /// Unknowns of the first term.
+        unknowns: usize,
+        /// Unknowns of the first term that differs (or of a coupling block).
+        found: usize,
+    },
 }

@@ -268,7 +268,7 @@ impl LocalPattern {
 
 /// The pattern of M = Aᵀ W A for every diagonal W with a weight on each
 /// row of A (`incidence` by rows, `by_columns` the same matrix by
-/// columns): the pattern [`Canonical`] gives such an operator, known from
+/// columns): the pattern [`Canonical`](super::Canonical) gives such an operator, known from
 /// topology before any weight is computed.
 pub(crate) fn diagonal_pattern(
     incidence: &CsMat<i8>,

@@ -738,3 +738,74 @@ fn restricted_columns_give_the_free_block_of_the_canonical_operator() {
         .to_dense();
     assert_eq!((w[(0, 0)], w[(1, 1)], w[(0, 1)]), (2.0, 3.0, 0.0));
 }
+
+#[test]
+fn a_coupling_block_with_the_identity_and_minus_one_is_minus_the_boundary() {
+    use hasse_complex::generate::rectangle;
+    // Two squares: ∂₂ is 7 edges × 2 cells. With A = I on the edges and
+    // Ω = −I, Aᵀ Ω ∂₂ = −∂₂, the flux–pressure block of mixed Darcy.
+    let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    let edges = k.cell_count(1);
+    let b = Canonical::coupling(
+        sprs::CsMat::<i8>::eye(edges),
+        BlockMetric::diagonal(&vec![-1.0; edges]),
+        k.shared_boundary(2),
+    )
+    .unwrap();
+    let m = b.assemble().to_dense();
+    assert_eq!((m.nrows(), m.ncols()), (7, 2));
+    for (v, (e, c)) in k.boundary(2).iter() {
+        assert_eq!(m[(e, c)], -f64::from(*v));
+    }
+}
+
+#[test]
+fn a_sum_of_operators_is_one_canonical_operator() {
+    use hasse_complex::generate::interval;
+    let k = interval(2, 0.0, 1.0).unwrap();
+    let stiffness = Canonical::new(k.coboundary(0), BlockMetric::diagonal(&[2.0, 2.0])).unwrap();
+    let mass = Canonical::new(
+        sprs::CsMat::<i8>::eye(3),
+        BlockMetric::diagonal(&[0.25, 0.5, 0.25]),
+    )
+    .unwrap();
+    let step = Canonical::sum(&[(4.0, &mass), (0.5, &stiffness)]).unwrap();
+    let m = step.assemble().to_dense();
+    // 4·0.5 + 0.5·(2 + 2) at the middle vertex, 0.5·(−2) beside it.
+    assert_eq!((m[(1, 1)], m[(0, 1)]), (4.0, -1.0));
+}
+
+#[test]
+fn a_diagonal_metric_stays_diagonal_until_a_block_breaks_the_layout() {
+    let mut omega = BlockMetric::from_weights(vec![2.0, 3.0]);
+    omega.add_rows(1);
+    omega.push_block(&[2], &[2], &[4.0]);
+    assert_eq!(omega.diagonal_weights(), Some(&[2.0, 3.0, 4.0][..]));
+    // A block off the diagonal (or out of row order) ends the layout.
+    omega.push_block(&[0], &[1], &[1.0]);
+    assert_eq!(omega.diagonal_weights(), None);
+    assert_eq!(omega.block(1), (&[1][..], &[1][..], &[3.0][..]));
+}
+
+#[test]
+fn stacked_metrics_sit_along_the_diagonal() {
+    let mut dense = BlockMetric::new(2);
+    dense.push_symmetric(&[0, 1], &[2.0, -1.0, -1.0, 2.0]);
+    let both = BlockMetric::stacked(&[(2.0, &BlockMetric::diagonal(&[1.0])), (0.5, &dense)]);
+    assert_eq!(
+        both.to_dense(),
+        vec![
+            vec![2.0, 0.0, 0.0],
+            vec![0.0, 1.0, -0.5],
+            vec![0.0, -0.5, 1.0]
+        ]
+    );
+}
+
+#[test]
+fn pushed_blocks_apply_as_their_sum() {
+    let mut omega = BlockMetric::new(3);
+    omega.push_symmetric(&[0, 2], &[2.0, -1.0, -1.0, 2.0]);
+    omega.push_block(&[1], &[1], &[5.0]);
+    assert_eq!(omega.apply(&[1.0, 1.0, 1.0]), vec![1.0, 5.0, 1.0]);
+}

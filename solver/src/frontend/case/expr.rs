@@ -335,7 +335,7 @@ fn syntax_problem(text: &str, names: &[String]) -> String {
             .chars()
             .take_while(|c| c.is_alphanumeric() || *c == '_')
             .collect();
-        if !word.is_empty() && names.iter().any(|n| *n == word) {
+        if !word.is_empty() && names.contains(&word) {
             return format!("`{number}{word}` is a product without `*`: write `{number}*{word}`");
         }
         if rest.starts_with(|c: char| c.is_alphabetic() || "µ°%Ω".contains(c)) {

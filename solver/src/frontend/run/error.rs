@@ -88,7 +88,12 @@ failure_from!(
 /// not trustworthy (exit code 1). It prints as a diagnostic of the case:
 /// `file:line:col: `key`: message` and a hint.
 #[derive(Debug)]
-pub struct RunError {
+pub struct RunError(Box<Inner>);
+
+/// A [`RunError`]'s parts, boxed: errors travel through every `Result` of
+/// a run, which should stay small.
+#[derive(Debug)]
+struct Inner {
     input: bool,
     diagnostic: Diagnostic,
     failure: Option<Failure>,
@@ -102,11 +107,11 @@ impl RunError {
         message: impl Into<String>,
         help: Option<String>,
     ) -> Self {
-        Self {
+        Self(Box::new(Inner {
             input: true,
             diagnostic: case.diagnostic(key, message, help),
             failure: None,
-        }
+        }))
     }
 
     /// Bad input that no single key holds (the mesh and the data
@@ -117,44 +122,44 @@ impl RunError {
 
     /// A solve that failed or is not trustworthy.
     pub fn solve(case: &Case, message: impl Into<String>, help: Option<String>) -> Self {
-        Self {
+        Self(Box::new(Inner {
             input: false,
             diagnostic: case.diagnostic("", message, help),
             failure: None,
-        }
+        }))
     }
 
     /// The same error, caused by the library error `failure`.
     pub fn because(mut self, failure: impl Into<Failure>) -> Self {
-        self.failure = Some(failure.into());
+        self.0.failure = Some(failure.into());
         self
     }
 
     /// Whether the user's input is at fault (as opposed to the numerics).
     pub fn is_input(&self) -> bool {
-        self.input
+        self.0.input
     }
 
     /// Where in the case the error points, what it says and how to fix it.
     pub fn diagnostic(&self) -> &Diagnostic {
-        &self.diagnostic
+        &self.0.diagnostic
     }
 
     /// The library error behind this one, if any.
     pub fn failure(&self) -> Option<&Failure> {
-        self.failure.as_ref()
+        self.0.failure.as_ref()
     }
 }
 
 impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.diagnostic.fmt(f)
+        self.0.diagnostic.fmt(f)
     }
 }
 
 impl std::error::Error for RunError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        self.failure.as_ref().map(Failure::as_error)
+        self.0.failure.as_ref().map(Failure::as_error)
     }
 }
 

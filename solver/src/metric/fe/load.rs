@@ -4,7 +4,7 @@ use super::*;
 
 /// Barycentric quadrature on the n-simplex, (coordinates, weight / |c|)
 /// with the coordinates in the first n + 1 entries: the P1 rules of
-/// [`load`], the same for every cell, so built once per dimension.
+/// [`load`](super::load()), the same for every cell, so built once per dimension.
 pub(super) fn simplex_rule(n: usize) -> &'static [([f64; 4], f64)] {
     type Rule = Vec<([f64; 4], f64)>;
     static RULES: [std::sync::OnceLock<Rule>; 4] = [

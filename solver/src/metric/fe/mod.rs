@@ -191,7 +191,7 @@ pub fn load(
     Ok(sum_shares(complex, characteristic, &shares))
 }
 
-/// [`stiffness_metric`] and [`load`] together, equal to them bit for bit:
+/// [`stiffness_metric`] and [`load()`] together, equal to them bit for bit:
 /// when every cell is a Q1 or virtual element, one pass over the cells
 /// finds each cell's element (its tensor order and, for Q1, the
 /// isoparametric map at the Gauss points) once for both. On a bad

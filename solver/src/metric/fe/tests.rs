@@ -555,3 +555,14 @@ fn a_cell_edge_count_is_its_edge_list_length() {
         }
     }
 }
+
+#[test]
+fn stiffness_and_load_in_one_pass_equal_the_two_passes() {
+    use hasse_complex::generate::rectangle;
+    let k = rectangle(3, 2, [0.0, 3.0], [0.0, 1.0]).unwrap();
+    let tensors = vec![isotropic(1.0); 6];
+    let f = |x: &[f64]| 1.0 + x[0];
+    let (omega, b) = stiffness_and_load(&k, &tensors, &f).unwrap();
+    assert_eq!(omega, stiffness_metric(&k, &tensors).unwrap());
+    assert_eq!(b, load(&k, &f).unwrap());
+}

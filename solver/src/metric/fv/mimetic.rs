@@ -18,6 +18,19 @@ use sprs::CsMat;
 
 /// Sizes of the hybrid unknown vector: cell values in columns
 /// `0..cells`, then face values in columns `cells..cells + faces`.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::{fv, isotropic};
+/// // One unit square: one cell unknown, then its four faces.
+/// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let (a, _, layout) = fv::mimetic_hybrid(&k, &[isotropic(1.0)]).unwrap();
+/// assert_eq!((layout.cells, layout.faces, layout.unknowns()), (1, 4, 5));
+/// assert_eq!(layout.face_column(3), 4);
+/// // Each half-face row of A is u_K − λ_F: +1 at the cell, −1 at the face.
+/// assert_eq!(a.cols(), layout.unknowns());
+/// assert!(a.outer_iterator().all(|row| row.get(0) == Some(&1) && row.nnz() == 2));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct HybridLayout {
     /// Number of top cells (cell unknowns u_K).
@@ -225,7 +238,7 @@ fn check_volume(complex: &Complex, method: &'static str) -> Result<usize, Metric
 /// g_F enters the right-hand side of row `cells + F`.
 ///
 /// On axis-aligned boxes with a diagonal tensor, T_K = W: eliminating the
-/// face unknowns gives the two-point scheme [`two_point`].
+/// face unknowns gives the two-point scheme [`two_point`](super::two_point).
 ///
 /// Non-planar faces (e.g. the warped quadrilateral faces of a randomly
 /// perturbed hexahedral grid) are described by the geometry module's unit
@@ -364,8 +377,9 @@ pub fn half_face_incidence(complex: &Complex) -> CsMat<i8> {
 /// The flux mass M_u = Aᵀ Ω A of mixed Darcy flow over the (n−1)-cells,
 /// as (A, Ω): for [`FluxMass::Dec`], A = I and Ω the diagonal inverse of
 /// the two-point transmissibility at the dual vertices; for
-/// [`FluxMass::Mimetic`], A the half-face incidence
-/// ([`half_face_incidence`]) and Ω one block M_c per cell in outward
+/// [`FluxMass::Mimetic`], A the half-face incidence (one row per
+/// half-face, holding ∂ₙ(F, K) in the face's column) and Ω one block M_c
+/// per cell in outward
 /// fluxes, M_c = (1/|c|) X K⁻¹ Xᵀ + (I − P_N) S (I − P_N) with
 /// S = diag(d/(κ|F|)).
 ///

@@ -24,7 +24,7 @@
 
 mod mimetic;
 
-pub use mimetic::{flux_mass, half_face_incidence, mimetic_hybrid, FluxMass, HybridLayout};
+pub use mimetic::{flux_mass, mimetic_hybrid, FluxMass, HybridLayout};
 
 use super::{CellTensors, MetricError, Tensor};
 use crate::operator::BlockMetric;
@@ -322,7 +322,7 @@ pub fn two_point_at<'a>(
 /// (x_F − p)·n_{K,F}: the distance from `point` to the face plane, positive
 /// when the point is on the inner side of the face for the cell with
 /// incidence `sign` (n_{K,F} = sign · n_F points out of that cell).
-pub fn signed_distance(x_face: &[f64], point: &[f64], normal: &[f64], sign: i8) -> f64 {
+pub(crate) fn signed_distance(x_face: &[f64], point: &[f64], normal: &[f64], sign: i8) -> f64 {
     f64::from(sign)
         * x_face
             .iter()

@@ -396,6 +396,7 @@ impl Reader {
     /// `name` gives them (the enum's own names: one mapping from names to
     /// values); `default` when the key is absent, or an error naming the
     /// choices.
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn choice<T: Copy>(
         &mut self,
         table: &dyn TableLike,
