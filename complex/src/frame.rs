@@ -10,6 +10,7 @@
 //! of c (interior for convex cells) to that of f.
 
 use crate::cells::Vertices;
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 /// Points are padded to three coordinates so all dimensions share one code path.
@@ -26,16 +27,19 @@ pub(crate) fn point(vertices: &Vertices, i: usize) -> Point {
     x
 }
 
+/// `a − b` for callers that keep their points as arrays.
 pub(crate) fn sub(a: &Point, b: &Point) -> Point {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    (Vector3::from(*a) - Vector3::from(*b)).into()
 }
 
+/// `a · b` for callers that keep their points as arrays.
 pub(crate) fn dot(a: &Point, b: &Point) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    Vector3::from(*a).dot(&Vector3::from(*b))
 }
 
+/// `|a|` for callers that keep their points as arrays.
 pub(crate) fn norm(a: &Point) -> f64 {
-    dot(a, a).sqrt()
+    Vector3::from(*a).norm()
 }
 
 /// An orthonormal basis of the span of a p-cell, oriented like the cell,
@@ -52,9 +56,10 @@ pub(crate) struct Frame {
 impl Frame {
     /// Coordinates of `v` in the basis (first `dim` entries used).
     pub fn local(&self, v: &Point) -> Point {
+        let v = Vector3::from(*v);
         let mut out = [0.0; 3];
         for (k, b) in self.basis.iter().take(self.dim).enumerate() {
-            out[k] = dot(b, v);
+            out[k] = Vector3::from(*b).dot(&v);
         }
         out
     }
@@ -130,39 +135,33 @@ pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Fra
         heap = cell.iter().map(|&v| point(vertices, v)).collect();
         &heap
     };
-    let origin = points[0];
-    let mut centre = [0.0; 3];
+    let origin = Vector3::from(points[0]);
+    let mut centre = Vector3::zeros();
     // sqrt is correctly rounded and monotone, so the largest root is the
     // root of the largest square: one sqrt per cell instead of one per vertex.
     let mut diameter_squared: f64 = 0.0;
     for x in points {
-        for k in 0..3 {
-            centre[k] += x[k];
-        }
-        let w = sub(x, &origin);
-        diameter_squared = diameter_squared.max(dot(&w, &w));
+        let x = Vector3::from(*x);
+        centre += x;
+        diameter_squared = diameter_squared.max((x - origin).norm_squared());
     }
     let diameter = diameter_squared.sqrt();
-    for c in &mut centre {
-        *c /= points.len() as f64;
-    }
-    let mut basis = [[0.0; 3]; 3];
+    centre /= points.len() as f64;
+    let mut basis = [Vector3::zeros(); 3];
     let mut found = 0;
     if p > 0 {
         for x in &points[1..] {
-            let mut w = sub(x, &origin);
+            let mut w = Vector3::from(*x) - origin;
             // Two Gram–Schmidt passes keep the basis orthonormal to rounding.
             for _ in 0..2 {
                 for b in basis.iter().take(found) {
-                    let c = dot(&w, b);
-                    for k in 0..3 {
-                        w[k] -= c * b[k];
-                    }
+                    let c = w.dot(b);
+                    w -= b * c;
                 }
             }
-            let len = norm(&w);
+            let len = w.norm();
             if len > SPAN_TOLERANCE * diameter {
-                basis[found] = [w[0] / len, w[1] / len, w[2] / len];
+                basis[found] = w / len;
                 found += 1;
                 if found == p {
                     break;
@@ -172,8 +171,8 @@ pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Fra
     }
     (found == p).then_some(Frame {
         dim: p,
-        basis,
-        centre,
+        basis: basis.map(Into::into),
+        centre: centre.into(),
         diameter,
     })
 }
@@ -196,7 +195,7 @@ pub(crate) fn det(n: usize, m: &[Point; 3]) -> f64 {
 /// opposite, `None` when the facet does not separate the cell's interior
 /// from outside (degenerate or non-convex geometry).
 pub(crate) fn induced_sign(cell: &Frame, facet: &Frame, diameter: f64) -> Option<i8> {
-    let outward = sub(&facet.centre, &cell.centre);
+    let outward = (Vector3::from(facet.centre) - Vector3::from(cell.centre)).into();
     let mut m = [[0.0; 3]; 3];
     m[0] = cell.local(&outward);
     for r in 0..facet.dim {

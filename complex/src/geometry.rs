@@ -31,6 +31,7 @@ use crate::complex::Complex;
 use crate::error::{ComplexError, Result};
 use crate::frame::{self, Point};
 use crate::lar::Lar;
+use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use sprs::CsMat;
 use std::borrow::Cow;
@@ -229,10 +230,10 @@ impl Complex {
                     let cell = self.cell_vertices(n, c);
                     let mut largest: f64 = 0.0;
                     for (k, &a) in cell.iter().enumerate() {
-                        let x = frame::point(vertices, a);
+                        let x = Vector3::from(frame::point(vertices, a));
                         for &b in &cell[k + 1..] {
-                            let r = frame::sub(&frame::point(vertices, b), &x);
-                            largest = largest.max(frame::dot(&r, &r));
+                            let r = Vector3::from(frame::point(vertices, b)) - x;
+                            largest = largest.max(r.norm_squared());
                         }
                     }
                     largest
@@ -282,37 +283,34 @@ impl Complex {
         let face_centres = self.centroid(n - 1);
         let mut normals = vec![0.0; self.cell_count(n - 1) * d];
         normals.par_chunks_mut(d).enumerate().for_each(|(f, out)| {
-            let xf = padded(&face_centres[f * d..(f + 1) * d]);
+            let xf = Vector3::from(padded(&face_centres[f * d..(f + 1) * d]));
             // Directions spanned by the face itself.
             let face_direction = match n {
-                1 => [0.0; 3],
+                1 => Vector3::zeros(),
                 2 => {
                     let (a, b) = mesh.ends(f);
-                    unit(&frame::sub(&b, &a))
+                    unit(&(b - a))
                 }
                 _ => unit(&mesh.vector_area(f)),
             };
             let (cells, signs) = row(top, f);
-            let mut sum = [0.0; 3];
+            let mut sum = Vector3::zeros();
             for (&c, &s) in cells.iter().zip(signs) {
-                let away = frame::sub(&xf, &padded(&top_centres[c * d..(c + 1) * d]));
+                let away = xf - Vector3::from(padded(&top_centres[c * d..(c + 1) * d]));
                 let nu = match n {
                     1 => away,
-                    2 => {
-                        let along = frame::dot(&away, &face_direction);
-                        frame::sub(&away, &scale(&face_direction, along))
-                    }
+                    2 => away - face_direction * away.dot(&face_direction),
                     _ => {
-                        if frame::dot(&away, &face_direction) >= 0.0 {
+                        if away.dot(&face_direction) >= 0.0 {
                             face_direction
                         } else {
-                            scale(&face_direction, -1.0)
+                            -face_direction
                         }
                     }
                 };
-                sum = add(&sum, &scale(&unit(&nu), f64::from(s)));
+                sum += unit(&nu) * f64::from(s);
             }
-            out.copy_from_slice(&unit(&sum)[..d]);
+            out.copy_from_slice(&unit(&sum).as_slice()[..d]);
         });
         normals
     }
@@ -361,73 +359,71 @@ impl<'a> Mesh<'a> {
     }
 
     #[inline(always)]
-    fn point(&self, i: usize) -> Point {
+    fn point(&self, i: usize) -> Vector3<f64> {
         let x = &self.coords[i * self.d..(i + 1) * self.d];
         match *x {
-            [a] => [a, 0.0, 0.0],
-            [a, b] => [a, b, 0.0],
-            [a, b, c, ..] => [a, b, c],
-            [] => [0.0; 3],
+            [a] => Vector3::new(a, 0.0, 0.0),
+            [a, b] => Vector3::new(a, b, 0.0),
+            [a, b, c, ..] => Vector3::new(a, b, c),
+            [] => Vector3::zeros(),
         }
     }
 
     /// Measure and centroid of p-cell `i`.
     #[inline(always)]
     fn cell(&self, p: usize, i: usize) -> (f64, Point) {
-        match p {
+        let (measure, centroid) = match p {
             0 => (1.0, self.point(i)),
             1 => self.segment(i),
             2 => self.polygon(i),
             _ => self.polyhedron(i),
-        }
+        };
+        (measure, centroid.into())
     }
 
     /// The two end points of edge `e` (tail = lower vertex id, head = higher).
     #[inline(always)]
-    fn ends(&self, e: usize) -> (Point, Point) {
+    fn ends(&self, e: usize) -> (Vector3<f64>, Vector3<f64>) {
         (
             self.point(self.edges[2 * e]),
             self.point(self.edges[2 * e + 1]),
         )
     }
 
-    fn segment(&self, e: usize) -> (f64, Point) {
+    fn segment(&self, e: usize) -> (f64, Vector3<f64>) {
         let (a, b) = self.ends(e);
-        (frame::norm(&frame::sub(&b, &a)), scale(&add(&a, &b), 0.5))
+        ((b - a).norm(), (a + b) * 0.5)
     }
 
     /// Fan of triangles (apex, v₀, v₁) over the edges of a 2-cell, apex the
     /// vertex average (every vertex of the cycle ends two edges).
-    fn polygon(&self, f: usize) -> (f64, Point) {
+    fn polygon(&self, f: usize) -> (f64, Vector3<f64>) {
         let (edges, _) = column(self.complex.boundary_csc(2), f);
         let Some(&first) = edges.first() else {
-            return (0.0, [0.0; 3]);
+            return (0.0, Vector3::zeros());
         };
         let origin = self.ends(first).0;
         let small = edges.len() <= SMALL_POLYGON;
-        let mut ends = [([0.0; 3], [0.0; 3]); SMALL_POLYGON];
-        let mut sum = [0.0; 3];
+        let mut ends = [(Vector3::zeros(), Vector3::zeros()); SMALL_POLYGON];
+        let mut sum = Vector3::zeros();
         for (k, &e) in edges.iter().enumerate() {
             let (a, b) = self.ends(e);
             if small {
                 ends[k] = (a, b);
             }
-            sum = add(
-                &sum,
-                &add(&frame::sub(&a, &origin), &frame::sub(&b, &origin)),
-            );
+            sum += (a - origin) + (b - origin);
         }
-        let apex = add(&origin, &scale(&sum, 0.5 / edges.len() as f64));
+        let apex = origin + sum * (0.5 / edges.len() as f64);
         let mut area = 0.0;
-        let mut moment = [0.0; 3];
+        let mut moment = Vector3::zeros();
         for (k, &e) in edges.iter().enumerate() {
             let (a, b) = if small { ends[k] } else { self.ends(e) };
-            let a = frame::sub(&a, &apex);
-            let b = frame::sub(&b, &apex);
-            let t = 0.5 * frame::norm(&cross(&a, &b));
+            let a = a - apex;
+            let b = b - apex;
+            let t = 0.5 * a.cross(&b).norm();
             area += t;
             // Triangle centroid relative to the apex: (a + b) / 3.
-            moment = add(&moment, &scale(&add(&a, &b), t / 3.0));
+            moment += (a + b) * (t / 3.0);
         }
         (area, centred(&apex, &moment, area))
     }
@@ -438,65 +434,65 @@ impl<'a> Mesh<'a> {
     /// the cone decomposition from the vertex average, computed with fewer
     /// loads. Per face, with primes relative to o and C = r (v₀′ × v₁′):
     /// 6 vol = s a_f′·ΣC and 24 moment = s [a_f′ (a_f′·ΣC) + Σ (v₀′ + v₁′)(C·a_f′)].
-    fn polyhedron(&self, c: usize) -> (f64, Point) {
+    fn polyhedron(&self, c: usize) -> (f64, Vector3<f64>) {
         let (faces, face_signs) = column(self.complex.boundary_csc(3), c);
         let edge_csc = self.complex.boundary_csc(2);
         let Some(&first_face) = faces.first() else {
-            return (0.0, [0.0; 3]);
+            return (0.0, Vector3::zeros());
         };
         let origin = match column(edge_csc, first_face).0.first() {
             Some(&e) => self.ends(e).0,
-            None => return (0.0, [0.0; 3]),
+            None => return (0.0, Vector3::zeros()),
         };
         let mut volume6 = 0.0;
-        let mut moment24 = [0.0; 3];
+        let mut moment24 = Vector3::zeros();
         for (&f, &s) in faces.iter().zip(face_signs) {
             let (edges, edge_signs) = column(edge_csc, f);
-            let mut sum = [0.0; 3];
-            let mut normal = [0.0; 3];
-            let mut tensor = [[0.0; 3]; 3];
+            let mut sum = Vector3::zeros();
+            let mut normal = Vector3::zeros();
+            let mut tensor = [Vector3::zeros(); 3];
             for (&e, &r) in edges.iter().zip(edge_signs) {
                 let (a, b) = self.ends(e);
-                let a = frame::sub(&a, &origin);
-                let b = frame::sub(&b, &origin);
-                let ab = add(&a, &b);
-                let c = scale(&cross(&a, &b), f64::from(r));
-                sum = add(&sum, &ab);
-                normal = add(&normal, &c);
-                for (row, x) in tensor.iter_mut().zip(ab) {
-                    *row = add(row, &scale(&c, x));
+                let a = a - origin;
+                let b = b - origin;
+                let ab = a + b;
+                let c = a.cross(&b) * f64::from(r);
+                sum += ab;
+                normal += c;
+                for (row, x) in tensor.iter_mut().zip(ab.iter()) {
+                    *row += c * *x;
                 }
             }
-            let apex = scale(&sum, 0.5 / edges.len().max(1) as f64);
+            let apex = sum * (0.5 / edges.len().max(1) as f64);
             let s = f64::from(s);
-            let height = s * frame::dot(&apex, &normal);
+            let height = s * apex.dot(&normal);
             volume6 += height;
-            let spread = tensor.map(|row| frame::dot(&row, &apex));
-            moment24 = add(&moment24, &add(&scale(&apex, height), &scale(&spread, s)));
+            let spread = Vector3::from(tensor.map(|row| row.dot(&apex)));
+            moment24 += apex * height + spread * s;
         }
         // The sign follows the orientation convention; the centroid does not.
         let centroid = if volume6 == 0.0 {
             origin
         } else {
-            add(&origin, &scale(&moment24, 0.25 / volume6))
+            origin + moment24 * (0.25 / volume6)
         };
         ((volume6 / 6.0).abs(), centroid)
     }
 
     /// Vector area of 2-cell `f` in its own orientation: ½ Σ r (v₀ − o) × (v₁ − o)
     /// over its edges with their ∂₂ signs, for any o.
-    fn vector_area(&self, f: usize) -> Point {
+    fn vector_area(&self, f: usize) -> Vector3<f64> {
         let (edges, signs) = column(self.complex.boundary_csc(2), f);
         let Some(&first) = edges.first() else {
-            return [0.0; 3];
+            return Vector3::zeros();
         };
         let origin = self.ends(first).0;
-        let mut area = [0.0; 3];
+        let mut area = Vector3::zeros();
         for (&e, &r) in edges.iter().zip(signs) {
             let (a, b) = self.ends(e);
-            let a = frame::sub(&a, &origin);
-            let b = frame::sub(&b, &origin);
-            area = add(&area, &scale(&cross(&a, &b), 0.5 * f64::from(r)));
+            let a = a - origin;
+            let b = b - origin;
+            area += a.cross(&b) * (0.5 * f64::from(r));
         }
         area
     }
@@ -528,27 +524,30 @@ fn edge_pairs(lar: &Lar) -> Cow<'_, [usize]> {
 /// (2BᵀB) y = (|x_i − x₀|²)_i, B = [x₁ − x₀, …, x_p − x₀]; `None` when
 /// the simplex is degenerate.
 fn circumcentre_of(complex: &Complex, cell: &[usize]) -> Option<Point> {
-    let origin = complex.point3(*cell.first()?);
-    let mut edges = [[0.0; 3]; 3];
+    let origin = Vector3::from(complex.point3(*cell.first()?));
+    let mut edges = [Vector3::zeros(); 3];
     let p = cell.len() - 1;
     for (k, &v) in cell[1..].iter().enumerate() {
-        edges[k] = frame::sub(&complex.point3(v), &origin);
+        edges[k] = Vector3::from(complex.point3(v)) - origin;
     }
     // Unused rows/columns are padded with the identity and a zero right-hand side.
-    let mut gram = nalgebra::Matrix3::<f64>::identity();
-    let mut rhs = nalgebra::Vector3::<f64>::zeros();
+    let mut gram = Matrix3::<f64>::identity();
+    let mut rhs = Vector3::<f64>::zeros();
     for i in 0..p {
         for j in 0..p {
-            gram[(i, j)] = 2.0 * frame::dot(&edges[i], &edges[j]);
+            gram[(i, j)] = 2.0 * edges[i].dot(&edges[j]);
         }
-        rhs[i] = frame::dot(&edges[i], &edges[i]);
+        rhs[i] = edges[i].dot(&edges[i]);
     }
     let y = gram.lu().solve(&rhs)?;
     let mut centre = origin;
     for (k, edge) in edges.iter().take(p).enumerate() {
-        centre = add(&centre, &scale(edge, y[k]));
+        centre += edge * y[k];
     }
-    centre.iter().all(|x| x.is_finite()).then_some(centre)
+    centre
+        .iter()
+        .all(|x| x.is_finite())
+        .then_some(centre.into())
 }
 
 /// Entries (row or column indices, values) of outer slice `j` of a
@@ -570,38 +569,29 @@ pub(crate) fn padded(x: &[f64]) -> Point {
     out
 }
 
-pub(crate) fn add(a: &Point, b: &Point) -> Point {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-pub(crate) fn scale(a: &Point, s: f64) -> Point {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
+/// `a × b` for callers that keep their points as arrays.
 pub(crate) fn cross(a: &Point, b: &Point) -> Point {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    Vector3::from(*a).cross(&Vector3::from(*b)).into()
 }
 
-/// `a / |a|`, or zero for the zero vector.
-pub(crate) fn unit(a: &Point) -> Point {
-    let len = frame::norm(a);
+/// `a / |a|`, or zero when |a| is not positive. Scaled by the reciprocal
+/// of the length rather than divided by it as nalgebra's `normalize`
+/// does, so that the normals keep their last bits.
+fn unit(a: &Vector3<f64>) -> Vector3<f64> {
+    let len = a.norm();
     if len > 0.0 {
-        scale(a, 1.0 / len)
+        a * (1.0 / len)
     } else {
-        [0.0; 3]
+        Vector3::zeros()
     }
 }
 
 /// apex + moment / mass, or the apex for a zero mass.
-fn centred(apex: &Point, moment: &Point, mass: f64) -> Point {
+fn centred(apex: &Vector3<f64>, moment: &Vector3<f64>, mass: f64) -> Vector3<f64> {
     if mass == 0.0 {
         *apex
     } else {
-        add(apex, &scale(moment, 1.0 / mass))
+        apex + moment * (1.0 / mass)
     }
 }
 

@@ -23,7 +23,7 @@
 use crate::complex::Complex;
 use crate::error::SplitError;
 use crate::split::{split_cells, Hyperplane, Refinement, SplitOptions};
-use nalgebra::{Matrix2, Matrix3, SymmetricEigen};
+use nalgebra::{Matrix2, Matrix3, SymmetricEigen, Vector3};
 
 /// Split each listed top cell by the d axis-aligned hyperplanes through its
 /// centroid (quads → 4 quads, hexes → 8 hexes, simplices → convex
@@ -151,14 +151,14 @@ pub fn bisect_longest_edge(
 ) -> Result<(Complex, Refinement), SplitError> {
     let (n, d) = space_filling_dims(complex)?;
     check_cells(complex, cells)?;
-    let point = |v: usize| padded(complex.vertices().point(v));
+    let point = |v: usize| Vector3::from(padded(complex.vertices().point(v)));
     let mut cuts = Vec::with_capacity(cells.len());
     for &c in cells {
         let verts = complex.cell_vertices(n, c);
         let (mut best, mut best_len) = ((verts[0], verts[0]), -1.0);
         for (i, &a) in verts.iter().enumerate() {
             for &b in &verts[i + 1..] {
-                let len = norm(&sub(&point(b), &point(a)));
+                let len = (point(b) - point(a)).norm();
                 if len > best_len && is_edge(complex, a, b) {
                     (best, best_len) = ((a, b), len);
                 }
@@ -173,20 +173,20 @@ pub fn bisect_longest_edge(
             .collect();
         let normal = if verts.len() == n + 1 {
             // The plane spanned by the midpoint and the opposite vertices.
-            let m = padded(&mid);
+            let m = Vector3::from(padded(&mid));
             match n {
                 2 => {
-                    let t = sub(&point(others[0]), &m);
+                    let t = point(others[0]) - m;
                     vec![-t[1], t[0]]
                 }
                 _ => {
-                    let u = sub(&point(others[0]), &m);
-                    let w = sub(&point(others[1]), &m);
-                    cross(&u, &w).to_vec()
+                    let u = point(others[0]) - m;
+                    let w = point(others[1]) - m;
+                    u.cross(&w).as_slice().to_vec()
                 }
             }
         } else {
-            sub(&point(b), &point(a))[..d].to_vec()
+            (point(b) - point(a)).as_slice()[..d].to_vec()
         };
         cuts.push((c, Hyperplane::through(&mid, &normal)?));
     }
@@ -379,23 +379,20 @@ pub fn section_measure(
 
 fn section(complex: &Complex, c: usize, point: &[f64; 3], normal: &[f64; 3]) -> f64 {
     let n = complex.dim();
+    let (point, normal) = (Vector3::from(*point), Vector3::from(*normal));
     // Crossing points of the plane with the cell's edges.
-    let mut points: Vec<[f64; 3]> = Vec::new();
-    let dist = |x: &[f64; 3]| dot(&sub(x, point), normal);
+    let mut points: Vec<Vector3<f64>> = Vec::new();
+    let dist = |x: &Vector3<f64>| (x - point).dot(&normal);
     let edges = cell_edges(complex, c);
     for (a, b) in edges {
         let (xa, xb) = (
-            padded(complex.vertices().point(a)),
-            padded(complex.vertices().point(b)),
+            Vector3::from(padded(complex.vertices().point(a))),
+            Vector3::from(padded(complex.vertices().point(b))),
         );
         let (da, db) = (dist(&xa), dist(&xb));
         if (da <= 0.0 && db >= 0.0) || (da >= 0.0 && db <= 0.0) {
             let t = if da == db { 0.0 } else { da / (da - db) };
-            points.push([
-                xa[0] + t * (xb[0] - xa[0]),
-                xa[1] + t * (xb[1] - xa[1]),
-                xa[2] + t * (xb[2] - xa[2]),
-            ]);
+            points.push(xa + (xb - xa) * t);
         }
     }
     if points.len() < 2 {
@@ -405,39 +402,34 @@ fn section(complex: &Complex, c: usize, point: &[f64; 3], normal: &[f64; 3]) -> 
         let mut longest: f64 = 0.0;
         for (i, a) in points.iter().enumerate() {
             for b in &points[i + 1..] {
-                longest = longest.max(norm(&sub(b, a)));
+                longest = longest.max((b - a).norm());
             }
         }
         return longest;
     }
     // 3D: the section is a convex polygon; order its points by angle about
     // their mean in the plane and sum the fan.
-    let mut mean = [0.0; 3];
-    for x in &points {
-        for k in 0..3 {
-            mean[k] += x[k] / points.len() as f64;
-        }
-    }
+    let mean: Vector3<f64> = points.iter().map(|x| x / points.len() as f64).sum();
     let helper = if normal[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
+        Vector3::x()
     } else {
-        [0.0, 1.0, 0.0]
+        Vector3::y()
     };
-    let u = unit(&cross(normal, &helper));
-    let w = cross(normal, &u);
-    let mut angled: Vec<(f64, [f64; 3])> = points
+    let u = normal.cross(&helper).normalize();
+    let w = normal.cross(&u);
+    let mut angled: Vec<(f64, Vector3<f64>)> = points
         .iter()
         .map(|x| {
-            let r = sub(x, &mean);
-            (dot(&r, &w).atan2(dot(&r, &u)), *x)
+            let r = x - mean;
+            (r.dot(&w).atan2(r.dot(&u)), *x)
         })
         .collect();
     angled.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut area = 0.0;
     for i in 0..angled.len() {
-        let a = sub(&angled[i].1, &mean);
-        let b = sub(&angled[(i + 1) % angled.len()].1, &mean);
-        area += 0.5 * dot(&cross(&a, &b), normal);
+        let a = angled[i].1 - mean;
+        let b = angled[(i + 1) % angled.len()].1 - mean;
+        area += 0.5 * a.cross(&b).dot(&normal);
     }
     area.abs()
 }
@@ -476,29 +468,4 @@ fn padded(x: &[f64]) -> [f64; 3] {
         *o = *v;
     }
     out
-}
-
-fn sub(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm(a: &[f64; 3]) -> f64 {
-    dot(a, a).sqrt()
-}
-
-fn unit(a: &[f64; 3]) -> [f64; 3] {
-    let l = norm(a);
-    [a[0] / l, a[1] / l, a[2] / l]
-}
-
-fn cross(a: &[f64; 3], b: &[f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }

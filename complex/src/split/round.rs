@@ -25,6 +25,7 @@ use crate::error::{ComplexError, SplitError};
 use crate::frame::{self, Frame, Point};
 use crate::lar::{characteristic_matrix, Lar};
 use crate::tags::{CellTag, Tags};
+use nalgebra::Vector3;
 use rayon::prelude::*;
 use sprs::CsMat;
 use std::ops::Range;
@@ -170,18 +171,10 @@ fn relative_orientation(a: &Frame, b: &Frame) -> i8 {
     let mut m = [[0.0; 3]; 3];
     for (i, row) in m.iter_mut().enumerate().take(a.dim) {
         for (j, slot) in row.iter_mut().enumerate().take(b.dim) {
-            *slot = frame::dot(&a.basis[i], &b.basis[j]);
+            *slot = Vector3::from(a.basis[i]).dot(&Vector3::from(b.basis[j]));
         }
     }
     sign_of(frame::det(a.dim, &m))
-}
-
-fn cross(a: &Point, b: &Point) -> Point {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// Per-level bookkeeping of the old p-cells: which plane splits them, the
@@ -225,11 +218,9 @@ pub(super) fn round(
     for e in 0..counts[1] {
         let ends = k.cell_vertices(1, e);
         let (a, b) = (ends[0], ends[1]);
-        let r = frame::sub(
-            &frame::point(k.vertices(), a),
-            &frame::point(k.vertices(), b),
-        );
-        let len = frame::norm(&r);
+        let r = Vector3::from(frame::point(k.vertices(), a))
+            - Vector3::from(frame::point(k.vertices(), b));
+        let len = r.norm();
         shortest[a] = shortest[a].min(len);
         shortest[b] = shortest[b].min(len);
     }
@@ -482,10 +473,10 @@ pub(super) fn round(
 /// cells computed from different vertices) thus share their cuts.
 fn compatible(k: &Complex, cls: &Classifier, p: usize, i: usize, a: u32, b: u32) -> bool {
     let (na, nb) = (
-        &cls.planes[a as usize].normal,
-        &cls.planes[b as usize].normal,
+        Vector3::from(cls.planes[a as usize].normal),
+        Vector3::from(cls.planes[b as usize].normal),
     );
-    let sigma = if frame::dot(na, nb) >= 0.0 { 1 } else { -1 };
+    let sigma = if na.dot(&nb) >= 0.0 { 1 } else { -1 };
     let verts = k.cell_vertices(p, i);
     if verts
         .iter()
@@ -939,16 +930,14 @@ fn cut_polygon(
         },
     ))?;
     // Newell's normal of the walk against the normal of the sorted frame.
-    let mut newell = [0.0; 3];
+    let mut newell = Vector3::zeros();
     for w in 0..order.len() {
-        let a = frame::point(vertices, order[w]);
-        let b = frame::point(vertices, order[(w + 1) % order.len()]);
-        let x = cross(&a, &b);
-        for i in 0..3 {
-            newell[i] += x[i];
-        }
+        let a = Vector3::from(frame::point(vertices, order[w]));
+        let b = Vector3::from(frame::point(vertices, order[(w + 1) % order.len()]));
+        newell += a.cross(&b);
     }
-    let eps = sign_of(frame::dot(&newell, &cross(&f.basis[0], &f.basis[1])));
+    let normal = Vector3::from(f.basis[0]).cross(&Vector3::from(f.basis[1]));
+    let eps = sign_of(newell.dot(&normal));
     let mut column: Vec<(usize, i8)> = chain.into_iter().map(|(e, s)| (e, s * eps)).collect();
     column.sort_unstable();
     Ok((column, set))

@@ -42,6 +42,7 @@ use super::fe::{gather, k_dot, simplex_gradients, Local, Point, Topology};
 use super::{CellTensors, MetricError, Tensor};
 use crate::operator::BlockMetric;
 use hasse_complex::{Complex, DualKind};
+use nalgebra::Vector3;
 use rayon::prelude::*;
 
 /// The coefficient-weighted Hodge star ⋆₁ as a metric over the edges.
@@ -223,39 +224,11 @@ impl<'a> Centres<'a> {
         })
     }
 
-    fn get(&self, p: usize, i: usize) -> Point {
-        let mut x = [0.0; 3];
-        x[..self.d].copy_from_slice(&self.points[p - 1][i * self.d..(i + 1) * self.d]);
+    fn get(&self, p: usize, i: usize) -> Vector3<f64> {
+        let mut x = Vector3::zeros();
+        x.as_mut_slice()[..self.d]
+            .copy_from_slice(&self.points[p - 1][i * self.d..(i + 1) * self.d]);
         x
-    }
-}
-
-fn sub(a: &Point, b: &Point) -> Point {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: &Point, b: &Point) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn norm(a: &Point) -> f64 {
-    dot(a, a).sqrt()
-}
-
-fn cross(a: &Point, b: &Point) -> Point {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn unit(a: &Point) -> Point {
-    let l = norm(a);
-    if l > 0.0 {
-        a.map(|x| x / l)
-    } else {
-        [0.0; 3]
     }
 }
 
@@ -278,13 +251,14 @@ fn midpoint_to_circumcentre(top: &Topology, e: usize, triangle: &[usize]) -> f64
     let Some(o) = opposite(triangle, ends) else {
         return 0.0;
     };
-    let xo = top.point(o);
-    let u = sub(&top.point(ends[0]), &xo);
-    let v = sub(&top.point(ends[1]), &xo);
-    let length = norm(&sub(&u, &v));
-    let sine = norm(&cross(&u, &v));
+    let point = |v: usize| Vector3::from(top.point(v));
+    let xo = point(o);
+    let u = point(ends[0]) - xo;
+    let v = point(ends[1]) - xo;
+    let length = (u - v).norm();
+    let sine = u.cross(&v).norm();
     if sine > 0.0 {
-        0.5 * length * dot(&u, &v) / sine
+        0.5 * length * u.dot(&v) / sine
     } else {
         0.0
     }
@@ -297,17 +271,18 @@ fn face_to_circumcentre(top: &Topology, centres: &Centres, f: usize, c: usize) -
     let Some(o) = opposite(top.complex.cell_vertices(3, c), face) else {
         return 0.0;
     };
-    let x0 = top.point(face[0]);
-    let normal = unit(&cross(
-        &sub(&top.point(face[1]), &x0),
-        &sub(&top.point(face[2]), &x0),
-    ));
-    let side = if dot(&normal, &sub(&top.point(o), &x0)) < 0.0 {
+    let point = |v: usize| Vector3::from(top.point(v));
+    let x0 = point(face[0]);
+    let normal = (point(face[1]) - x0)
+        .cross(&(point(face[2]) - x0))
+        .try_normalize(0.0)
+        .unwrap_or_else(Vector3::zeros);
+    let side = if normal.dot(&(point(o) - x0)) < 0.0 {
         -1.0
     } else {
         1.0
     };
-    side * dot(&normal, &sub(&centres.get(3, c), &x0))
+    side * normal.dot(&(centres.get(3, c) - x0))
 }
 
 /// |⋆e ∩ τ| for every edge e of top cell τ = `c`.
@@ -323,7 +298,7 @@ fn dual_pieces(top: &Topology, centres: &Centres, c: usize) -> Vec<(usize, f64)>
                 let piece = if signed {
                     midpoint_to_circumcentre(top, e, top.complex.cell_vertices(2, c))
                 } else {
-                    norm(&sub(&centres.get(2, c), &centres.get(1, e)))
+                    (centres.get(2, c) - centres.get(1, e)).norm()
                 };
                 (e, piece)
             })
@@ -344,8 +319,8 @@ fn dual_pieces(top: &Topology, centres: &Centres, c: usize) -> Vec<(usize, f64)>
                         0.5 * leg * height
                     } else {
                         let mid = centres.get(1, e);
-                        let face = sub(&centres.get(2, f), &mid);
-                        0.5 * norm(&cross(&face, &sub(&centres.get(3, c), &mid)))
+                        let face = centres.get(2, f) - mid;
+                        0.5 * face.cross(&(centres.get(3, c) - mid)).norm()
                     };
                     // Present: the edges of a face of c are edges of c.
                     if let Ok(k) = edges.binary_search(&e) {

@@ -10,6 +10,7 @@
 
 use super::OutputError;
 use hasse_complex::Complex;
+use nalgebra::Vector3;
 use std::collections::HashMap;
 
 /// XDMF topology type codes used in `Mixed` connectivity arrays.
@@ -217,25 +218,10 @@ fn point3(complex: &Complex, v: usize) -> [f64; 3] {
     p
 }
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// Six times the signed volume of the tetrahedron (a, b, c, d).
 pub(crate) fn tet_volume6(a: [f64; 3], b: [f64; 3], c: [f64; 3], d: [f64; 3]) -> f64 {
-    dot(cross(sub(b, a), sub(c, a)), sub(d, a))
+    let [a, b, c, d] = [a, b, c, d].map(Vector3::from);
+    (b - a).cross(&(c - a)).dot(&(d - a))
 }
 
 fn positive_tet(complex: &Complex, mut t: [usize; 4]) -> [usize; 4] {
@@ -401,12 +387,12 @@ mod tests {
         assert!((vtk_hex_volume(&p) - 6.0).abs() < 1e-12);
         // Each top vertex sits straight above its bottom vertex along one axis.
         for i in 0..4 {
-            let d = sub(p[i + 4], p[i]);
+            let d = Vector3::from(p[i + 4]) - Vector3::from(p[i]);
             assert_eq!(d.iter().filter(|x| x.abs() > 0.0).count(), 1);
         }
         // Bottom face is a cycle: consecutive vertices differ along one axis.
         for i in 0..4 {
-            let d = sub(p[(i + 1) % 4], p[i]);
+            let d = Vector3::from(p[(i + 1) % 4]) - Vector3::from(p[i]);
             assert_eq!(d.iter().filter(|x| x.abs() > 0.0).count(), 1);
         }
     }

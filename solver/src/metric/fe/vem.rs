@@ -2,59 +2,31 @@
 //! the cell and the projected stiffness.
 
 use super::*;
-
-pub(super) fn sub(a: &Point, b: &Point) -> Point {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(super) fn dot(a: &Point, b: &Point) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(super) fn cross(a: &Point, b: &Point) -> Point {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(super) fn average(points: impl ExactSizeIterator<Item = Point>) -> Point {
-    let count = points.len() as f64;
-    let mut sum = [0.0; 3];
-    for p in points {
-        for i in 0..3 {
-            sum[i] += p[i];
-        }
-    }
-    sum.map(|s| s / count)
-}
+use nalgebra::Vector3;
 
 /// ∫_∂c φ_i n for every vertex of a polygon (exact: φ_i is linear on each
 /// edge) and the polygon's area, both from the outward edge normals.
 pub(super) fn polygon_moments(
     top: &Topology,
     c: usize,
-    x: &[Point],
-    centre: &Point,
-) -> Result<(Vec<Point>, f64), MetricError> {
+    x: &[Vector3<f64>],
+    centre: &Vector3<f64>,
+) -> Result<(Vec<Vector3<f64>>, f64), MetricError> {
     let vertices = top.complex.cell_vertices(2, c);
-    let mut moments = vec![[0.0; 3]; x.len()];
+    let mut moments = vec![Vector3::zeros(); x.len()];
     let mut area = 0.0;
     for e in top.edges_of(c) {
         let (a, b) = top.local_ends(e, vertices, c)?;
-        let t = sub(&x[b], &x[a]);
-        let mid = [0.5 * (x[a][0] + x[b][0]), 0.5 * (x[a][1] + x[b][1]), 0.0];
-        let mut normal = [t[1], -t[0], 0.0];
-        if dot(&normal, &sub(&mid, centre)) < 0.0 {
-            normal = normal.map(|v| -v);
+        let t = x[b] - x[a];
+        let mid = Vector3::new(0.5 * (x[a][0] + x[b][0]), 0.5 * (x[a][1] + x[b][1]), 0.0);
+        let mut normal = Vector3::new(t[1], -t[0], 0.0);
+        if normal.dot(&(mid - centre)) < 0.0 {
+            normal = -normal;
         }
         for i in [a, b] {
-            for (mi, ni) in moments[i].iter_mut().zip(&normal) {
-                *mi += 0.5 * ni;
-            }
+            moments[i] += normal * 0.5;
         }
-        area += 0.5 * dot(&sub(&mid, centre), &normal);
+        area += 0.5 * (mid - centre).dot(&normal);
     }
     Ok((moments, area))
 }
@@ -65,11 +37,11 @@ pub(super) fn polygon_moments(
 pub(super) fn polyhedron_moments(
     top: &Topology,
     c: usize,
-    x: &[Point],
-    centre: &Point,
-) -> Result<(Vec<Point>, f64), MetricError> {
+    x: &[Vector3<f64>],
+    centre: &Vector3<f64>,
+) -> Result<(Vec<Vector3<f64>>, f64), MetricError> {
     let vertices = top.complex.cell_vertices(3, c);
-    let mut moments = vec![[0.0; 3]; x.len()];
+    let mut moments = vec![Vector3::zeros(); x.len()];
     let mut volume = 0.0;
     for &f in top.facets_of(3, c).0 {
         let face: Vec<usize> = top
@@ -86,21 +58,19 @@ pub(super) fn polyhedron_moments(
                     })
             })
             .collect::<Result<_, _>>()?;
-        let apex = average(face.iter().map(|&i| x[i]));
+        let apex = face.iter().map(|&i| x[i]).sum::<Vector3<f64>>() / face.len() as f64;
         // Fan triangles (apex, tail, head), all turning the face's way.
         let (edges, signs) = top.facets_of(2, f);
         let mut fan = Vec::with_capacity(edges.len());
-        let mut total = [0.0; 3];
+        let mut total = Vector3::zeros();
         for (&e, &s) in edges.iter().zip(signs) {
             let (a, b) = top.local_ends(e, vertices, c)?;
             let (t, h) = if s > 0 { (a, b) } else { (b, a) };
-            let area = cross(&sub(&x[t], &apex), &sub(&x[h], &apex)).map(|v| 0.5 * v);
-            for i in 0..3 {
-                total[i] += area[i];
-            }
+            let area = (x[t] - apex).cross(&(x[h] - apex)) * 0.5;
+            total += area;
             fan.push((t, h, area));
         }
-        let outward = match dot(&total, &sub(&apex, centre)) {
+        let outward = match total.dot(&(apex - centre)) {
             s if s > 0.0 => 1.0,
             s if s < 0.0 => -1.0,
             _ => {
@@ -113,16 +83,14 @@ pub(super) fn polyhedron_moments(
         };
         let share = 1.0 / (3 * face.len()) as f64;
         for (t, h, area) in fan {
-            let area = area.map(|v| outward * v);
-            for i in 0..3 {
-                moments[t][i] += area[i] / 3.0;
-                moments[h][i] += area[i] / 3.0;
-                for &j in &face {
-                    moments[j][i] += area[i] * share;
-                }
+            let area = area * outward;
+            moments[t] += area / 3.0;
+            moments[h] += area / 3.0;
+            for &j in &face {
+                moments[j] += area * share;
             }
-            let centroid = average([apex, x[t], x[h]].into_iter());
-            volume += dot(&sub(&centroid, centre), &area) / 3.0;
+            let centroid = [apex, x[t], x[h]].iter().sum::<Vector3<f64>>() / 3.0;
+            volume += (centroid - centre).dot(&area) / 3.0;
         }
     }
     Ok((moments, volume))
@@ -134,9 +102,9 @@ pub(super) fn vem_stiffness(
     k: &Tensor,
 ) -> Result<DMatrix<f64>, MetricError> {
     let n = top.n;
-    let x = top.points(c);
+    let x: Vec<Vector3<f64>> = top.points(c).into_iter().map(Vector3::from).collect();
     let m = x.len();
-    let centre = average(x.iter().copied());
+    let centre = x.iter().sum::<Vector3<f64>>() / m as f64;
     let (moments, measure) = if n == 2 {
         polygon_moments(top, c, &x, &centre)?
     } else {
@@ -158,7 +126,7 @@ pub(super) fn vem_stiffness(
     let residual = DMatrix::identity(m, m) - projection;
     let diameter = x
         .iter()
-        .flat_map(|a| x.iter().map(move |b| dot(&sub(a, b), &sub(a, b))))
+        .flat_map(|a| x.iter().map(move |b| (a - b).norm_squared()))
         .fold(0.0f64, f64::max)
         .sqrt();
     let alpha = kn.trace() / n as f64 * diameter.powi(n as i32 - 2);
