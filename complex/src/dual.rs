@@ -26,7 +26,8 @@
 use crate::complex::Complex;
 use crate::error::{ComplexError, Result};
 use crate::frame::{self, Point};
-use crate::geometry::{cross, padded, row};
+use crate::geometry::{padded, row};
+use nalgebra::Vector3;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -219,40 +220,40 @@ impl FlagWalker<'_> {
         let Some(&opposite) = upper.iter().find(|v| lower.binary_search(v).is_err()) else {
             return 1.0;
         };
-        let origin = complex.point3(lower[0]);
-        let mut basis = [[0.0; 3]; 2];
+        let origin = Vector3::from(complex.point3(lower[0]));
+        let mut basis = [Vector3::zeros(); 2];
         let mut found = 0;
         for &v in &lower[1..] {
-            let w = reject(&frame::sub(&complex.point3(v), &origin), &basis[..found]);
-            let len = frame::norm(&w);
+            let w = reject(Vector3::from(complex.point3(v)) - origin, &basis[..found]);
+            let len = w.norm();
             if len > 0.0 && found < 2 {
-                basis[found] = [w[0] / len, w[1] / len, w[2] / len];
+                basis[found] = Vector3::new(w[0] / len, w[1] / len, w[2] / len);
                 found += 1;
             }
         }
         let inward = reject(
-            &frame::sub(&complex.point3(opposite), &origin),
+            Vector3::from(complex.point3(opposite)) - origin,
             &basis[..found],
         );
         let centre = reject(
-            &frame::sub(&self.centre(k + 1, tau), &origin),
+            Vector3::from(self.centre(k + 1, tau)) - origin,
             &basis[..found],
         );
         // The centre is on σ when its distance from σ's span is at rounding level.
-        if frame::norm(&centre) <= 1e-12 * frame::norm(&inward) {
+        if centre.norm() <= 1e-12 * inward.norm() {
             return 0.0;
         }
-        frame::dot(&centre, &inward).signum()
+        centre.dot(&inward).signum()
     }
 }
 
 /// `v` minus its components along the orthonormal `basis` (two passes).
-fn reject(v: &Point, basis: &[Point]) -> Point {
-    let mut w = *v;
+fn reject(v: Vector3<f64>, basis: &[Vector3<f64>]) -> Vector3<f64> {
+    let mut w = v;
     for _ in 0..2 {
         for b in basis {
-            let c = frame::dot(&w, b);
-            w = [w[0] - c * b[0], w[1] - c * b[1], w[2] - c * b[2]];
+            let c = w.dot(b);
+            w = Vector3::new(w[0] - c * b[0], w[1] - c * b[1], w[2] - c * b[2]);
         }
     }
     w
@@ -260,12 +261,12 @@ fn reject(v: &Point, basis: &[Point]) -> Point {
 
 /// m-volume of the simplex spanned by m+1 points (m ≤ 3), sqrt(det Gram)/m!.
 fn simplex_volume(points: &[Point]) -> f64 {
-    let edge = |i: usize| frame::sub(&points[i], &points[0]);
+    let edge = |i: usize| Vector3::from(points[i]) - Vector3::from(points[0]);
     match points.len() {
         0 | 1 => 1.0,
-        2 => frame::norm(&edge(1)),
-        3 => 0.5 * frame::norm(&cross(&edge(1), &edge(2))),
-        _ => frame::det(3, &[edge(1), edge(2), edge(3)]).abs() / 6.0,
+        2 => edge(1).norm(),
+        3 => 0.5 * edge(1).cross(&edge(2)).norm(),
+        _ => frame::det(3, &[edge(1).into(), edge(2).into(), edge(3).into()]).abs() / 6.0,
     }
 }
 

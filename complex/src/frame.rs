@@ -27,21 +27,6 @@ pub(crate) fn point(vertices: &Vertices, i: usize) -> Point {
     x
 }
 
-/// `a − b` for callers that keep their points as arrays.
-pub(crate) fn sub(a: &Point, b: &Point) -> Point {
-    (Vector3::from(*a) - Vector3::from(*b)).into()
-}
-
-/// `a · b` for callers that keep their points as arrays.
-pub(crate) fn dot(a: &Point, b: &Point) -> f64 {
-    Vector3::from(*a).dot(&Vector3::from(*b))
-}
-
-/// `|a|` for callers that keep their points as arrays.
-pub(crate) fn norm(a: &Point) -> f64 {
-    Vector3::from(*a).norm()
-}
-
 /// An orthonormal basis of the span of a p-cell, oriented like the cell,
 /// and the average of its vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]

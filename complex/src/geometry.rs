@@ -569,11 +569,6 @@ pub(crate) fn padded(x: &[f64]) -> Point {
     out
 }
 
-/// `a × b` for callers that keep their points as arrays.
-pub(crate) fn cross(a: &Point, b: &Point) -> Point {
-    Vector3::from(*a).cross(&Vector3::from(*b)).into()
-}
-
 /// `a / |a|`, or zero when |a| is not positive. Scaled by the reciprocal
 /// of the length rather than divided by it as nalgebra's `normalize`
 /// does, so that the normals keep their last bits.
