@@ -66,3 +66,9 @@ pub mod operator;
 pub mod physics;
 pub mod refine;
 pub mod study;
+
+/// The README's Rust examples, compiled and run as doctests so that they
+/// stay true.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+struct ReadmeExamples;
