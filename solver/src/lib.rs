@@ -58,6 +58,8 @@
 //! The rule is checked by the test `tests/layers.rs`: it fails when a
 //! lower layer names a higher one.
 
+#![warn(missing_docs)]
+
 pub mod frontend;
 pub mod la;
 pub mod metric;

@@ -26,13 +26,13 @@ enum Command {
     ///
     /// Examples:
     ///   hasse run cases/poisson-square.toml
-    ///   hasse run cases/poisson-square.toml --set problem.method=fv --set mesh.n=[64,64] -o out/fv
+    ///   hasse run cases/poisson-square.toml --set problem.method=fv --set mesh.n=\[64,64\] -o out/fv
     #[command(verbatim_doc_comment)]
     Run {
         /// The case file (.toml).
         case: PathBuf,
         /// Output stem: writes OUT.h5, OUT.xdmf, and OUT.edges.xdmf /
-        /// OUT.faces.xdmf for edge / face fields (default: [output] of the
+        /// OUT.faces.xdmf for edge / face fields (default: `[output]` of the
         /// case, else the case file's name in the current directory).
         #[arg(short, long, value_name = "OUT")]
         output: Option<PathBuf>,
@@ -54,7 +54,7 @@ enum Command {
     /// division rules), moves the solution to the refined mesh through the
     /// chain map, and re-solves by conjugate gradients from zero and from
     /// the transferred solution (the table shows both iteration counts).
-    /// Options override the case's [refine] table. Output: the final mesh.
+    /// Options override the case's `[refine]` table. Output: the final mesh.
     ///
     /// Example: hasse refine cases/l-shape-adaptive.toml --steps 4
     #[command(verbatim_doc_comment)]
@@ -103,7 +103,7 @@ enum Command {
     /// Report on a mesh: cell counts per dimension, Euler characteristic,
     /// Betti numbers, boundary regions (tags) and cell quality.
     ///
-    /// MESH may be a case file (.toml, its [mesh] table is used), a Gmsh
+    /// MESH may be a case file (.toml, its `[mesh]` table is used), a Gmsh
     /// file (.msh, version 4) or a hasse complex file (.json).
     ///
     /// Example: hasse info cases/torus.toml
@@ -119,13 +119,13 @@ enum Command {
         timing: bool,
     },
     /// Convergence study: solve CASE on N successively refined meshes and
-    /// report the errors against its [exact] solution and the observed
+    /// report the errors against its `[exact]` solution and the observed
     /// orders of convergence.
     ///
     /// For each method and level: the generator's resolution, the mesh size
     /// h (largest top-cell diameter), unknowns, L² and max errors of the
     /// solution, the gradient L² error (an energy-norm error; needs
-    /// [exact].gradient), the face-flux error where the method defines one,
+    /// `exact.gradient`), the face-flux error where the method defines one,
     /// and seconds. Orders: between consecutive levels, and the
     /// least-squares slope of log e against log h over all levels.
     ///
@@ -142,12 +142,12 @@ enum Command {
     /// Examples:
     ///   hasse converge cases/poisson-square.toml --levels 4 --methods fd,fe,fv,fv-mimetic
     ///   hasse converge cases/distorted-quads.toml --levels 5 --methods fv,fv-mimetic,fe -o out/dq
-    ///   hasse converge cases/box-3d.toml --levels 3 --set mesh.n=[8,8,8] --expect 2
+    ///   hasse converge cases/box-3d.toml --levels 3 --set mesh.n=\[8,8,8\] --expect 2
     ///   hasse converge cases/poisson-square.toml --levels 4 --methods dec,fe --set mesh.cells=simplex
     // Verbatim: the examples are one per line.
     #[command(verbatim_doc_comment)]
     Converge {
-        /// The case file (.toml); it needs an [exact] table.
+        /// The case file (.toml); it needs an `[exact]` table.
         case: PathBuf,
         /// Number of meshes: the case's own resolution, then N − 1 refinements.
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
@@ -159,7 +159,8 @@ enum Command {
         /// fd, fe, fv, fv-mimetic, dec, dec-barycentric.
         #[arg(long, value_delimiter = ',', value_name = "METHOD,...")]
         methods: Vec<String>,
-        /// Output directory (default: converge-<case file stem>).
+        /// Output directory (default: converge-STEM, STEM the case
+        /// file's name without its extension).
         #[arg(short, long, value_name = "DIR")]
         output: Option<PathBuf>,
         /// Fail (exit code 1) when the least-squares L² order of any method

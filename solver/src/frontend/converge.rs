@@ -47,6 +47,7 @@ use std::time::Instant;
 pub struct Study {
     /// Number of meshes, the case's own resolution being level 0.
     pub levels: usize,
+    /// How each level's mesh is made.
     pub refinement: Refinement,
     /// Methods solved side by side on the same meshes.
     pub methods: Vec<Method>,
@@ -55,30 +56,54 @@ pub struct Study {
 /// Why a study could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum StudyError {
+    /// The case file could not be read.
     #[error(transparent)]
     Case(#[from] CaseError),
     /// The case (with a level's overrides) or its mesh is invalid.
     #[error("{0}")]
     Invalid(Diagnostics),
+    /// A method name (`--methods`) names no method.
     #[error(transparent)]
     UnknownMethod(#[from] crate::metric::UnknownMethod),
+    /// An `--expect` text is not `ORDER` or `ORDER:TOL`.
     #[error(transparent)]
     BadExpectation(#[from] BadExpectation),
+    /// [`Study::levels`] is 0.
     #[error("a study needs at least 1 level")]
     NoLevels,
+    /// The case is not a diffusion problem, whose methods a study compares.
     #[error("{case}: a convergence study compares methods on a diffusion problem; this case is kind = \"{kind}\"")]
-    NotDiffusion { case: String, kind: &'static str },
+    NotDiffusion {
+        /// The case file.
+        case: String,
+        /// Its `problem.kind`.
+        kind: &'static str,
+    },
+    /// The case has no `[exact]` solution to measure errors against.
     #[error("{case}: a convergence study needs the exact solution: add an [exact] table with `solution` (and `gradient` for gradient and flux errors)")]
-    NoExact { case: String },
+    NoExact {
+        /// The case file.
+        case: String,
+    },
     /// The case's mesh cannot be refined as asked.
     #[error("{case}: {message}")]
-    Refinement { case: String, message: String },
+    Refinement {
+        /// The case file.
+        case: String,
+        /// Why (a mesh file, a missing `mesh.n`, an overflowing
+        /// resolution).
+        message: String,
+    },
     /// A level failed to solve.
     #[error("level {level}, method {method}: {source}")]
     Run {
+        /// The case file.
         case: String,
+        /// The level that failed.
         level: usize,
+        /// The method that failed on it.
         method: String,
+        /// Why.
         source: RunError,
     },
 }

@@ -36,31 +36,67 @@ use std::path::{Path, PathBuf};
 /// What went wrong while reading or building a mesh, with where.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
+    /// The case file could not be read.
     #[error("{path}: cannot read: {source}")]
     Io {
+        /// The case file.
         path: String,
+        /// Why.
         source: std::io::Error,
     },
+    /// The case file is not TOML, or has no usable `[mesh]` table.
     #[error("{path}: {message}")]
-    Syntax { path: String, message: String },
-    #[error("{path}: key `mesh.{key}`: {message}")]
-    Key {
+    Syntax {
+        /// The case file.
         path: String,
-        key: &'static str,
+        /// toml's message, with line and column, or what is missing.
         message: String,
     },
+    /// A key of `[mesh]` has a value the generator cannot use, or the
+    /// mesh file it names cannot be read or is defective.
+    #[error("{path}: key `mesh.{key}`: {message}")]
+    Key {
+        /// The case file.
+        path: String,
+        /// The key, without `mesh.`.
+        key: &'static str,
+        /// What is wrong with its value.
+        message: String,
+    },
+    /// The generator refused its parameters, or the perturbation failed.
     #[error("{path}: {source}")]
     Complex {
+        /// The case file.
         path: String,
+        /// The complex's error.
         source: hasse_complex::ComplexError,
     },
+    /// A Gmsh file could not be read.
     #[error(transparent)]
     Gmsh(#[from] gmsh::GmshError),
+    /// A hasse JSON complex could not be read.
     #[error(transparent)]
     Json(#[from] json::JsonError),
 }
 
-/// The `[mesh]` table.
+/// The `[mesh]` table (its keys are explained in the module
+/// documentation and in `cases/README.md`).
+///
+/// ```
+/// use hasse_solver::frontend::mesh_spec::MeshSpec;
+/// use std::path::Path;
+/// let spec = MeshSpec {
+///     generator: Some("rectangle".into()),
+///     n: Some(vec![3, 2]),
+///     x: Some([0.0, 3.0]),
+///     cells: Some("simplex".into()),
+///     ..MeshSpec::default()
+/// };
+/// let k = spec.build(Path::new("demo.toml")).unwrap();
+/// // 3 × 2 squares of Kuhn triangles on [0, 3] × [0, 1] (y defaults to [0, 1]).
+/// assert_eq!(k.cell_counts(), vec![12, 23, 12]);
+/// assert!((k.measure(2).iter().sum::<f64>() - 3.0).abs() < 1e-14);
+/// ```
 #[derive(Clone, Debug, Default, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct MeshSpec {
@@ -70,13 +106,18 @@ pub struct MeshSpec {
     pub file: Option<PathBuf>,
     /// Cells per axis (or per radial/angular direction).
     pub n: Option<Vec<usize>>,
+    /// Extent `[lo, hi]` along x (default `[0, 1]`).
     pub x: Option<[f64; 2]>,
+    /// Extent along y (default `[0, 1]`).
     pub y: Option<[f64; 2]>,
+    /// Extent along z (default `[0, 1]`).
     pub z: Option<[f64; 2]>,
     /// Geometric grading ratio per axis (spacing multiplies by it cell to cell).
     pub grading: Option<Vec<f64>>,
     /// "cuboid" (default) or "simplex".
     pub cells: Option<String>,
+    /// Move interior vertices randomly by up to this fraction of the local
+    /// mesh size (default 0).
     pub perturb: Option<f64>,
     /// Seed of the perturbation, or of the Voronoi sites.
     pub seed: Option<u64>,
@@ -86,11 +127,16 @@ pub struct MeshSpec {
     pub radius: Option<f64>,
     /// Icosphere subdivision levels.
     pub subdivisions: Option<u32>,
+    /// Annulus inner radius.
     pub inner_radius: Option<f64>,
+    /// Annulus outer radius.
     pub outer_radius: Option<f64>,
+    /// Torus radius of the centre circle (larger than `minor_radius`).
     pub major_radius: Option<f64>,
+    /// Torus radius of the tube.
     pub minor_radius: Option<f64>,
-    /// Cell index range [first, last] of the cavity (hollow-box).
+    /// Cell index range `[first, end)` of the cavity, the same on every
+    /// axis (hollow-box; half-open, inside the box).
     pub cavity: Option<[usize; 2]>,
 }
 
@@ -436,10 +482,23 @@ const BYTES_PER_CELL: f64 = 100.0;
 const BYTES_PER_NONZERO: f64 = 16.0;
 
 /// What a generated mesh will at least cost, before it is built.
+///
+/// ```
+/// use hasse_solver::frontend::mesh_spec::MeshSpec;
+/// let spec = MeshSpec { generator: Some("rectangle".into()), n: Some(vec![100, 100]), ..MeshSpec::default() };
+/// let estimate = spec.estimate("rectangle").unwrap();
+/// // 10⁴ squares, ≈ 4 cells of all dimensions and 5 nonzeros each.
+/// assert_eq!((estimate.top_cells, estimate.cells, estimate.nonzeros), (1e4, 4e4, 5e4));
+/// assert_eq!(estimate.bytes, 100.0 * 4e4 + 16.0 * 5e4);
+/// // Under a 1 MB limit the mesh is refused before it is built.
+/// std::env::set_var("HASSE_MEMORY_LIMIT", "1000000");
+/// assert!(estimate.check().unwrap_err().contains("use a smaller mesh.n"));
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct MemoryEstimate {
     /// The `[mesh]` key that sets the size.
     pub key: &'static str,
+    /// Top cells the mesh will have.
     pub top_cells: f64,
     /// Cells of every dimension.
     pub cells: f64,
@@ -473,7 +532,7 @@ impl MemoryEstimate {
 }
 
 /// Memory the process may still use, and where the number comes from.
-pub fn available_memory() -> Option<(u64, &'static str)> {
+pub(crate) fn available_memory() -> Option<(u64, &'static str)> {
     if let Some(limit) = std::env::var("HASSE_MEMORY_LIMIT")
         .ok()
         .and_then(|v| v.trim().parse::<u64>().ok())
@@ -501,18 +560,29 @@ fn human_bytes(bytes: f64) -> String {
 /// the solver; generated meshes have none by construction.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MeshDefect {
+    /// Two vertices at the same place (within 10⁻¹⁰ of the mesh's
+    /// extent): the mesh is cut there.
     #[error("vertices {first} and {second} coincide at {point:?}: the cells on either side are not connected there (a crack); merge duplicate nodes (Gmsh: Geometry.Tolerance / Coherence Mesh) or remesh")]
     DuplicateVertices {
+        /// The lower vertex id.
         first: usize,
+        /// The higher vertex id.
         second: usize,
+        /// Where the first one is.
         point: Vec<f64>,
     },
+    /// An (n−1)-cell bounds more than two top cells.
     #[error("{dim}-cell {face} (vertices {vertices:?}) bounds {count} top cells ({cells:?}): the mesh is not a manifold there, and fluxes through a face need exactly one cell on each side; split the mesh into separate surfaces or remesh")]
     NonManifold {
+        /// Its dimension, n − 1.
         dim: usize,
+        /// The face's id.
         face: usize,
+        /// Its vertices.
         vertices: Vec<usize>,
+        /// How many top cells it bounds.
         count: usize,
+        /// Those top cells.
         cells: Vec<usize>,
     },
 }

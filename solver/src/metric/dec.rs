@@ -52,7 +52,7 @@ use rayon::prelude::*;
 /// Whitney block per simplex. Errors: a circumcentric dual on a cell that
 /// is not a simplex, or a tensor on a cell that is not a simplex
 /// ([`MetricError::UnsupportedCell`]); coefficient errors as in
-/// [`check_tensors`].
+/// [`check_tensors`](super::check_tensors).
 ///
 /// ```
 /// use hasse_complex::{dual::DualKind, generate::kuhn, generate::uniform_axis};

@@ -47,13 +47,36 @@ use hasse_complex::Complex;
 
 /// One of the two fields: a name and its diffusion problem (method, D,
 /// source, boundary conditions).
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::coupled::{CoupledError, CoupledField};
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::Conductivity;
+/// use std::sync::Arc;
+/// let mesh = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let field = |method| {
+///     CoupledField::new("u", Diffusion::new(method, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 0.0)))
+/// };
+/// assert_eq!(field(Method::Fe).degree(&mesh).unwrap(), 0); // on vertices
+/// assert_eq!(field(Method::Fv).degree(&mesh).unwrap(), 2); // on squares
+/// // Cell and face unknowns have no pointwise partner in the other field.
+/// let hybrid = field(Method::FvMimetic).degree(&mesh);
+/// assert!(matches!(hybrid, Err(CoupledError::Unsupported { method: "fv-mimetic", .. })));
+/// ```
 #[derive(Clone)]
 pub struct CoupledField {
+    /// The field's name, by which the solution gives it back
+    /// ([`CoupledSolution::field`]) and output files store it.
     pub name: String,
+    /// −∇·(D ∇·) = source with the field's method and boundary
+    /// conditions; the reaction terms come from [`Reaction`].
     pub diffusion: Diffusion,
 }
 
 impl CoupledField {
+    /// The field `name` with its diffusion problem.
     pub fn new(name: &str, diffusion: Diffusion) -> Self {
         Self {
             name: name.to_string(),
@@ -79,10 +102,33 @@ impl CoupledField {
 }
 
 /// The reaction coefficients a, c and the coupling coefficient b.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::coupled::{Coupled, CoupledField, Reaction};
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::Conductivity;
+/// use std::sync::Arc;
+/// // No boundary conditions (no flux anywhere) and constant sources: the
+/// // fields are constants solving the reaction alone,
+/// // 2u − v = 0, −u + 2v = 3, i.e. u = 1, v = 2.
+/// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let field = |name, source: f64| {
+///     CoupledField::new(name, Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(move |_| source)))
+/// };
+/// let reaction = Reaction { a: Arc::new(|_| 2.0), b: Arc::new(|_| 1.0), c: Arc::new(|_| 2.0) };
+/// let solution = Coupled::new(field("u", 0.0), field("v", 3.0), reaction).solve(&mesh).unwrap();
+/// assert!(solution.field("u").unwrap().iter().all(|u| (u - 1.0).abs() < 1e-12));
+/// assert!(solution.field("v").unwrap().iter().all(|v| (v - 2.0).abs() < 1e-12));
+/// ```
 #[derive(Clone)]
 pub struct Reaction {
+    /// a, the first field's own reaction rate (+a u in its equation).
     pub a: ScalarFn,
+    /// b, the exchange: −b v in the first equation, −b u in the second.
     pub b: ScalarFn,
+    /// c, the second field's own reaction rate (+c v in its equation).
     pub c: ScalarFn,
 }
 
@@ -114,7 +160,9 @@ pub struct Reaction {
 /// ```
 #[derive(Clone)]
 pub struct Coupled {
+    /// u and v, in the order of the block rows.
     pub fields: [CoupledField; 2],
+    /// a, b and c.
     pub reaction: Reaction,
     /// Direct factorisation (default LLᵀ).
     pub factorization: Factorization,
@@ -123,36 +171,69 @@ pub struct Coupled {
 /// Why a coupled problem could not be assembled or solved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum CoupledError {
+    /// One field's own diffusion problem could not be assembled.
     #[error("field '{name}': {source}")]
     Field {
+        /// The field.
         name: String,
+        /// Why.
         source: DiffusionError,
     },
+    /// The two fields have the same name, so the solution could not tell
+    /// them apart.
     #[error("both fields are called '{name}'; give them different names")]
-    SameName { name: String },
+    SameName {
+        /// The shared name.
+        name: String,
+    },
+    /// One field is nodal and the other cell-centred: there is no
+    /// pointwise coupling between vertices and cells.
     #[error("field '{first}' is {first_location:?} and field '{second}' is {second_location:?}: the pointwise coupling needs both fields on the same cells (both nodal or both cell-centred methods)")]
     Locations {
+        /// The first field.
         first: String,
+        /// Where its unknowns live.
         first_location: Location,
+        /// The second field.
         second: String,
+        /// Where its unknowns live.
         second_location: Location,
     },
+    /// A field uses the hybrid mimetic method, whose face unknowns have
+    /// no reaction term.
     #[error("field '{name}': the {method} method has cell and face unknowns; coupling needs nodal or cell-centred fields")]
-    Unsupported { name: String, method: &'static str },
+    Unsupported {
+        /// The field.
+        name: String,
+        /// Its method's name.
+        method: &'static str,
+    },
+    /// a, b or c is NaN or ±∞ at an unknown.
     #[error("coupling coefficient {what} is not finite at {location:?}")]
     NonFinite {
+        /// `"a"`, `"b"` or `"c"`.
         what: &'static str,
+        /// The vertex or centroid where it was evaluated.
         location: Vec<f64>,
     },
+    /// The factorisation failed, most likely because the coupling makes
+    /// the system indefinite for LLᵀ.
     #[error("{factorization} failed on the coupled system: {source} (the system is positive definite when a > 0, c > 0 and ac > b² everywhere; for stronger coupling use Factorization::Lblt or Factorization::Lu)")]
     Factorization {
+        /// The factorisation tried.
         factorization: Factorization,
+        /// How it failed.
         source: SolveError,
     },
+    /// The block system could not be built or updated; an update with
+    /// other fixed unknowns or another location is
+    /// [`BlockError::PatternChanged`].
     #[error(transparent)]
     Block(#[from] BlockError),
+    /// A and Ω of a block do not fit together.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
+    /// The solve with the factor failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
 }
@@ -184,6 +265,32 @@ struct Values {
 }
 
 /// The assembled block system, ready to solve and to take new values.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::la::direct::Factorization;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::coupled::{Coupled, CoupledField, Reaction};
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::Conductivity;
+/// use std::sync::Arc;
+/// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let field = |name, source: f64| {
+///     CoupledField::new(name, Diffusion::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(move |_| source)))
+/// };
+/// let with_c = |c: f64| {
+///     let reaction = Reaction { a: Arc::new(|_| 2.0), b: Arc::new(|_| 1.0), c: Arc::new(move |_| c) };
+///     Coupled::new(field("u", 0.0), field("v", 3.0), reaction)
+/// };
+/// let mut system = with_c(2.0).assemble(&mesh).unwrap();
+/// let first = system.solve(Factorization::Llt).unwrap();
+/// assert!((first.field("v").unwrap()[0] - 2.0).abs() < 1e-12);
+/// // c = 5: 2u − v = 0, −u + 5v = 3, so v = 2/3, on the same pattern.
+/// system.update(&mesh, &with_c(5.0)).unwrap();
+/// let second = system.solve(Factorization::Llt).unwrap();
+/// assert!((second.field("v").unwrap()[0] - 2.0 / 3.0).abs() < 1e-12);
+/// assert_eq!(second.symbolic_analyses, 1);
+/// ```
 pub struct CoupledSystem {
     names: [String; 2],
     system: BlockSystem,
@@ -195,7 +302,10 @@ pub struct CoupledSystem {
 /// Both fields on all their unknowns (Dirichlet values included).
 #[derive(Clone, Debug)]
 pub struct CoupledSolution {
+    /// The fields' names, in the order of [`Coupled::fields`].
     pub names: [String; 2],
+    /// Their values, in the same order, on every vertex (nodal) or top
+    /// cell (cell-centred).
     pub fields: [Vec<f64>; 2],
     /// Where both fields live.
     pub location: Location,

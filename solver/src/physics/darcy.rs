@@ -126,6 +126,31 @@ use sprs::CsMat;
 use std::time::Instant;
 
 /// A condition on one boundary (n−1)-cell.
+///
+/// Fluxes count outward: a negative flux is inflow.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::{fv::FluxMass, isotropic};
+/// use hasse_solver::physics::darcy::{self, BoundaryConditions, FaceCondition};
+/// // Inflow u·n = −1 on the left, p = 0 on the right: u = (1, 0),
+/// // p = 1 − x. The left faces have |F| = ¼, so a total flux of −¼ each
+/// // is the same condition.
+/// let k = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let solve = |inflow: FaceCondition| {
+///     let bc = BoundaryConditions::from_fn(&k, |x| {
+///         if x[0] == 0.0 { Some(inflow) } else if x[0] == 1.0 { Some(FaceCondition::Pressure(0.0)) } else { None }
+///     });
+///     darcy::solve(&k, &[isotropic(1.0); 16], FluxMass::Mimetic, &[0.0; 16], &bc).unwrap()
+/// };
+/// let density = solve(FaceCondition::FluxDensity(-1.0));
+/// let total = solve(FaceCondition::Flux(-0.25));
+/// for c in 0..16 {
+///     let x = k.centroid_of(2, c)[0];
+///     assert!((density.pressure[c] - (1.0 - x)).abs() < 1e-12);
+///     assert!((total.pressure[c] - density.pressure[c]).abs() < 1e-12);
+/// }
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FaceCondition {
     /// Pressure p_D on the face (natural condition).
@@ -187,34 +212,76 @@ pub enum DarcyError {
     /// Permeability (non-positive, non-finite, wrong count) or geometry.
     #[error(transparent)]
     Metric(#[from] MetricError),
+    /// A and Ω of a block do not fit together.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
+    /// The saddle-point blocks could not be put together.
     #[error(transparent)]
     Block(#[from] BlockError),
+    /// The factorisation or solve failed (a zero pivot of an unsuited
+    /// factorisation, a singular system).
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The complex does not fill its space (a surface in R³, say): its
+    /// faces have no normal flux.
     #[error("mixed Darcy needs a complex that fills its space (n = d ≥ 1); this one is {n}-dimensional in R^{d}")]
-    NotVolume { n: usize, d: usize },
+    NotVolume {
+        /// Dimension of the complex.
+        n: usize,
+        /// Dimension of the space it lies in.
+        d: usize,
+    },
+    /// The source has not one integral per top cell.
     #[error("{found} source integrals given for {expected} top cells")]
-    SourceCount { expected: usize, found: usize },
+    SourceCount {
+        /// Top cells of the mesh.
+        expected: usize,
+        /// Values given.
+        found: usize,
+    },
+    /// A condition names a face number beyond the (n−1)-cells.
     #[error("{kind} condition on face {face}, but the complex has only {faces} (n−1)-cells")]
     FaceOutOfRange {
+        /// `"pressure"` or `"flux"`.
         kind: &'static str,
+        /// The face number given.
         face: usize,
+        /// Number of (n−1)-cells.
         faces: usize,
     },
+    /// A condition is on a face inside the domain.
     #[error("{kind} condition on face {face}, which is an interior face (it lies on {cells} top cells); boundary conditions go on boundary faces only")]
     InteriorFace {
+        /// `"pressure"` or `"flux"`.
         kind: &'static str,
+        /// The face.
         face: usize,
+        /// Number of top cells on it.
         cells: usize,
     },
+    /// A face appears twice among the conditions.
     #[error("face {face} has more than one boundary condition")]
-    RepeatedFace { face: usize },
+    RepeatedFace {
+        /// The face.
+        face: usize,
+    },
+    /// A prescribed pressure or flux is NaN or ±∞.
     #[error("{kind} value on face {face} is not finite")]
-    NonFinite { kind: &'static str, face: usize },
+    NonFinite {
+        /// `"pressure"` or `"flux"`.
+        kind: &'static str,
+        /// The face.
+        face: usize,
+    },
+    /// Without a pressure face, mass conservation needs the sources to
+    /// equal the total outflow, and they do not.
     #[error("no pressure is prescribed anywhere, so the sources must balance the boundary outflow: Σ ∫f = {sources:e} but Σ q = {outflow:e}")]
-    Incompatible { sources: f64, outflow: f64 },
+    Incompatible {
+        /// Σ_c ∫_c f.
+        sources: f64,
+        /// Σ_F q_F over the flux faces.
+        outflow: f64,
+    },
 }
 
 /// The solved fields and the linear-solve report.
@@ -226,6 +293,7 @@ pub struct DarcySolution {
     pub pressure: Vec<f64>,
     /// Where each p_c lives (stride d): dual vertices of the mass's kind.
     pub points: Vec<f64>,
+    /// The linear solve: sizes, seconds and relative residual.
     pub report: SolveReport,
 }
 
@@ -345,6 +413,21 @@ fn classify(
 /// the free face fluxes (faces without a prescribed flux, in face order),
 /// then the cell pressures, then (pure-flux problems only) the multiplier
 /// of the mean-pressure constraint.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::la::direct::Factorization;
+/// use hasse_solver::metric::{fv::FluxMass, isotropic};
+/// use hasse_solver::physics::darcy::{self, BoundaryConditions, FaceCondition};
+/// let k = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let bc = BoundaryConditions::from_fn(&k, |x| (x[0] == 0.0 || x[0] == 1.0).then_some(FaceCondition::Pressure(x[0])));
+/// let system = darcy::assemble(&k, &[isotropic(1.0); 16], FluxMass::Mimetic, &[0.0; 16], &bc).unwrap();
+/// // 40 faces, of which the 8 no-flow faces at the bottom and top are known.
+/// assert_eq!((system.free_faces, system.cells, system.matrix.nrows()), (32, 16, 48));
+/// // The constrained LDLᵀ and LU give the same solution.
+/// let (ldlt, lu) = (system.solve_ldlt().unwrap(), system.solve(Factorization::Lu).unwrap());
+/// assert!(ldlt.pressure.iter().zip(&lu.pressure).all(|(a, b)| (a - b).abs() < 1e-12));
+/// ```
 pub struct DarcySystem {
     /// The symmetric indefinite matrix [[M_u, B], [Bᵀ, 0]] (both triangles).
     pub matrix: SparseColMat<usize, f64>,

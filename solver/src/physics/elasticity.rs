@@ -54,9 +54,30 @@ use std::time::Instant;
 
 /// A material coefficient: a function of position evaluated at each top
 /// cell's centroid, or one value per top cell.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::physics::elasticity::{Coefficient, Elasticity, ElasticityError, Material};
+/// use std::sync::Arc;
+/// // Two materials side by side: stiff on the left half, soft on the right.
+/// let mesh = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// let by_position = Coefficient::Function(Arc::new(|x| if x[0] < 1.0 { 10.0 } else { 1.0 }));
+/// let by_cell = Coefficient::PerCell(Arc::from([10.0, 1.0]));
+/// let lame = |mu| {
+///     let material = Material::Lame { lambda: Coefficient::constant(1.0), mu };
+///     Elasticity::new(material, Arc::new(|_| [0.0; 3])).lame(&mesh)
+/// };
+/// assert_eq!(lame(by_position).unwrap(), lame(by_cell).unwrap());
+/// // Per-cell values must match the top cells one to one.
+/// let short = Coefficient::PerCell(Arc::from([10.0]));
+/// assert_eq!(lame(short).unwrap_err(), ElasticityError::CoefficientCount { count: 1, cells: 2 });
+/// ```
 #[derive(Clone)]
 pub enum Coefficient {
+    /// A function of position, evaluated at each top cell's centroid.
     Function(ScalarFn),
+    /// One value per top cell, in cell order (e.g. a material read from a
+    /// file of regions).
     PerCell(Arc<[f64]>),
 }
 
@@ -84,26 +105,60 @@ impl Coefficient {
 
 /// The elastic material, by Lamé parameters or by Young's modulus and
 /// Poisson's ratio (λ = Eν/((1+ν)(1−2ν)), μ = E/(2(1+ν))).
+///
+/// ```
+/// use hasse_complex::generate::box3;
+/// use hasse_solver::physics::elasticity::{Coefficient, Elasticity, Lame, Material};
+/// use std::sync::Arc;
+/// // E = 2.5, ν = 0.25: λ = 0.625 / (1.25 · 0.5) = 1, μ = 2.5 / 2.5 = 1.
+/// let mesh = box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let material = Material::Young { young: Coefficient::constant(2.5), poisson: Coefficient::constant(0.25) };
+/// let lame = Elasticity::new(material, Arc::new(|_| [0.0; 3])).lame(&mesh).unwrap();
+/// assert_eq!(lame, vec![Lame { lambda: 1.0, mu: 1.0 }]);
+/// ```
 #[derive(Clone)]
 pub enum Material {
+    /// By the Lamé parameters: λ, and μ the shear modulus. They must give
+    /// μ > 0 and a positive bulk modulus λ + 2μ/d.
     Lame {
+        /// The first Lamé parameter λ.
         lambda: Coefficient,
+        /// The shear modulus μ.
         mu: Coefficient,
     },
+    /// By Young's modulus E > 0 and Poisson's ratio ν ∈ (−1, ½) (ν → ½ is
+    /// incompressible, where λ → ∞).
     Young {
+        /// Young's modulus E.
         young: Coefficient,
+        /// Poisson's ratio ν.
         poisson: Coefficient,
     },
 }
 
-/// The Lamé parameters of one top cell.
+/// The Lamé parameters of one top cell (see [`Elasticity::lame`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lame {
+    /// The first Lamé parameter λ.
     pub lambda: f64,
+    /// The shear modulus μ.
     pub mu: f64,
 }
 
 /// What a 2D problem stands for.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::physics::elasticity::{Coefficient, Elasticity, Material, PlaneModel};
+/// use std::sync::Arc;
+/// let mesh = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let material = Material::Lame { lambda: Coefficient::constant(1.0), mu: Coefficient::constant(1.0) };
+/// let problem = Elasticity::new(material, Arc::new(|_| [0.0; 3]));
+/// assert_eq!(problem.lame(&mesh).unwrap()[0].lambda, 1.0);
+/// // Plane stress: λ* = 2λμ / (λ + 2μ) = 2/3; μ is unchanged.
+/// let stress = problem.with_plane(PlaneModel::Stress).lame(&mesh).unwrap();
+/// assert!((stress[0].lambda - 2.0 / 3.0).abs() < 1e-15 && stress[0].mu == 1.0);
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum PlaneModel {
     /// Plane strain (ε_zz = 0): λ and μ as given.
@@ -132,13 +187,41 @@ impl PlaneModel {
 }
 
 /// A boundary condition's kind and data.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::physics::elasticity::{Coefficient, ElasticBoundary, Elasticity, Material, PlaneModel};
+/// use std::sync::Arc;
+/// // Uniaxial tension on rollers: u_x = 0 on the left, u_y = 0 at the
+/// // bottom, σn = (1, 0) on the right. Plane stress with E = 1, ν = ¼
+/// // gives ε_xx = 1, ε_yy = −¼: u = (x, −y/4), reproduced exactly.
+/// let mesh = rectangle(4, 2, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// let material = Material::Young { young: Coefficient::constant(1.0), poisson: Coefficient::constant(0.25) };
+/// let u = Elasticity::new(material, Arc::new(|_| [0.0; 3]))
+///     .with_plane(PlaneModel::Stress)
+///     .with_boundary("xmin", ElasticBoundary::Component { component: 0, value: Arc::new(|_| 0.0) })
+///     .with_boundary("ymin", ElasticBoundary::Component { component: 1, value: Arc::new(|_| 0.0) })
+///     .with_boundary("xmax", ElasticBoundary::Traction(Arc::new(|_| [1.0, 0.0, 0.0])))
+///     .solve(&mesh)
+///     .unwrap();
+/// for v in 0..mesh.cell_count(0) {
+///     let x = mesh.vertices().point(v);
+///     let [ux, uy, _] = u.at(v);
+///     assert!((ux - x[0]).abs() < 1e-12 && (uy + x[1] / 4.0).abs() < 1e-12);
+/// }
+/// ```
 #[derive(Clone)]
 pub enum ElasticBoundary {
     /// u = g (every component).
     Displacement(VectorFn),
     /// u_a = g for one component a (a roller, a symmetry plane); the other
     /// components are traction-free.
-    Component { component: usize, value: ScalarFn },
+    Component {
+        /// The component a: 0 for x, 1 for y, 2 for z.
+        component: usize,
+        /// g, its prescribed value.
+        value: ScalarFn,
+    },
     /// σ n = t, n the outward normal.
     Traction(VectorFn),
 }
@@ -150,8 +233,8 @@ pub enum ElasticBoundary {
 /// use hasse_solver::physics::elasticity::{Coefficient, ElasticBoundary, Elasticity, Material};
 /// use std::sync::Arc;
 /// // A bar clamped at x = 0 and pulled at x = 2 by a unit traction:
-/// // σ_xx = 1, so u_x(2, y) = 2/E in plane stress with ν = 0 (no lateral
-/// // contraction).
+/// // σ_xx = 1, so u_x(2, y) = 2/E. With ν = 0 there is no lateral
+/// // contraction (and plane strain and plane stress agree).
 /// let mesh = rectangle(8, 2, [0.0, 2.0], [0.0, 0.5]).unwrap();
 /// let material = Material::Young { young: Coefficient::constant(4.0), poisson: Coefficient::constant(0.0) };
 /// let problem = Elasticity::new(material, Arc::new(|_| [0.0; 3]))
@@ -163,6 +246,7 @@ pub enum ElasticBoundary {
 /// ```
 #[derive(Clone)]
 pub struct Elasticity {
+    /// λ and μ (or E and ν), per top cell.
     pub material: Material,
     /// Body force f (the first d components are used).
     pub body_force: VectorFn,
@@ -180,55 +264,110 @@ pub struct Elasticity {
 /// Why an elasticity problem could not be solved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ElasticityError {
+    /// The mesh is not a 2D or 3D volume mesh (n = d ∈ {2, 3}): a
+    /// surface or a curve has no in-plane elasticity here.
     #[error("elasticity needs a 2- or 3-dimensional mesh that fills its space; this one is {n}-dimensional in R^{d}")]
-    Dimension { n: usize, d: usize },
-    #[error("{count} material values given for {cells} top cells")]
-    CoefficientCount { count: usize, cells: usize },
-    #[error("material parameter {what} = {value} in top cell {cell} is not finite")]
-    NonFiniteMaterial {
-        what: &'static str,
-        cell: usize,
-        value: f64,
-    },
-    #[error("Lamé parameters λ = {lambda}, μ = {mu} in top cell {cell}: need μ > 0 and λ + 2μ/{d} > 0 (positive shear and bulk moduli)")]
-    Lame {
-        cell: usize,
-        lambda: f64,
-        mu: f64,
+    Dimension {
+        /// Dimension of the complex.
+        n: usize,
+        /// Dimension of the space it lies in.
         d: usize,
     },
+    /// A [`Coefficient::PerCell`] has not one value per top cell.
+    #[error("{count} material values given for {cells} top cells")]
+    CoefficientCount {
+        /// Values given.
+        count: usize,
+        /// Top cells of the mesh.
+        cells: usize,
+    },
+    /// A material parameter is NaN or ±∞ in a cell.
+    #[error("material parameter {what} = {value} in top cell {cell} is not finite")]
+    NonFiniteMaterial {
+        /// `"λ"`, `"μ"`, `"E"` or `"ν"`.
+        what: &'static str,
+        /// The top cell.
+        cell: usize,
+        /// The value there.
+        value: f64,
+    },
+    /// The Lamé parameters of a cell make the stiffness indefinite.
+    #[error("Lamé parameters λ = {lambda}, μ = {mu} in top cell {cell}: need μ > 0 and λ + 2μ/{d} > 0 (positive shear and bulk moduli)")]
+    Lame {
+        /// The top cell.
+        cell: usize,
+        /// Its λ.
+        lambda: f64,
+        /// Its μ.
+        mu: f64,
+        /// The space dimension, which sets the bulk modulus λ + 2μ/d.
+        d: usize,
+    },
+    /// Young's modulus is zero or negative in a cell.
     #[error("Young's modulus E = {young} in top cell {cell} must be positive")]
-    Young { cell: usize, young: f64 },
+    Young {
+        /// The top cell.
+        cell: usize,
+        /// Its E.
+        young: f64,
+    },
+    /// Poisson's ratio lies outside (−1, ½) in a cell (½ would make λ
+    /// infinite).
     #[error("Poisson's ratio ν = {poisson} in top cell {cell} must lie in (−1, 0.5)")]
-    Poisson { cell: usize, poisson: f64 },
+    Poisson {
+        /// The top cell.
+        cell: usize,
+        /// Its ν.
+        poisson: f64,
+    },
+    /// A boundary condition names a tag the mesh does not have, or one
+    /// that does not tag boundary faces.
     #[error(transparent)]
     Tag(#[from] TagError),
+    /// An [`ElasticBoundary::Component`] names a component ≥ d.
     #[error("boundary condition on tag '{tag}' fixes component {component}, but displacements have {d} components (0..{d})")]
     Component {
+        /// The condition's tag.
         tag: String,
+        /// The component it names.
         component: usize,
+        /// Components of the displacement.
         d: usize,
     },
     /// A given function (body force, boundary displacement or traction)
     /// is NaN or ±∞ at a point.
     #[error("{datum} is not finite ({}) at {}", non_finite_text(*.value), point_text(.point))]
     NonFinite {
+        /// Which input gave the value.
         datum: Datum,
+        /// Where it was evaluated.
         point: Vec<f64>,
+        /// The value (NaN or ±∞).
         value: f64,
     },
+    /// The prescribed displacements do not hold some rigid-body motion of
+    /// a connected part of the mesh, so K is singular there.
     #[error("the prescribed displacements leave {free} of the {modes} rigid-body modes (translations and rotations) of part {part} of the mesh free, so the solution is not unique; prescribe displacements on enough of its boundary (pure traction problems have no unique solution)")]
     RigidModes {
+        /// Index of the connected part, parts numbered in the order
+        /// of their lowest vertex.
         part: usize,
+        /// How many rigid-body modes are left free.
         free: usize,
+        /// How many the part has: d(d+1)/2.
         modes: usize,
     },
+    /// The element stiffness refused the mesh (cells of an unsupported
+    /// shape, degenerate cells).
     #[error(transparent)]
     Metric(#[from] MetricError),
+    /// A and Ω do not fit together.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
+    /// The factorisation or solve failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// Another failure of the shared solve with fixed unknowns.
     #[error(transparent)]
     Diffusion(DiffusionError),
 }
@@ -246,6 +385,7 @@ pub struct ElasticSystem {
     pub rhs: Vec<f64>,
     /// Prescribed values of the fixed unknowns.
     pub fixed: Vec<Option<f64>>,
+    /// Seconds the assembly took.
     pub assembly_seconds: f64,
 }
 
@@ -256,7 +396,9 @@ pub struct Displacement {
     pub dim: usize,
     /// Component-major: u_a at vertex v is `values[a * vertices + v]`.
     pub values: Vec<f64>,
+    /// The linear solve: sizes, seconds and relative residual.
     pub report: SolveReport,
+    /// Seconds to assemble K and the loads.
     pub assembly_seconds: f64,
 }
 
@@ -433,6 +575,27 @@ impl Elasticity {
     }
 
     /// Assemble K = Aᵀ Ω A, the loads and the prescribed components.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::physics::elasticity::{rigid_modes, Coefficient, ElasticBoundary, Elasticity, Material};
+    /// use std::sync::Arc;
+    /// let mesh = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    /// let material = Material::Lame { lambda: Coefficient::constant(1.0), mu: Coefficient::constant(1.0) };
+    /// let system = Elasticity::new(material, Arc::new(|_| [0.0; 3]))
+    ///     .with_boundary("xmin", ElasticBoundary::Displacement(Arc::new(|_| [0.0; 3])))
+    ///     .assemble(&mesh)
+    ///     .unwrap();
+    /// // 6 vertices × 2 components; the 2 clamped vertices fix 4 of them.
+    /// assert_eq!((system.dim, system.matrix.nrows()), (2, 12));
+    /// assert_eq!(system.fixed.iter().filter(|g| g.is_some()).count(), 4);
+    /// // Rigid motions strain nothing: K r = 0 for both translations and
+    /// // the rotation.
+    /// let k = system.matrix.to_dense();
+    /// for r in rigid_modes(&mesh) {
+    ///     assert!((0..12).all(|i| (0..12).map(|j| k[(i, j)] * r[j]).sum::<f64>().abs() < 1e-12));
+    /// }
+    /// ```
     pub fn assemble(&self, complex: &Complex) -> Result<ElasticSystem, ElasticityError> {
         let started = Instant::now();
         let d = dimension(complex)?;

@@ -29,6 +29,25 @@ use hasse_complex::Complex;
 use sprs::CsMat;
 
 /// The metric Ω on the (n−1)-cells.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::physics::gradient::{normal_gradient, FaceMetric};
+/// // f = 3x + y at the centroids of a 4×4 grid with h = ½: the normal
+/// // gradient is ±3 on vertical faces and ±1 on horizontal ones.
+/// let k = rectangle(4, 4, [0.0, 2.0], [0.0, 2.0]).unwrap();
+/// let f: Vec<f64> = (0..16).map(|c| { let x = k.centroid_of(2, c); 3.0 * x[0] + x[1] }).collect();
+/// let two_point = normal_gradient(&k, &f, &FaceMetric::TwoPoint).unwrap();
+/// for (face, g) in two_point.gradient.iter().enumerate() {
+///     let interior = k.boundary(2).outer_view(face).unwrap().nnz() == 2;
+///     let vertical = k.normal()[2 * face].abs() > 0.5;
+///     let expected = if !interior { 0.0 } else if vertical { 3.0 } else { 1.0 };
+///     assert!((g.abs() - expected).abs() < 1e-12);
+/// }
+/// // On a uniform grid that is σ = 1/h on every face.
+/// let diagonal = normal_gradient(&k, &f, &FaceMetric::Diagonal(2.0)).unwrap();
+/// assert!(diagonal.gradient.iter().zip(&two_point.gradient).all(|(a, b)| (a - b).abs() < 1e-12));
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub enum FaceMetric {
     /// Ω = σ I.
@@ -44,18 +63,36 @@ pub enum FaceMetric {
 /// Why a normal gradient could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum GradientError {
+    /// The complex is a set of points: there are no faces to jump across.
     #[error("a gradient needs a mesh of dimension ≥ 1")]
     NoFaces,
+    /// The field has not one value per top cell.
     #[error("{count} field values given for {cells} top cells")]
-    FieldCount { count: usize, cells: usize },
+    FieldCount {
+        /// Values given.
+        count: usize,
+        /// Top cells of the mesh.
+        cells: usize,
+    },
+    /// The field is NaN or ±∞ on a cell.
     #[error("the field is not finite ({value}) at top cell {cell}")]
-    NonFinite { cell: usize, value: f64 },
+    NonFinite {
+        /// The first such top cell.
+        cell: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// An entry of [`FaceMetric::Entries`] lies outside the faces.
     #[error("metric entry ({row}, {column}) names a face the mesh does not have (it has {faces}, numbered from 0)")]
     FaceOutOfRange {
+        /// The entry's row face.
         row: usize,
+        /// The entry's column face.
         column: usize,
+        /// Number of (n−1)-cells.
         faces: usize,
     },
+    /// A and Ω do not fit together.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
 }

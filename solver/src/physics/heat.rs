@@ -35,6 +35,24 @@ pub type SpaceTimeFn = Arc<dyn Fn(&[f64], f64) -> f64 + Send + Sync>;
 
 /// Data that may depend on time. Steady data are assembled once; varying
 /// data are re-assembled at every time level.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::heat::{Heat, HeatBoundary, TimeFn};
+/// use hasse_solver::physics::Conductivity;
+/// use std::sync::Arc;
+/// // u = t solves ∂u/∂t − Δu = 1 with u = t on the boundary, and the
+/// // θ-scheme is exact for it (it is linear in t and constant in x).
+/// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let heat = Heat::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), 0.1)
+///     .with_source(TimeFn::Steady(Arc::new(|_| 1.0)))
+///     .with_boundary("boundary", HeatBoundary::Dirichlet(TimeFn::Varying(Arc::new(|_, t| t))));
+/// let history = heat.run(&mesh, &|_| 0.0, 5, 1).unwrap();
+/// for (t, u) in history.times.iter().zip(&history.fields) {
+///     assert!(u.iter().all(|v| (v - t).abs() < 1e-12));
+/// }
+/// ```
 #[derive(Clone)]
 pub enum TimeFn {
     /// g(x), the same at every time.
@@ -61,44 +79,97 @@ impl TimeFn {
 
 /// A boundary condition of the heat problem (see [`BoundaryKind`]); the
 /// Robin coefficient α enters the matrix and so may not depend on time.
+///
+/// ```
+/// use hasse_complex::generate::interval;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::heat::{Heat, HeatBoundary, TimeFn};
+/// use hasse_solver::physics::Conductivity;
+/// use std::sync::Arc;
+/// // A bar at u = 0 exchanging heat through both ends with an exterior
+/// // at g/α = 0.5 (K∇u·n + 2u = 1) settles at u = 0.5.
+/// let mesh = interval(8, 0.0, 1.0).unwrap();
+/// let robin = HeatBoundary::Robin { alpha: Arc::new(|_| 2.0), value: TimeFn::Steady(Arc::new(|_| 1.0)) };
+/// let heat = Heat::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), 10.0)
+///     .with_boundary("boundary", robin);
+/// let history = heat.run(&mesh, &|_| 0.0, 20, 0).unwrap();
+/// assert!(history.fields[1].iter().all(|u| (u - 0.5).abs() < 1e-9));
+/// ```
 #[derive(Clone)]
 pub enum HeatBoundary {
+    /// u = g(x, t).
     Dirichlet(TimeFn),
+    /// K∇u·n = g(x, t), n outward: g > 0 heats the domain.
     Neumann(TimeFn),
-    Robin { alpha: ScalarFn, value: TimeFn },
+    /// K∇u·n + α u = g(x, t), α > 0.
+    Robin {
+        /// The transfer coefficient α(x), constant in time.
+        alpha: ScalarFn,
+        /// g, the right-hand side of the condition.
+        value: TimeFn,
+    },
 }
 
 /// Why a transient run could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HeatError {
+    /// [`Heat::dt`] is zero, negative, NaN or infinite.
     #[error("time step Δt = {dt} must be positive and finite")]
-    TimeStep { dt: f64 },
+    TimeStep {
+        /// The step given.
+        dt: f64,
+    },
+    /// [`Heat::theta`] lies outside [0, 1], where the θ-scheme is no
+    /// consistent mix of the two time levels.
     #[error("θ = {theta} must lie in [0, 1] (1: backward Euler, ½: Crank–Nicolson)")]
-    Theta { theta: f64 },
+    Theta {
+        /// The θ given.
+        theta: f64,
+    },
+    /// [`Heat::start`] is NaN or infinite.
     #[error("start time t₀ = {t0} is not finite")]
-    StartTime { t0: f64 },
+    StartTime {
+        /// The start time given.
+        t0: f64,
+    },
     /// A given function (the initial value) is NaN or ±∞ at a point.
     #[error("{datum} is not finite ({}) at {} (t = {time})", non_finite_text(*.value), point_text(.point))]
     NonFinite {
+        /// Which input gave the value.
         datum: Datum,
+        /// Where it was evaluated.
         point: Vec<f64>,
+        /// The value (NaN or ±∞).
         value: f64,
+        /// The time level it was evaluated at.
         time: f64,
     },
     /// The temperature itself overflowed: an unstable scheme (θ < ½ with
     /// a step above the stability limit), not a wrong datum.
     #[error("the temperature is not finite at {} at t = {time}: the θ-scheme with θ = {theta} is only conditionally stable (θ < ½ needs Δt below about h²/(2K) per dimension); use θ ≥ ½ or a smaller time step", point_text(.point))]
     Overflow {
+        /// Where the first non-finite value lives.
         point: Vec<f64>,
+        /// The time level it appeared at.
         time: f64,
+        /// The scheme's θ.
         theta: f64,
     },
+    /// The method's unknowns have no lumped mass (the hybrid mimetic
+    /// method's face unknowns stand for no volume).
     #[error("the {method} method has no mass matrix here: transient heat needs nodal or cell-centred unknowns")]
-    Unsupported { method: &'static str },
+    Unsupported {
+        /// The method's name.
+        method: &'static str,
+    },
+    /// The spatial problem (conductivity, tags, boundary data, sources)
+    /// could not be assembled.
     #[error(transparent)]
     Diffusion(#[from] DiffusionError),
+    /// The factorisation of M/Δt + θK or a solve with it failed.
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The operator M/Δt + θK could not be formed.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
 }
@@ -125,7 +196,9 @@ pub enum HeatError {
 /// ```
 #[derive(Clone)]
 pub struct Heat {
+    /// The spatial discretisation (nodal or cell-centred).
     pub method: Method,
+    /// K, constant in time.
     pub conductivity: Conductivity,
     /// f(x, t).
     pub source: TimeFn,
@@ -146,6 +219,7 @@ pub struct Heat {
 /// The computed time levels and how long they took.
 #[derive(Clone, Debug)]
 pub struct History {
+    /// Where the unknowns of the fields live.
     pub location: Location,
     /// Degree of the cochain the fields are: 0 (nodal) or n (cell-centred).
     pub degree: usize,
@@ -168,13 +242,36 @@ pub struct History {
 }
 
 /// What [`Heat::run_observed`] reports while it runs.
+///
+/// ```
+/// use hasse_complex::generate::interval;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::heat::{Heat, HeatEvent};
+/// use hasse_solver::physics::Conductivity;
+/// use std::sync::Arc;
+/// let mesh = interval(4, 0.0, 1.0).unwrap();
+/// let heat = Heat::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), 0.1);
+/// let mut events = Vec::new();
+/// heat.run_observed(&mesh, &|_| 1.0, 2, 1, &mut |event| {
+///     events.push(match event {
+///         HeatEvent::Level { index, .. } => format!("level {index}"),
+///         HeatEvent::Step(n) => format!("step {n}"),
+///     })
+/// })
+/// .unwrap();
+/// // Each saved level is told before the step that produced it.
+/// assert_eq!(events, ["level 0", "level 1", "step 1", "level 2", "step 2"]);
+/// ```
 #[derive(Clone, Copy, Debug)]
 pub enum HeatEvent<'a> {
     /// Saved level `index` (0 is t₀) at `time`, with all unknowns as in
     /// [`History::fields`]; told before the step's [`HeatEvent::Step`].
     Level {
+        /// Position among the saved levels.
         index: usize,
+        /// Its time t.
         time: f64,
+        /// u at t, every unknown.
         field: &'a [f64],
     },
     /// Step number `n` (1-based) has been taken.

@@ -58,33 +58,69 @@ use sprs::CsMat;
 /// ```
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MaxwellError {
+    /// The complex is not 2- or 3-dimensional.
     #[error("a Maxwell cavity needs a 2- or 3-dimensional complex (curl lives on edges and faces); this one is {dim}-dimensional")]
-    Dimension { dim: usize },
+    Dimension {
+        /// Its dimension n.
+        dim: usize,
+    },
+    /// A closed surface or a periodic complex: there is no wall to hold
+    /// the tangential field at zero.
     #[error("the complex has no boundary: a cavity needs conducting walls (boundary (n−1)-cells)")]
     NoWall,
+    /// The mesh is so coarse that every edge touches the wall.
     #[error("every edge lies on the wall, so no field is left (refine the mesh)")]
     NoInteriorEdges,
+    /// A Hodge star that enters K or M is zero or negative (a
+    /// circumcentric dual on a mesh that is not well centred).
     #[error("⋆{p} of {p}-cell {cell} is {value:e} ≤ 0: with a vanishing or negative star the {what} is not definite and spurious modes appear. Use the barycentric dual, a well-centred mesh{hint}")]
     NonPositiveStar {
+        /// Degree of the star: 1 (the mass) or 2 (the curl-curl).
         p: usize,
+        /// The p-cell.
         cell: usize,
+        /// Its star, ≤ 0 or NaN.
         value: f64,
+        /// The operator it would spoil, in words.
         what: &'static str,
+        /// A further remedy for the message (the Whitney mass), or empty.
         hint: &'static str,
     },
+    /// The LLᵀ of the gradient Gram matrix Gᵀ M G failed, so the null
+    /// space of K cannot be deflated.
     #[error("the gradients of the interior vertices are not independent (Gᵀ M G is not positive definite): {0}")]
     DependentGradients(SolveError),
+    /// The complex could not give a dual or a star.
     #[error(transparent)]
     Complex(#[from] ComplexError),
+    /// The Whitney mass refused the mesh (cells that are not simplices).
     #[error(transparent)]
     Metric(#[from] MetricError),
+    /// A and Ω of K or M do not fit together.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
+    /// The eigensolver failed (shift, factorisation or convergence).
     #[error(transparent)]
     Eigen(#[from] EigenError),
 }
 
 /// Which mass matrix M the 1-cochains get.
+///
+/// ```
+/// use hasse_complex::{dual::DualKind, generate::{kuhn, uniform_axis}};
+/// use hasse_solver::physics::maxwell::{Cavity, Mass, MaxwellError};
+/// use std::f64::consts::PI;
+/// // Right triangles: the circumcentre of each lies on its diagonal, whose
+/// // circumcentric dual edge then has length 0.
+/// let x = uniform_axis(8, 0.0, PI).unwrap();
+/// let k = kuhn(&[x.clone(), x]).unwrap();
+/// let hodge = Cavity::new(&k, DualKind::Circumcentric, Mass::Hodge);
+/// assert!(matches!(hodge, Err(MaxwellError::NonPositiveStar { p: 1, .. })));
+/// // The Whitney mass needs no dual: lowest ω² on [0, π]² is 1.
+/// let cavity = Cavity::new(&k, DualKind::Circumcentric, Mass::Whitney).unwrap();
+/// let modes = cavity.modes(1, &cavity.default_options()).unwrap();
+/// assert!((modes.eigenvalues[0] - 1.0).abs() < 0.05);
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mass {
     /// The diagonal DEC Hodge star ⋆₁ = |⋆e| / |e| of the chosen dual.
@@ -159,8 +195,9 @@ pub struct Modes {
     pub fields: Vec<Vec<f64>>,
     /// Relative residuals ‖Ke − ω²Me‖ / (‖Ke‖ + ω²‖Me‖).
     pub residuals: Vec<f64>,
-    /// Krylov basis size and solves with K − σM used.
+    /// Krylov basis size used.
     pub basis: usize,
+    /// Solves with K − σM used.
     pub solves: usize,
     /// The shift σ used.
     pub shift: f64,

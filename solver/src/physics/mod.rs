@@ -25,7 +25,32 @@ pub type TensorFn = Arc<dyn Fn(&[f64]) -> Tensor + Send + Sync>;
 /// A vector-valued function of position (gradients of exact solutions).
 pub type VectorFn = Arc<dyn Fn(&[f64]) -> [f64; 3] + Send + Sync>;
 
-/// The diffusion coefficient K.
+/// The diffusion coefficient K, a function of position evaluated once per
+/// top cell (at its centroid).
+///
+/// A scalar λ stands for λI and is stored as one number a cell; a tensor
+/// must be symmetric positive definite in its leading d×d block (checked
+/// when a problem is assembled).
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// // An anisotropic, rotated K with f = 0: every linear u solves
+/// // ∇·(K∇u) = 0, and Q1 elements reproduce it exactly.
+/// let k = Conductivity::Tensor(Arc::new(|_| [[2.0, 0.5, 0.0], [0.5, 1.0, 0.0], [0.0, 0.0, 1.0]]));
+/// let u = |x: &[f64]| 1.0 + x[0] - 2.0 * x[1];
+/// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let solution = Diffusion::new(Method::Fe, k, Arc::new(|_| 0.0))
+///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(u)))
+///     .solve(&mesh)
+///     .unwrap();
+/// for v in 0..mesh.cell_count(0) {
+///     assert!((solution.values[v] - u(mesh.vertices().point(v))).abs() < 1e-12);
+/// }
+/// ```
 #[derive(Clone)]
 pub enum Conductivity {
     /// K = λ(x) I.
@@ -34,27 +59,103 @@ pub enum Conductivity {
     Tensor(TensorFn),
 }
 
-/// A boundary condition's kind and data.
+/// A boundary condition's kind and data, functions of the position on the
+/// boundary.
+///
+/// The normal n points out of the domain, so a Neumann value g > 0 is
+/// heat flowing *into* the domain: K∇u·n = g means −K∇u·n, the outward
+/// flux, is −g.
+///
+/// ```
+/// use hasse_complex::generate::interval;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// // −(2u′)′ = 0 on [0, 1], u(0) = 0. With K u′·n = g at x = 1 (n = +1),
+/// // u = g x / K; with K u′·n + α u = g instead, u = g x / (K + α).
+/// let mesh = interval(8, 0.0, 1.0).unwrap();
+/// let problem = |right: BoundaryKind| {
+///     Diffusion::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 2.0)), Arc::new(|_| 0.0))
+///         .with_boundary("xmin", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+///         .with_boundary("xmax", right)
+///         .solve(&mesh)
+///         .unwrap()
+/// };
+/// let neumann = problem(BoundaryKind::Neumann(Arc::new(|_| 3.0)));
+/// let robin = problem(BoundaryKind::Robin { alpha: Arc::new(|_| 1.0), value: Arc::new(|_| 3.0) });
+/// for v in 0..mesh.cell_count(0) {
+///     let x = mesh.vertices().point(v)[0];
+///     assert!((neumann.values[v] - 1.5 * x).abs() < 1e-12);
+///     assert!((robin.values[v] - x).abs() < 1e-12);
+/// }
+/// ```
 #[derive(Clone)]
 pub enum BoundaryKind {
     /// u = g.
     Dirichlet(ScalarFn),
     /// K∇u·n = g (n outward).
     Neumann(ScalarFn),
-    /// K∇u·n + α u = g, α > 0.
-    Robin { alpha: ScalarFn, value: ScalarFn },
+    /// K∇u·n + α u = g, α > 0: a heat-transfer (or leaky) boundary towards
+    /// an exterior at u = g/α; α → ∞ approaches Dirichlet, α → 0 Neumann.
+    Robin {
+        /// The transfer coefficient α, positive everywhere on the faces.
+        alpha: ScalarFn,
+        /// g, the right-hand side of the condition.
+        value: ScalarFn,
+    },
 }
 
 /// A condition on the boundary faces carrying a tag.
+///
+/// A problem applies its conditions in order, so a later condition on a
+/// face replaces an earlier one: a condition on `"boundary"` followed by
+/// one on a side changes only that side.
+///
+/// ```
+/// use hasse_complex::generate::interval;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::{BoundaryCondition, BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// let mesh = interval(4, 0.0, 1.0).unwrap();
+/// let mut problem = Diffusion::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 0.0));
+/// problem.boundary = vec![
+///     BoundaryCondition { tag: "boundary".into(), kind: BoundaryKind::Dirichlet(Arc::new(|_| 1.0)) },
+///     BoundaryCondition { tag: "xmax".into(), kind: BoundaryKind::Dirichlet(Arc::new(|_| 0.0)) },
+/// ];
+/// // u(0) = 1 from the first condition, u(1) = 0 from the second: u = 1 − x.
+/// let u = problem.solve(&mesh).unwrap().values;
+/// for v in 0..5 {
+///     assert!((u[v] - (1.0 - mesh.vertices().point(v)[0])).abs() < 1e-12);
+/// }
+/// ```
 #[derive(Clone)]
 pub struct BoundaryCondition {
+    /// The tag of the mesh naming the faces: (n−1)-cells on the boundary.
     pub tag: String,
+    /// The condition and its data.
     pub kind: BoundaryKind,
 }
 
 /// Which input of a problem a value came from, so that an error about
 /// the value can point back to where the input gave it (a front end maps
 /// a datum to its key in a case file).
+///
+/// ```
+/// use hasse_complex::generate::interval;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::{Diffusion, DiffusionError};
+/// use hasse_solver::physics::{BoundaryKind, Conductivity, Datum};
+/// use std::sync::Arc;
+/// let mesh = interval(4, 0.0, 1.0).unwrap();
+/// let problem = Diffusion::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 0.0))
+///     .with_boundary("xmin", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+///     .with_boundary("xmax", BoundaryKind::Dirichlet(Arc::new(|_| f64::NAN)));
+/// let Err(DiffusionError::NonFinite { datum, .. }) = problem.solve(&mesh) else { panic!() };
+/// assert_eq!(datum, Datum::BoundaryValue { condition: 1, kind: "Dirichlet" });
+/// assert_eq!(datum.to_string(), "the Dirichlet value of boundary condition 1");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Datum {
     /// The source f.
@@ -67,11 +168,16 @@ pub enum Datum {
     /// problem's conditions, in the order they were given), of `kind`
     /// Dirichlet, Neumann or Robin.
     BoundaryValue {
+        /// Index of the condition among the problem's conditions.
         condition: usize,
+        /// `"Dirichlet"`, `"Neumann"` or `"Robin"`.
         kind: &'static str,
     },
     /// The Robin α of boundary condition `condition`.
-    RobinAlpha { condition: usize },
+    RobinAlpha {
+        /// Index of the condition among the problem's conditions.
+        condition: usize,
+    },
     /// A named parameter: a material constant (λ, μ, E, ν) or a reaction
     /// coefficient (a, b, c).
     Parameter(&'static str),
@@ -123,12 +229,35 @@ pub(crate) fn non_finite_text(value: f64) -> &'static str {
 /// Why the faces of a boundary tag could not be found.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum TagError {
+    /// The mesh has no tag of this name (a misspelt tag, or a generator
+    /// that names its sides otherwise).
     #[error("boundary condition on tag '{tag}': no such tag in the mesh (tags: {available})")]
-    UnknownTag { tag: String, available: String },
+    UnknownTag {
+        /// The tag as the condition names it.
+        tag: String,
+        /// The mesh's tags, comma-separated, or `none`.
+        available: String,
+    },
+    /// The tag names cells of another dimension than the faces (e.g. a
+    /// region of top cells, or edges of a 3D mesh).
     #[error("boundary condition on tag '{tag}': it tags {dim}-cells, but boundary conditions need (n−1)-cells (n = {n})")]
-    TagDimension { tag: String, dim: usize, n: usize },
+    TagDimension {
+        /// The tag.
+        tag: String,
+        /// Dimension of the cells it tags.
+        dim: usize,
+        /// Dimension of the complex.
+        n: usize,
+    },
+    /// The tag includes a face inside the domain (on two top cells), where
+    /// a boundary condition means nothing.
     #[error("boundary condition on tag '{tag}': face {face} is not on the boundary")]
-    InteriorFace { tag: String, face: usize },
+    InteriorFace {
+        /// The tag.
+        tag: String,
+        /// The first interior (n−1)-cell it names.
+        face: usize,
+    },
 }
 
 /// (face, k) for every (n−1)-cell a tag names, in face order, with k the

@@ -47,13 +47,41 @@ use hasse_complex::Complex;
 use std::fmt;
 
 /// How each step refines.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use hasse_solver::refine::{refine_and_solve, RefineSpec, Strategy};
+/// use std::sync::Arc;
+/// let problem = Diffusion::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)));
+/// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let refined = |strategy| {
+///     let spec = RefineSpec { strategy, steps: 1, ..RefineSpec::default() };
+///     refine_and_solve(&problem, &mesh, &spec, None, &mut |_| {}).unwrap()
+/// };
+/// // A square splits into 4 by both axis planes, into 2 by one wall.
+/// assert_eq!(refined(Strategy::Uniform).levels[1].complex.cell_count(2), 64);
+/// assert_eq!(refined(Strategy::DivideLongestAxis).levels[1].complex.cell_count(2), 32);
+/// // Dörfler marking splits only the cells that carry most of the error.
+/// let adaptive = refined(Strategy::Adaptive { theta: 0.3 });
+/// let marked = adaptive.steps[0].marked.unwrap();
+/// assert!(0 < marked && marked < 16);
+/// assert_eq!(Strategy::Adaptive { theta: 0.3 }.name(), "adaptive");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Strategy {
     /// Every top cell by the axis-aligned hyperplanes through its centroid.
     Uniform,
     /// The cells holding the fraction θ of the squared error indicator
     /// (Dörfler marking), each split like a uniform step.
-    Adaptive { theta: f64 },
+    Adaptive {
+        /// θ ∈ (0, 1]: the share of Σ η_c² the marked cells hold; small θ
+        /// marks few cells, 1 marks them all.
+        theta: f64,
+    },
     /// Every top cell divided once by the plane through its centroid normal
     /// to its longest axis (growing tissue).
     DivideLongestAxis,
@@ -63,6 +91,8 @@ pub enum Strategy {
 }
 
 impl Strategy {
+    /// The name case files (`refine.strategy`), `hasse refine --strategy`
+    /// and reports use.
     pub fn name(&self) -> &'static str {
         match self {
             Strategy::Uniform => "uniform",
@@ -76,6 +106,7 @@ impl Strategy {
 /// A refinement study's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RefineSpec {
+    /// How each step refines (default uniform).
     pub strategy: Strategy,
     /// Refinement steps after the coarse solve.
     pub steps: usize,
@@ -96,20 +127,30 @@ impl Default for RefineSpec {
 /// What one level of the study found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StepReport {
+    /// The step: 0 for the solve on the initial mesh, then 1, 2, ….
     pub step: usize,
+    /// Cells per dimension of this level's complex (`cells[p]` p-cells).
     pub cells: Vec<usize>,
+    /// Unknowns of the solved system.
     pub unknowns: usize,
     /// Cells marked for refinement at the end of this step (adaptive).
     pub marked: Option<usize>,
+    /// L² error against the exact solution, when one was given (see
+    /// [`diffusion::Errors`]).
     pub l2: Option<f64>,
+    /// Largest pointwise error, when an exact solution was given.
     pub max: Option<f64>,
+    /// L² error of the reconstructed gradient, when an exact gradient was
+    /// given.
     pub gradient_l2: Option<f64>,
-    /// CG iterations from zero and from the transferred solution (refined
-    /// steps only).
+    /// CG iterations from zero (refined steps only).
     pub cold_iterations: Option<usize>,
+    /// CG iterations from the transferred solution (refined steps only).
     pub warm_iterations: Option<usize>,
     /// Relative residual of the transferred solution on the refined system.
     pub warm_initial_residual: Option<f64>,
+    /// Wall-clock seconds of the step: refining, moving the solution and
+    /// both solves (on step 0, the one solve).
     pub seconds: f64,
 }
 
@@ -125,14 +166,18 @@ pub struct Exact {
 /// One level of a refinement study: the complex and the solution on it.
 #[derive(Clone, Debug)]
 pub struct Level {
+    /// The complex of this level.
     pub complex: Complex,
+    /// The solution on it (the warm-started one on refined levels).
     pub solution: Solution,
 }
 
 /// The study's steps and every level, the last one the finest.
 #[derive(Clone, Debug)]
 pub struct RefinementStudy {
+    /// One report per step, the initial solve first.
     pub steps: Vec<StepReport>,
+    /// One level per step, in the same order.
     pub levels: Vec<Level>,
 }
 

@@ -21,6 +21,13 @@ use serde::Serialize;
 use std::str::FromStr;
 
 /// How each level's mesh is made from the previous one.
+///
+/// ```
+/// use hasse_solver::study::Refinement;
+/// assert_eq!(Refinement::Uniform.name(), "uniform");
+/// // Reports (the study's JSON) use the same name.
+/// assert_eq!(serde_json::to_value(Refinement::Uniform).unwrap(), "uniform");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Refinement {
@@ -44,6 +51,18 @@ impl Refinement {
 }
 
 /// The error norms a study reports.
+///
+/// ```
+/// use hasse_solver::study::{Norm, StudyRow};
+/// let row = StudyRow {
+///     method: "fe".into(), level: 0, resolution: vec![8, 8], h: 0.18, cells: 64, unknowns: 81,
+///     l2: 1e-3, max: 3e-3, gradient_l2: None, flux: None, mesh_seconds: 0.0, solve_seconds: 0.0,
+/// };
+/// // A nodal method has no face fluxes, and this case no exact gradient.
+/// let present: Vec<&str> = Norm::ALL.iter().filter(|&&n| row.error(n).is_some()).map(|n| n.key()).collect();
+/// assert_eq!(present, ["l2", "max"]);
+/// assert_eq!(Norm::GradientL2.label(), "gradient L²");
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Norm {
@@ -98,8 +117,12 @@ pub struct StudyRow {
     pub h: f64,
     /// Number of top cells.
     pub cells: usize,
+    /// Unknowns of the solved system.
     pub unknowns: usize,
+    /// Discrete L² error of the primary field (see
+    /// [`Errors::l2`](crate::physics::diffusion::Errors::l2)).
     pub l2: f64,
+    /// Largest pointwise error of the primary field.
     pub max: f64,
     /// Gradient L² error, when the case gives the exact gradient.
     pub gradient_l2: Option<f64>,
@@ -126,7 +149,9 @@ impl StudyRow {
 /// Observed orders of one method in one norm.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Orders {
+    /// The method's name.
     pub method: String,
+    /// The norm the errors were measured in.
     pub norm: Norm,
     /// Between level k and k + 1 (None where undefined, e.g. a zero error).
     pub pairwise: Vec<Option<f64>>,
@@ -139,17 +164,23 @@ pub struct Orders {
 pub struct StudyResult {
     /// The case file as named.
     pub case: String,
+    /// The case's title, if it has one.
     pub title: Option<String>,
+    /// How the meshes of the levels were made.
     pub refinement: Refinement,
+    /// Number of levels (meshes), the case's own included.
     pub levels: usize,
     /// Method names in the order studied.
     pub methods: Vec<String>,
+    /// One row per method and level: the first method's levels in order,
+    /// then the next method's.
     pub rows: Vec<StudyRow>,
 }
 
 /// A minimum order that a study must reach: `ORDER[:TOL]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Expectation {
+    /// The order the least-squares L² slope should reach.
     pub order: f64,
     /// Slack below `order` (default 0.15, the design's tolerance).
     pub tolerance: f64,
@@ -163,7 +194,10 @@ impl Expectation {
 /// An expectation that is not `ORDER` or `ORDER:TOLERANCE`.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("`{0}` is not ORDER or ORDER:TOLERANCE with numbers (tolerance ≥ 0), e.g. 2 or 2:0.1")]
-pub struct BadExpectation(pub String);
+pub struct BadExpectation(
+    /// The text as given.
+    pub String,
+);
 
 impl FromStr for Expectation {
     type Err = BadExpectation;
@@ -197,6 +231,7 @@ impl FromStr for Expectation {
 /// A method whose least-squares L² order missed an [`Expectation`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Shortfall {
+    /// The method's name.
     pub method: String,
     /// None when the order could not be computed (e.g. a zero error).
     pub observed: Option<f64>,
@@ -211,6 +246,24 @@ impl StudyResult {
     /// Observed orders of `method` in `norm`. Where some level lacks the
     /// norm (no exact gradient, no flux for this method), every order is
     /// None.
+    ///
+    /// ```
+    /// use hasse_solver::study::{Norm, Refinement, StudyResult, StudyRow};
+    /// let row = |level: usize, h: f64, l2: f64| StudyRow {
+    ///     method: "fv".into(), level, resolution: vec![], h, cells: 0, unknowns: 0,
+    ///     l2, max: l2, gradient_l2: None, flux: Some(l2.sqrt()), mesh_seconds: 0.0, solve_seconds: 0.0,
+    /// };
+    /// let result = StudyResult {
+    ///     case: "demo".into(), title: None, refinement: Refinement::Uniform, levels: 3,
+    ///     methods: vec!["fv".into()],
+    ///     rows: vec![row(0, 0.2, 1.6e-3), row(1, 0.1, 4e-4), row(2, 0.05, 1e-4)],
+    /// };
+    /// // e = 0.04 h²: order 2 in L², and the square root of it order 1.
+    /// let l2 = result.orders("fv", Norm::L2);
+    /// assert!(l2.pairwise.iter().all(|p| (p.unwrap() - 2.0).abs() < 1e-12));
+    /// assert!((result.orders("fv", Norm::Flux).least_squares.unwrap() - 1.0).abs() < 1e-12);
+    /// assert_eq!(result.orders("fv", Norm::GradientL2).least_squares, None);
+    /// ```
     pub fn orders(&self, method: &str, norm: Norm) -> Orders {
         let rows: Vec<&StudyRow> = self.method_rows(method).collect();
         let h: Vec<f64> = rows.iter().map(|r| r.h).collect();

@@ -12,7 +12,12 @@
 pub enum OrderError {
     /// `h` and `e` have different lengths.
     #[error("{h} mesh sizes but {e} errors")]
-    LengthMismatch { h: usize, e: usize },
+    LengthMismatch {
+        /// Mesh sizes given.
+        h: usize,
+        /// Errors given.
+        e: usize,
+    },
     /// An order needs at least two levels.
     #[error("an order needs at least 2 levels, got {0}")]
     TooFewLevels(usize),
@@ -21,8 +26,11 @@ pub enum OrderError {
     /// the solution, and there is no order to observe).
     #[error("level {level}: {what} = {value} is not a positive finite number")]
     NotPositive {
+        /// The level.
         level: usize,
+        /// `"h"` or `"error"`.
         what: &'static str,
+        /// The value.
         value: f64,
     },
     /// Two levels with the same mesh size: the slope is undefined.

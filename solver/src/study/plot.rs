@@ -22,25 +22,57 @@ const FAMILY: &str = "sans-serif";
 /// Why a plot could not be drawn.
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
+    /// The font embedded in the binary was refused by the renderer (a
+    /// broken build, not bad input).
     #[error("the embedded plot font could not be loaded")]
     Font,
+    /// The plotting library failed, e.g. on a size too small for the
+    /// chart; the message is its own.
     #[error("drawing the plot: {0}")]
     Draw(String),
+    /// No error is positive and finite, so a logarithmic axis has nothing
+    /// to show.
     #[error("nothing to plot: no level has a positive error")]
     Empty,
 }
 
 /// Image formats of a study's plot.
+///
+/// ```
+/// use hasse_solver::study::{PlotFormat, PlotOptions, Refinement, StudyResult, StudyRow};
+/// let row = |level: usize, h: f64, l2: f64| StudyRow {
+///     method: "fe".into(), level, resolution: vec![], h, cells: 0, unknowns: 0,
+///     l2, max: l2, gradient_l2: None, flux: None, mesh_seconds: 0.0, solve_seconds: 0.0,
+/// };
+/// let result = StudyResult {
+///     case: "demo.toml".into(), title: None, refinement: Refinement::Uniform, levels: 2,
+///     methods: vec!["fe".into()], rows: vec![row(0, 0.2, 4e-2), row(1, 0.1, 1e-2)],
+/// };
+/// let options = PlotOptions { width: 320, height: 200 };
+/// let bytes = |format| match format {
+///     PlotFormat::Png => result.png(options).unwrap(),
+///     PlotFormat::Svg => result.svg(options).unwrap().into_bytes(),
+/// };
+/// // The PNG signature, and an XML document with an <svg> element.
+/// assert_eq!(&bytes(PlotFormat::Png)[..4], b"\x89PNG");
+/// assert!(String::from_utf8(bytes(PlotFormat::Svg)).unwrap().contains("<svg"));
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PlotFormat {
+    /// A raster image ([`StudyResult::png`]), text drawn with the
+    /// embedded font.
     Png,
+    /// A vector image ([`StudyResult::svg`]); the viewer renders the
+    /// text.
     Svg,
 }
 
 /// Size of the plot in pixels (SVG: user units).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PlotOptions {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
 }
 

@@ -5,6 +5,16 @@ use std::fmt;
 use std::ops::Range;
 
 /// One problem in a case file.
+///
+/// ```
+/// use hasse_solver::frontend::case::Case;
+/// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n\n[problem]\nmethdo = \"fv\"\n";
+/// let errors = Case::from_text("demo.toml", text, &[]).unwrap_err();
+/// let first = errors.iter().next().unwrap();
+/// assert_eq!((first.line, first.column, first.key.as_str()), (6, 1, "problem.methdo"));
+/// assert!(first.help.as_deref().unwrap().contains("method"));
+/// assert!(first.to_string().starts_with("demo.toml:6:1: `problem.methdo`: "));
+/// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct Diagnostic {
     /// The case file (as given on the command line).
@@ -19,6 +29,7 @@ pub struct Diagnostic {
     pub set: Option<String>,
     /// The dotted key, e.g. `boundary[1].value`; empty for file-level problems.
     pub key: String,
+    /// What is wrong, in the case file's terms.
     pub message: String,
     /// How to fix it.
     pub help: Option<String>,
@@ -46,18 +57,35 @@ impl fmt::Display for Diagnostic {
 
 /// Every problem found in one case file; reading reports all of them at
 /// once rather than stopping at the first.
+///
+/// ```
+/// use hasse_solver::frontend::case::Case;
+/// // A misspelt method and a source that names an unknown variable.
+/// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nmethod = \"fvm\"\nsource = \"sin(w * x)\"\n";
+/// let errors = Case::from_text("demo.toml", text, &[]).unwrap_err();
+/// let keys: Vec<&str> = errors.iter().map(|d| d.key.as_str()).collect();
+/// assert_eq!(keys, ["problem.method", "problem.source"]);
+/// // Printed one after the other, each as `error: file:line:col: ...`.
+/// assert_eq!(errors.to_string().matches("error: demo.toml:").count(), 2);
+/// ```
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct Diagnostics(pub Vec<Diagnostic>);
+pub struct Diagnostics(
+    /// The problems, in the order the reader found them.
+    pub Vec<Diagnostic>,
+);
 
 impl Diagnostics {
+    /// Whether there is no problem.
     pub fn is_empty(&self) -> bool {
         self.0.is_empty()
     }
 
+    /// How many problems there are.
     pub fn len(&self) -> usize {
         self.0.len()
     }
 
+    /// The problems, in order.
     pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
         self.0.iter()
     }
@@ -80,7 +108,7 @@ impl std::error::Error for Diagnostics {}
 /// Turns byte offsets of the case text into line and column numbers and
 /// collects diagnostics.
 #[derive(Clone, Debug)]
-pub struct Collector {
+pub(crate) struct Collector {
     file: String,
     text: String,
     line_starts: Vec<usize>,
@@ -167,11 +195,6 @@ impl Collector {
             message: message.into(),
             help,
         }
-    }
-
-    /// The file name used in messages.
-    pub fn file(&self) -> &str {
-        &self.file
     }
 
     /// 1-based (line, column) of a byte offset.

@@ -30,7 +30,7 @@ use std::sync::Arc;
 /// numbers such as `1e-7` (which case files pass on as expression text)
 /// could not be read at all.
 #[derive(Clone, Debug)]
-pub struct ScientificNumbers;
+pub(crate) struct ScientificNumbers;
 
 impl MatchLiteral for ScientificNumbers {
     fn is_literal(text: &str) -> Option<&str> {
@@ -70,22 +70,41 @@ pub enum ExprError {
     /// The text is not an expression; `message` says why in the case
     /// file's terms (never the parser's internals).
     #[error("cannot parse `{text}`: {message}")]
-    Syntax { text: String, message: String },
+    Syntax {
+        /// The text as written.
+        text: String,
+        /// What is wrong with it.
+        message: String,
+    },
     /// The expression uses a name that is neither a coordinate, a constant
     /// nor a definition.
     #[error("unknown variable `{name}` in `{text}`{}", suggestion_text(.suggestion))]
     UnknownVariable {
+        /// The expression as written.
         text: String,
+        /// The unknown name.
         name: String,
+        /// The known name closest to it, if one is close enough to be
+        /// the intended one.
         suggestion: Option<String>,
     },
     /// A constant or definition would shadow a coordinate, a built-in or
     /// an earlier name.
     #[error("`{name}` cannot be used as a name: {reason}")]
-    ReservedName { name: String, reason: String },
+    ReservedName {
+        /// The name.
+        name: String,
+        /// Why it cannot be one.
+        reason: String,
+    },
     /// A constant whose value is NaN or infinite.
     #[error("constant `{name}` is not finite ({value})")]
-    NonFiniteConstant { name: String, value: f64 },
+    NonFiniteConstant {
+        /// The constant's name.
+        name: String,
+        /// Its value.
+        value: f64,
+    },
 }
 
 fn suggestion_text(suggestion: &Option<String>) -> String {
@@ -105,6 +124,19 @@ enum Slot {
 }
 
 /// A parsed expression, ready to evaluate at points.
+///
+/// ```
+/// use hasse_solver::frontend::case::expr::Scope;
+/// let scope = Scope::new();
+/// let e = scope.parse("x^2 + 2.5e-1 * z").unwrap();
+/// // Missing coordinates are 0: a point of a 2D mesh has z = 0.
+/// assert_eq!(e.eval(&[3.0, 1.0], 0.0), 9.0);
+/// assert_eq!(e.eval(&[3.0, 1.0, 4.0], 0.0), 10.0);
+/// assert!(!e.is_constant() && !e.uses_time());
+/// assert!(scope.parse("2 * pi").unwrap().is_constant());
+/// // Division by zero is a value, not an error: callers check values.
+/// assert!(scope.parse("1 / x").unwrap().eval(&[0.0], 0.0).is_infinite());
+/// ```
 #[derive(Clone, Debug)]
 pub struct Expression {
     text: String,
@@ -164,6 +196,21 @@ impl Expression {
 
 /// Names available to expressions: coordinates, `pi`, constants and
 /// definitions.
+///
+/// ```
+/// use hasse_solver::frontend::case::expr::{ExprError, Scope};
+/// let mut scope = Scope::new();
+/// scope.add_constant("amplitude", 3.0).unwrap();
+/// // A definition that uses t makes every expression using it depend on t.
+/// scope.add_definition("wave", "amplitude * sin(x - t)").unwrap();
+/// assert!(scope.parse("wave^2").unwrap().uses_time());
+/// // Names may not shadow coordinates, built-ins or earlier names.
+/// assert!(matches!(scope.add_constant("t", 1.0), Err(ExprError::ReservedName { .. })));
+/// assert!(matches!(scope.add_constant("sin", 1.0), Err(ExprError::ReservedName { .. })));
+/// // Misspelt names come back with the closest known one.
+/// let Err(ExprError::UnknownVariable { suggestion, .. }) = scope.parse("amplitud * x") else { panic!() };
+/// assert_eq!(suggestion.as_deref(), Some("amplitude"));
+/// ```
 #[derive(Clone, Debug, Default)]
 pub struct Scope {
     constants: Vec<(String, f64)>,

@@ -283,23 +283,35 @@ pub enum OutputError {
     /// A directory or file could not be created, written or renamed.
     #[error("{path}: {source}")]
     Io {
+        /// The directory or file.
         path: PathBuf,
+        /// Why.
         #[source]
         source: std::io::Error,
     },
     /// The HDF5 library refused an operation on the (temporary) h5 file.
     #[error("{path}: HDF5 error: {message}")]
-    Hdf5 { path: PathBuf, message: String },
+    Hdf5 {
+        /// The h5 file.
+        path: PathBuf,
+        /// The library's message.
+        message: String,
+    },
     /// A cochain's length is not the number of cells of its degree (in
     /// the complex of its step).
     #[error(
         "cochain '{name}' (step {step}) of degree {dim} has {got} values, the complex has {expected} {dim}-cells"
     )]
     Shape {
+        /// The step, counted from 0.
         step: usize,
+        /// The cochain's name.
         name: String,
+        /// Its degree p.
         dim: usize,
+        /// The number of p-cells.
         expected: usize,
+        /// The number of values.
         got: usize,
     },
     /// A cochain's degree exceeds the dimension of the complex.
@@ -307,9 +319,13 @@ pub enum OutputError {
         "cochain '{name}' (step {step}) has degree {dim}, the complex has dimension {complex_dim}"
     )]
     Degree {
+        /// The step, counted from 0.
         step: usize,
+        /// The cochain's name.
         name: String,
+        /// Its degree.
         dim: usize,
+        /// The dimension of the complex.
         complex_dim: usize,
     },
     /// NaN or ±∞ in a cochain; `cell` is the first bad cell id.
@@ -317,21 +333,41 @@ pub enum OutputError {
         "cochain '{name}' (step {step}) has the non-finite value {value} on {dim}-cell {cell}"
     )]
     NonFinite {
+        /// The step, counted from 0.
         step: usize,
+        /// The cochain's name.
         name: String,
+        /// Its degree p.
         dim: usize,
+        /// The first p-cell with a non-finite value.
         cell: usize,
+        /// That value.
         value: f64,
     },
     /// Two cochains of one step share a name.
     #[error("step {step} has two cochains named '{name}'")]
-    DuplicateName { step: usize, name: String },
+    DuplicateName {
+        /// The step, counted from 0.
+        step: usize,
+        /// The shared name.
+        name: String,
+    },
     /// A cochain name that cannot be an HDF5 link name or an XDMF reference.
     #[error("cochain name '{name}' cannot be stored: {reason}")]
-    InvalidName { name: String, reason: &'static str },
+    InvalidName {
+        /// The name.
+        name: String,
+        /// Why it cannot be stored.
+        reason: &'static str,
+    },
     /// Times must be finite and strictly increasing.
     #[error("step {step} has time {time}: times must be finite and strictly increasing")]
-    Time { step: usize, time: f64 },
+    Time {
+        /// The first step out of order, counted from 0.
+        step: usize,
+        /// Its time.
+        time: f64,
+    },
     /// A series whose mesh changes needs at least one time level: the
     /// complexes come with the levels.
     #[error("a series whose mesh changes needs at least one step")]
@@ -340,23 +376,45 @@ pub enum OutputError {
     /// XDMF files are one per cell degree).
     #[error("step {step} has a complex of dimension {dim}, step 0 one of dimension {expected}")]
     MeshDimension {
+        /// The step, counted from 0.
         step: usize,
+        /// The dimension of its complex.
         dim: usize,
+        /// The dimension of step 0's complex.
         expected: usize,
     },
     /// The output stem cannot name the output files.
     #[error("output stem '{path}': {reason}")]
-    Stem { path: PathBuf, reason: &'static str },
+    Stem {
+        /// The stem as given.
+        path: PathBuf,
+        /// Why it cannot be used.
+        reason: &'static str,
+    },
     /// A provenance or metadata string cannot be stored (e.g. it contains NUL).
     #[error("{field} cannot be stored as an HDF5 string: {reason}")]
-    Text { field: String, reason: String },
+    Text {
+        /// Which string: its attribute or dataset name (e.g.
+        /// `case_text`, `units`).
+        field: String,
+        /// Why.
+        reason: String,
+    },
     /// [`PartialOutput::finish`] was given a run that is not the series it
     /// streamed (other times or another complex); nothing was written.
     #[error("{path}: {reason}")]
-    Partial { path: PathBuf, reason: String },
+    Partial {
+        /// The partial output.
+        path: PathBuf,
+        /// How the run differs from it.
+        reason: String,
+    },
     /// The reader-order connectivity of some cell could not be rebuilt.
     #[error("cannot write the XDMF cells: {message}")]
-    Topology { message: String },
+    Topology {
+        /// Which cell, and why.
+        message: String,
+    },
 }
 
 /// Writes `<stem>.h5`, `<stem>.xdmf` and one `<stem>.<grid>.xdmf` per

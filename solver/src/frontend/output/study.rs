@@ -1,5 +1,6 @@
 //! The files of a convergence study: CSV, JSON and the log–log plot (PNG
-//! or SVG), each written atomically (see [`super::atomic`]).
+//! or SVG), each written under a temporary name and renamed into place,
+//! so that a failed write leaves no truncated file.
 
 use super::atomic::write_atomically;
 use super::OutputError;
@@ -9,12 +10,20 @@ use std::path::Path;
 /// Why a study file could not be written.
 #[derive(Debug, thiserror::Error)]
 pub enum WriteError {
+    /// The file could not be created, written or renamed into place.
     #[error(transparent)]
     Output(#[from] OutputError),
+    /// The plot could not be drawn.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// serde_json refused the study (a non-finite number, say).
     #[error("{path}: the study could not be written as JSON: {message}")]
-    Json { path: String, message: String },
+    Json {
+        /// The JSON file.
+        path: String,
+        /// serde_json's message.
+        message: String,
+    },
 }
 
 /// Write [`StudyResult::csv`] to `path`.

@@ -101,7 +101,7 @@ struct Inner {
 
 impl RunError {
     /// Bad input at key `key` of `case` (`""`: the case as a whole).
-    pub fn input_at(
+    pub(crate) fn input_at(
         case: &Case,
         key: &str,
         message: impl Into<String>,
@@ -116,12 +116,12 @@ impl RunError {
 
     /// Bad input that no single key holds (the mesh and the data
     /// together, e.g. a part of the domain without a Dirichlet boundary).
-    pub fn input(case: &Case, message: impl Into<String>) -> Self {
+    pub(crate) fn input(case: &Case, message: impl Into<String>) -> Self {
         Self::input_at(case, "", message, None)
     }
 
     /// A solve that failed or is not trustworthy.
-    pub fn solve(case: &Case, message: impl Into<String>, help: Option<String>) -> Self {
+    pub(crate) fn solve(case: &Case, message: impl Into<String>, help: Option<String>) -> Self {
         Self(Box::new(Inner {
             input: false,
             diagnostic: case.diagnostic("", message, help),
@@ -130,7 +130,7 @@ impl RunError {
     }
 
     /// The same error, caused by the library error `failure`.
-    pub fn because(mut self, failure: impl Into<Failure>) -> Self {
+    pub(crate) fn because(mut self, failure: impl Into<Failure>) -> Self {
         self.0.failure = Some(failure.into());
         self
     }

@@ -66,13 +66,21 @@ pub use stream::{solve_streaming, write_levels, write_output, LevelStream};
 pub struct RunResult {
     /// Short name of the problem and method, e.g. `diffusion/fe`.
     pub problem: String,
+    /// The method's name, for problems that have one.
     pub method: Option<String>,
+    /// Unknowns of the solved system.
     pub unknowns: usize,
+    /// The cochains to write: the solution and, with an exact solution,
+    /// its values and the error on the same cells; for a transient run,
+    /// those of the last level.
     pub fields: Vec<Cochain>,
+    /// Errors against the case's `[exact]` solution, when it has one.
     pub errors: Option<Errors>,
     /// L² error of face fluxes (cell-centred and hybrid methods).
     pub flux_error: Option<f64>,
+    /// ‖b − Mx‖₂ / ‖b‖₂ of the (last) linear solve, when there is one.
     pub relative_residual: Option<f64>,
+    /// The direct factorisation used, when one was.
     pub factorization: Option<Factorization>,
     /// The fill-reducing ordering of that factorisation, when it is one of
     /// [`Ordering`]'s (not for LU or a solver's own ordering).
@@ -81,6 +89,8 @@ pub struct RunResult {
     pub timings: Vec<(String, f64)>,
     /// Messages worth a user's attention (large residual, pure Neumann…).
     pub warnings: Vec<String>,
+    /// The problem had no Dirichlet or Robin boundary (its solution is
+    /// the one with zero mean).
     pub pure_neumann: bool,
     /// Saved time levels of a transient run, (t, fields) in order; the
     /// output writes them as a time series. Empty for steady problems,

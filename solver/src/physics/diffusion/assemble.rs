@@ -7,6 +7,7 @@ use super::*;
 /// The assembled system of a diffusion problem (see [`Diffusion::assemble`]).
 #[derive(Clone, Debug)]
 pub struct Assembled {
+    /// Where the unknowns live.
     pub location: Location,
     /// The canonical operator, with boundary and ghost rows.
     pub canonical: Canonical,
@@ -26,6 +27,7 @@ pub struct Assembled {
     pub neumann_flux: Vec<f64>,
     /// Cell points of [`Method::Fv`] when they are not the centroids.
     pub cell_points: Option<Vec<f64>>,
+    /// Seconds the assembly took.
     pub assembly_seconds: f64,
     /// What [`Diffusion::data`] needs to redo only the data part.
     layout: DataLayout,

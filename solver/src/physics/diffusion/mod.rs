@@ -88,10 +88,42 @@ pub enum CellPoints {
 }
 
 /// The problem −∇·(K ∇u) = f with boundary conditions.
+///
+/// The fields configure it; [`Diffusion::new`] sets the solver ones to
+/// their defaults and the `with_*` methods chain the common choices.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::Diffusion;
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::f64::consts::PI;
+/// use std::sync::Arc;
+/// // −Δu = 2π² sin(πx) sin(πy), u = 0 on the boundary.
+/// let mesh = rectangle(8, 8, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let problem = |method| {
+///     Diffusion::new(method, Conductivity::Scalar(Arc::new(|_| 1.0)),
+///         Arc::new(|x: &[f64]| 2.0 * PI * PI * (PI * x[0]).sin() * (PI * x[1]).sin()))
+///         .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+/// };
+/// let fv = problem(Method::Fv).solve(&mesh).unwrap();
+/// let fd = problem(Method::Fd).solve(&mesh).unwrap();
+/// // On a uniform grid, two-point finite volumes are the five-point
+/// // finite differences: the same Aᵀ Ω A.
+/// assert!(fv.values.iter().zip(&fd.values).all(|(a, b)| (a - b).abs() < 1e-12));
+/// // 64 cell values, close to u = sin(πx) sin(πy) at the centroids.
+/// assert_eq!(fv.unknowns(), 64);
+/// let centre = 4 * 8 + 4; // the cell at (0.5625, 0.5625)
+/// let exact = (PI * 0.5625).sin().powi(2);
+/// assert!((fv.values[centre] - exact).abs() < 2e-2);
+/// ```
 #[derive(Clone)]
 pub struct Diffusion {
+    /// The discretisation: which Ω (and A) and where the unknowns live.
     pub method: Method,
+    /// K, evaluated at the top cells' centroids.
     pub conductivity: Conductivity,
+    /// f, the source per unit volume (positive f adds heat).
     pub source: ScalarFn,
     /// Applied in order; a later condition on the same face replaces an earlier one.
     pub boundary: Vec<BoundaryCondition>,
@@ -111,8 +143,30 @@ pub struct Diffusion {
 }
 
 /// Settings of an iterative solve.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::la::iterative::CgOptions;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::diffusion::{Diffusion, Iterative};
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// let mesh = rectangle(8, 8, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let mut problem = Diffusion::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+///     .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)));
+/// let direct = problem.solve(&mesh).unwrap();
+/// let options = CgOptions { tolerance: 1e-10, ..CgOptions::default() };
+/// problem.iterative = Some(Iterative { options, ..Iterative::default() });
+/// let cold = problem.solve(&mesh).unwrap();
+/// assert!(cold.iterations.unwrap().iterations > 0);
+/// assert!(cold.values.iter().zip(&direct.values).all(|(a, b)| (a - b).abs() < 1e-8));
+/// // Started from the solution itself, there is nothing left to do.
+/// problem.iterative = Some(Iterative { options, initial: Some(direct.values), ..Iterative::default() });
+/// assert_eq!(problem.solve(&mesh).unwrap().iterations.unwrap().iterations, 0);
+/// ```
 #[derive(Clone, Debug, Default)]
 pub struct Iterative {
+    /// Tolerance and iteration limit of conjugate gradients.
     pub options: CgOptions,
     /// A guess for every unknown (fixed ones are ignored), e.g. a coarse
     /// solution transferred to a refined mesh.
@@ -122,6 +176,31 @@ pub struct Iterative {
 }
 
 /// The preconditioner of an iterative solve.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::la::iterative::CgOptions;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::multigrid::{Hierarchy, MultigridOptions};
+/// use hasse_solver::physics::diffusion::{Diffusion, Iterative, Preconditioning};
+/// use hasse_solver::physics::{BoundaryKind, Conductivity};
+/// use std::sync::Arc;
+/// let mesh = rectangle(32, 32, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let iterations = |preconditioner| {
+///     let mut problem = Diffusion::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), Arc::new(|_| 1.0))
+///         .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)));
+///     let options = CgOptions { tolerance: 1e-8, ..CgOptions::default() };
+///     problem.iterative = Some(Iterative { options, initial: None, preconditioner });
+///     problem.solve(&mesh).unwrap().iterations.unwrap().iterations
+/// };
+/// let jacobi = iterations(Preconditioning::Jacobi);
+/// let multigrid = iterations(Preconditioning::Multigrid {
+///     hierarchy: Hierarchy::Grid { cells: vec![32, 32] },
+///     options: MultigridOptions::default(),
+/// });
+/// // Jacobi needs O(1/h) iterations, a V-cycle a few whatever h.
+/// assert!(multigrid < 15 && 4 * multigrid < jacobi);
+/// ```
 #[derive(Clone, Debug, Default)]
 pub enum Preconditioning {
     /// diag(M)⁻¹: cheap, iteration counts grow like 1/h.
@@ -131,7 +210,10 @@ pub enum Preconditioning {
     /// independent of h. The hierarchy is for all unknowns of the mesh;
     /// Dirichlet unknowns are removed from it at solve time.
     Multigrid {
+        /// How the coarse levels are made (grid levels, SPLIT refinements,
+        /// or algebraic aggregation).
         hierarchy: Hierarchy,
+        /// Cycle and smoother settings.
         options: MultigridOptions,
     },
 }
@@ -139,59 +221,115 @@ pub enum Preconditioning {
 /// Why a problem could not be solved.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DiffusionError {
+    /// A boundary condition names a tag the mesh does not have, or one
+    /// that does not tag boundary faces.
     #[error(transparent)]
     Tag(#[from] TagError),
+    /// A Robin α is zero or negative at a face: the condition would not
+    /// bound the solution (α ≤ 0 can make the system singular or
+    /// indefinite).
     #[error("the Robin coefficient α = {alpha} of boundary condition {condition} (tag '{tag}') at {} (face {face}) must be positive", point_text(.point))]
     RobinAlpha {
+        /// Index of the condition among the problem's conditions.
         condition: usize,
+        /// Its tag.
         tag: String,
+        /// The (n−1)-cell where α was evaluated.
         face: usize,
+        /// Where α was evaluated: a vertex of the face for nodal methods,
+        /// a point of the face (its centroid on boxes) otherwise.
         point: Vec<f64>,
+        /// The value α had there.
         alpha: f64,
     },
     /// A given function is NaN or ±∞ at a point (or, without a point, its
     /// load overflowed).
     #[error("{datum} is not finite ({}){}", non_finite_text(*.value), .point.as_deref().map(|x| format!(" at {}", point_text(x))).unwrap_or_else(|| " in the sum of its load".into()))]
     NonFinite {
+        /// Which input gave the value.
         datum: Datum,
+        /// Where it was evaluated; `None` for an overflowing load.
         point: Option<Vec<f64>>,
+        /// The value (NaN or ±∞).
         value: f64,
     },
+    /// A problem without Dirichlet or Robin boundary has a solution only
+    /// when the sources and boundary fluxes balance, and they do not
+    /// (beyond [`Diffusion::neumann_tolerance`]).
     #[error("pure Neumann problem with incompatible data: sources plus boundary fluxes sum to {imbalance:e} (relative {relative:e}); they must balance (∫f + ∮g = 0)")]
-    IncompatibleNeumann { imbalance: f64, relative: f64 },
+    IncompatibleNeumann {
+        /// Σ b over the unknowns: ∫f + ∮g as assembled.
+        imbalance: f64,
+        /// The imbalance relative to Σ |b|.
+        relative: f64,
+    },
+    /// A problem without Dirichlet or Robin boundary on a domain in
+    /// several pieces: one zero-mean constraint cannot fix a constant on
+    /// each.
     #[error("pure Neumann problem on a disconnected domain ({components} parts): give every part a Dirichlet or Robin boundary")]
-    Disconnected { components: usize },
+    Disconnected {
+        /// Number of connected pieces of the domain.
+        components: usize,
+    },
+    /// Some connected part of the domain has no Dirichlet or Robin
+    /// boundary while another has: the system is singular on that part.
     #[error("the domain has {parts} disconnected parts and the part holding {what} {unknown} (at {point:?}) has no Dirichlet or Robin boundary: its solution is fixed only up to a constant and the system is singular; put a Dirichlet or Robin condition on a boundary tag of every part, or mesh the parts separately")]
     FloatingPart {
+        /// Number of connected parts of the complex (its Betti number b₀).
         parts: usize,
+        /// The kind of the unknown named: `"vertex"`, `"top cell"` or
+        /// `"face"`.
         what: &'static str,
+        /// One unknown of the floating part, numbered among the cells of
+        /// its kind.
         unknown: usize,
+        /// Where that unknown lives.
         point: Vec<f64>,
     },
+    /// The conductivity at a cell is not finite or not symmetric positive
+    /// definite.
     #[error("the conductivity at {} (top cell {cell}) is {}", point_text(.point), coefficient_problem(.source))]
     Coefficient {
+        /// The top cell.
         cell: usize,
+        /// Its centroid, where K was evaluated.
         point: Vec<f64>,
+        /// What the check of the coefficients found.
         source: MetricError,
     },
+    /// The method built a non-symmetric Ω but the chosen factorisation
+    /// needs a symmetric system.
     #[error("the {method} metric is not symmetric, but {factorization} needs a symmetric positive definite system; use Factorization::Lu for a non-symmetric Ω")]
     NotSymmetric {
+        /// The method's name.
         method: &'static str,
+        /// The factorisation asked for.
         factorization: Factorization,
     },
+    /// The method cannot do what the problem asks: cell points with a
+    /// method other than `fv`, new data of other boundary kinds in
+    /// [`Diffusion::data`], a Dirichlet or Robin face on a non-diagonal
+    /// boundary metric.
     #[error("the {method} method cannot impose {what}")]
     Unsupported {
+        /// The method's name.
         method: &'static str,
+        /// What it cannot impose, in words.
         what: &'static str,
     },
+    /// The method refused the mesh or the coefficients while building Ω.
     #[error(transparent)]
     Metric(#[from] MetricError),
+    /// A and Ω do not fit together.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
+    /// The direct factorisation or solve failed (e.g. a singular matrix).
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// Conjugate gradients did not reach the tolerance or broke down.
     #[error(transparent)]
     Iterative(#[from] CgError),
+    /// The multigrid hierarchy could not be built for this mesh.
     #[error(transparent)]
     Multigrid(#[from] MultigridError),
 }
@@ -210,14 +348,18 @@ fn coefficient_problem(error: &MetricError) -> String {
 /// The discrete solution and how it was obtained.
 #[derive(Clone, Debug)]
 pub struct Solution {
+    /// The method that made it.
     pub method: Method,
+    /// Where `values` live.
     pub location: Location,
     /// All unknowns (fixed ones included), in the layout of `location`.
     pub values: Vec<f64>,
     /// The flux cochain Ω A u on the rows of A (edges for nodal methods,
     /// (n−1)-cells for cell-centred ones, half-faces for the hybrid one).
     pub flux: Vec<f64>,
+    /// The linear solve: sizes, seconds and relative residual.
     pub report: SolveReport,
+    /// Seconds to build Ω, A and M = Aᵀ Ω A with the right-hand side.
     pub assembly_seconds: f64,
     /// Whether the direct solve's symbolic analysis ran beside the assembly
     /// (from the solved matrix's pattern known from topology: two-point
@@ -242,7 +384,10 @@ pub struct Solution {
 
 /// max M_ii / min M_ii over the unknowns not held fixed (see
 /// [`Solution::condition_bound`]); infinite when a diagonal entry is zero.
-pub fn diagonal_condition_bound(matrix: &SparseColMat<usize, f64>, fixed: &[Option<f64>]) -> f64 {
+pub(crate) fn diagonal_condition_bound(
+    matrix: &SparseColMat<usize, f64>,
+    fixed: &[Option<f64>],
+) -> f64 {
     let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
     for c in 0..matrix.ncols() {
         if fixed.get(c).is_some_and(Option::is_some) {
@@ -289,7 +434,10 @@ pub struct Errors {
     pub l2: f64,
     /// Largest pointwise error of the primary field.
     pub max: f64,
-    /// Discrete L² error of the cell-wise reconstructed gradient.
+    /// Discrete L² error of the cell-wise reconstructed gradient
+    /// ([`reconstruct_gradient`]) against the exact gradient at the
+    /// centroids, weighted by cell volumes; NaN when no exact gradient was
+    /// given.
     pub gradient_l2: f64,
 }
 
@@ -322,7 +470,7 @@ impl Diffusion {
     /// [`SolverChoice::Multigrid`] runs multigrid-preconditioned CG to
     /// `tolerance`, [`SolverChoice::Auto`] applies [`multigrid::automatic`]
     /// to this method's unknowns on `complex`. A case file's
-    /// `[solver] kind = "direct" | "multigrid" | "amg" | "auto"` maps onto
+    /// `[solver] type = "direct" | "multigrid" | "amg" | "auto"` maps onto
     /// Direct, Multigrid(Grid or Refinements), Multigrid(Algebraic), Auto.
     ///
     /// ```

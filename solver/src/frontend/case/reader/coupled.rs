@@ -1,4 +1,4 @@
-//! The [problem] table of kind = "coupled" and its two [[field]] tables.
+//! The `[problem]` table of kind = "coupled" and its two `[[field]]` tables.
 
 use super::kinds::Conditions;
 use super::*;

@@ -1,4 +1,4 @@
-//! The [mesh] and [problem] tables and the boundary conditions: what a
+//! The `[mesh]` and `[problem]` tables and the boundary conditions: what a
 //! case solves and on which cells.
 
 use super::*;

@@ -1,4 +1,4 @@
-//! The [exact], [solver], [refine] and [output] tables.
+//! The `[exact]`, `[solver]`, `[refine]` and `[output]` tables.
 
 use super::*;
 
