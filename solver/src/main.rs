@@ -132,7 +132,8 @@ enum Command {
     /// Refinement `uniform` re-generates the case's mesh with 2^k times its
     /// mesh.n on level k (voronoi: 4^k times the sites; sphere: k more
     /// subdivisions). A mesh read from a file cannot be refined this way;
-    /// refinement by SPLIT (`--refine split`) will be added with SPLIT.
+    /// `hasse refine` refines any mesh by SPLIT and reports each step's
+    /// errors.
     ///
     /// Prints the table, writes DIR/convergence.csv, .json, .png and .svg
     /// (log–log error against h, reference slopes 1 and 2).
@@ -152,7 +153,7 @@ enum Command {
         /// Number of meshes: the case's own resolution, then N − 1 refinements.
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
         levels: u32,
-        /// How meshes are refined (split refinement will be added with SPLIT).
+        /// How meshes are refined (SPLIT refinement: `hasse refine`).
         #[arg(long, value_enum, default_value_t = RefineArg::Uniform)]
         refine: RefineArg,
         /// Methods side by side on the same meshes (default: the case's own):
