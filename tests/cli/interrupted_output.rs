@@ -11,9 +11,6 @@
 //! are readable and where; a re-run replaces the partial output by the
 //! final one.
 
-#[path = "common/pyenv.rs"]
-mod pyenv;
-
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -255,7 +252,7 @@ fn a_killed_heat_run_keeps_its_completed_levels_and_a_rerun_replaces_them() {
         }
     }
     // A reader that knows nothing of hasse opens the partial series.
-    if let Some(python) = pyenv::python_or_skip("interrupted_output") {
+    if let Some(python) = crate::pyenv::python_or_skip("interrupted_output") {
         let script = r#"
 import sys, meshio
 with meshio.xdmf.TimeSeriesReader(sys.argv[1]) as reader:

@@ -19,9 +19,7 @@ use hasse_solver::physics::VectorFn;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-#[path = "common/orders.rs"]
-mod orders;
-use orders::order;
+use crate::orders::order;
 
 fn scalar(f: impl Fn(&[f64]) -> f64 + Send + Sync + 'static) -> ScalarFn {
     Arc::new(f)

@@ -3,7 +3,7 @@
 //! (`solver/fuzz/harness.rs`). Each file of `tests/fuzz-regressions/TARGET/`
 //! is one input; the test fails if any still panics.
 
-#[path = "../solver/fuzz/harness.rs"]
+#[path = "../../solver/fuzz/harness.rs"]
 mod harness;
 
 use std::cell::Cell;

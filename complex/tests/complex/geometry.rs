@@ -928,7 +928,7 @@ fn results_do_not_depend_on_the_thread_count() {
 }
 
 #[test]
-#[ignore = "timing, run by hand: cargo test --release -p hasse-complex --test geometry -- --ignored --nocapture"]
+#[ignore = "timing, run by hand: cargo test --release -p hasse-complex --test complex geometry:: -- --ignored --nocapture"]
 fn timing_of_a_million_hexahedra() {
     let start = std::time::Instant::now();
     let k = hex_grid([100, 100, 100], [1.0, 1.0, 1.0], 0.0);

@@ -33,9 +33,7 @@ use hasse_solver::physics::Conductivity;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-#[path = "common/orders.rs"]
-mod orders;
-use orders::order;
+use crate::orders::order;
 
 fn exact_u(x: &[f64]) -> f64 {
     (PI * x[0]).sin() * (PI * x[1]).sin()

@@ -27,9 +27,7 @@ use nalgebra::DMatrix;
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-#[path = "common/orders.rs"]
-mod orders;
-use orders::order;
+use crate::orders::order;
 
 const LAMBDA: f64 = 2.0;
 const MU: f64 = 1.0;

@@ -17,9 +17,7 @@ use hasse_solver::physics::darcy::{
 };
 use std::f64::consts::PI;
 
-#[path = "common/orders.rs"]
-mod orders;
-use orders::order;
+use crate::orders::order;
 
 /// A manufactured problem: exact pressure, exact velocity u = −K∇p, scalar
 /// K(x) and f = ∇·u, all written out by hand.

@@ -488,7 +488,7 @@ fn torus_pure_neumann() {
 #[test]
 fn voronoi_virtual_elements() {
     // 400 Voronoi cells, h = 1/20 (mean cell size): VEM is second order in
-    // L² on these meshes (least-squares slope 1.95 in tests/diffusion.rs);
+    // L² on these meshes (least-squares slope 1.95 in tests/physics/diffusion.rs);
     // observed 1.2e-3 = C h² with C ≈ 0.47, bound C ≤ 1.2.
     let (stdout, _) = run_case("cases/voronoi.toml", &[], "voronoi");
     assert!(reported(&stdout, "error", "L2") < 3e-3, "{stdout}");
@@ -497,7 +497,7 @@ fn voronoi_virtual_elements() {
 #[test]
 fn refinement_cases_run_as_shipped() {
     // l-shape-adaptive: 8 Dörfler steps, the last with 2136 cells and
-    // gradient error 3.9e-3 (tests/refinement.rs compares with uniform).
+    // gradient error 3.9e-3 (tests/physics/refinement.rs compares with uniform).
     let (stdout, _) = run_case("cases/l-shape-adaptive.toml", &[], "l-shape-adaptive");
     let rows: Vec<&str> = stdout
         .lines()

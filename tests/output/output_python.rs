@@ -9,11 +9,8 @@
 //! `TimeSeriesReader` is shown to give the first step's mesh only.
 //!
 //! Python runs in a private venv at `<target>/pyenv` (see
-//! `common/pyenv.rs`). Without network the test fails under `CI` and is
+//! `tests/common/pyenv.rs`). Without network the test fails under `CI` and is
 //! skipped loudly elsewhere.
-
-#[path = "common/pyenv.rs"]
-mod pyenv;
 
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
@@ -172,7 +169,7 @@ fn prisms() -> Complex {
 
 #[test]
 fn h5py_and_meshio_read_the_output() {
-    let Some(python) = pyenv::python_or_skip("output_python") else {
+    let Some(python) = crate::pyenv::python_or_skip("output_python") else {
         return;
     };
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("output_python");

@@ -2,15 +2,12 @@
 //! errors from the stored arrays (its own cell areas and exact values), and
 //! meshio opens the XDMF and finds the cells and the field.
 
-#[path = "common/pyenv.rs"]
-mod pyenv;
-
 use std::path::Path;
 use std::process::Command;
 
 #[test]
 fn h5py_and_meshio_read_a_run() {
-    let Some(python) = pyenv::python_or_skip("cli_output") else {
+    let Some(python) = crate::pyenv::python_or_skip("cli_output") else {
         return;
     };
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
