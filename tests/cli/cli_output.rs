@@ -11,8 +11,7 @@ fn h5py_and_meshio_read_a_run() {
         return;
     };
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_output");
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = crate::scratch::Scratch::new("cli_output");
     let stem = dir.join("fv");
     let out = Command::new(env!("CARGO_BIN_EXE_hasse"))
         .args([

@@ -11,6 +11,8 @@
 
 #[path = "../common/pyenv.rs"]
 mod pyenv;
+#[path = "../common/scratch.rs"]
+mod scratch;
 
 mod bad_input;
 mod case_docs;

@@ -6,6 +6,8 @@
 
 #[path = "../common/pyenv.rs"]
 mod pyenv;
+#[path = "../common/scratch.rs"]
+mod scratch;
 
 mod output_files;
 mod output_python;

@@ -5,6 +5,7 @@
 //! reader needs, and failed writes are shown to leave no file behind and an
 //! older output untouched.
 
+use crate::scratch::Scratch;
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
 use hasse_solver::frontend::output::{
@@ -13,12 +14,11 @@ use hasse_solver::frontend::output::{
 };
 use hdf5::types::VarLenUnicode;
 use sprs::CsMat;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("output_files-{name}"));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+/// This test's scratch directory (not created), removed when the test passes.
+fn scratch(name: &str) -> Scratch {
+    Scratch::new(&format!("output_files-{name}"))
 }
 
 fn files_in(dir: &Path) -> Vec<String> {

@@ -172,8 +172,7 @@ fn h5py_and_meshio_read_the_output() {
     let Some(python) = crate::pyenv::python_or_skip("output_python") else {
         return;
     };
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("output_python");
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = crate::scratch::Scratch::new("output_python");
 
     let quad = rectangle(3, 2, [0.0, 1.5], [0.0, 1.0]).unwrap();
     let x = uniform_axis(2, 0.0, 1.0).unwrap();
