@@ -1,7 +1,9 @@
 //! Inputs that once crashed a fuzz target (`scripts/fuzz`), replayed on
 //! stable with the same harness code as the targets
 //! (`solver/fuzz/harness.rs`). Each file of `tests/fuzz-regressions/TARGET/`
-//! is one input; the test fails if any still panics.
+//! is one input (`tests/fuzz-regressions/README.md` says what is kept
+//! there); the test fails if any still panics, and if the directory is
+//! missing or holds no input, since a replay of nothing proves nothing.
 
 #[path = "../../solver/fuzz/harness.rs"]
 mod harness;
@@ -28,15 +30,31 @@ fn watch_panics() {
     });
 }
 
-/// Run every kept input of `target`; returns how many there were.
+/// Where a corpus lives (repository-relative) and how to get it back, for
+/// the failure messages.
+fn restore_hint(target: &str) -> String {
+    format!(
+        "restore tests/fuzz-regressions/{target}/ with \
+         `git checkout HEAD -- tests/fuzz-regressions/{target}`, or put at least \
+         one input there (a crash input from solver/fuzz/artifacts/{target}/ \
+         after `scripts/fuzz`; see tests/fuzz-regressions/README.md)"
+    )
+}
+
+/// Run every kept input of `target`; returns how many there were. A
+/// missing or empty corpus directory is a failure, not a silent pass.
 fn replay(target: &str, run: fn(&[u8])) -> usize {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../tests/fuzz-regressions")
         .join(target);
     let mut count = 0;
-    let Ok(entries) = std::fs::read_dir(&dir) else {
-        return 0;
-    };
+    let entries = std::fs::read_dir(&dir).unwrap_or_else(|e| {
+        panic!(
+            "the `{target}` fuzz corpus {} cannot be read ({e}): {}",
+            dir.display(),
+            restore_hint(target)
+        )
+    });
     for entry in entries {
         let path = entry.unwrap().path();
         if path.file_name().is_some_and(|n| n == "README.md") {
@@ -54,6 +72,12 @@ fn replay(target: &str, run: fn(&[u8])) -> usize {
         );
         count += 1;
     }
+    assert!(
+        count > 0,
+        "the `{target}` fuzz corpus {} holds no input, so nothing was replayed: {}",
+        dir.display(),
+        restore_hint(target)
+    );
     count
 }
 
@@ -69,6 +93,8 @@ fn expression_inputs() {
 
 #[test]
 fn gmsh_inputs() {
+    // The two committed crash inputs (inverted-node-tag-range.msh,
+    // twisted-hex-dd-nonzero.msh).
     assert!(replay("gmsh", harness::gmsh) >= 2);
 }
 
