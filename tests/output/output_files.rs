@@ -21,6 +21,23 @@ fn scratch(name: &str) -> Scratch {
     Scratch::new(&format!("output_files-{name}"))
 }
 
+/// Open a file this test wrote, for reading, without HDF5's file lock.
+///
+/// HDF5 opens files without close-on-exec and locks them with flock(2),
+/// whose lock belongs to the open file description. A child process
+/// spawned by another test of this binary (output_python runs Python)
+/// while one of our writes has its file open inherits the descriptor and
+/// keeps the writer's exclusive lock for its whole life, after the writer
+/// closed the file and renamed it into place; an ordinary open of the
+/// renamed file then fails with "unable to lock file" (EAGAIN). Nothing
+/// else writes these files, so reading them unlocked is safe.
+fn open(path: &Path) -> hdf5::File {
+    hdf5::File::with_options()
+        .with_fapl(|p| p.file_locking(false))
+        .open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
 fn files_in(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .map(|r| {
@@ -229,7 +246,7 @@ fn quad_grid_round_trips_exactly() {
     assert_eq!(files.extra_xdmf, [dir.join("quad.edges.xdmf")]);
     assert_eq!(files_in(&dir), ["quad.edges.xdmf", "quad.h5", "quad.xdmf"]);
 
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     check_mesh(&f, &k);
     assert_eq!(
         f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
@@ -341,7 +358,7 @@ fn triangles_and_hexes_get_reader_vertex_order() {
         &steady(&tri, vec![Cochain::new("id", 2, index_cochain(&tri, 2))]),
     )
     .unwrap();
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     check_mesh(&f, &tri);
     let t = read_i64(&f, "xdmf/2/topology");
     assert_eq!(t.len(), 3 * 18);
@@ -364,7 +381,7 @@ fn triangles_and_hexes_get_reader_vertex_order() {
         Cochain::new("id", 3, index_cochain(&hex, 3)),
     ];
     let files = write_run(&dir.join("hex"), &steady(&hex, cochains)).unwrap();
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     check_mesh(&f, &hex);
     let h = read_i64(&f, "xdmf/3/topology");
     assert_eq!(h.len(), 8 * 4);
@@ -434,7 +451,7 @@ fn polygons_mix_in_one_topology_array() {
         &steady(&k, vec![Cochain::new("id", 2, index_cochain(&k, 2))]),
     )
     .unwrap();
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     check_mesh(&f, &k);
     let mixed = read_i64(&f, "xdmf/2/topology");
     assert_eq!(mixed.len(), (2 + 5) + (1 + 4) + (1 + 3));
@@ -511,7 +528,7 @@ fn polyhedra_are_written_as_tetrahedra_with_their_cell_ids() {
         &steady(&k, vec![Cochain::new("p", 3, values.clone())]),
     )
     .unwrap();
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     let ids = usizes(&read_u64(&f, "xdmf/3/cell_ids"));
     let tets = read_i64(&f, "xdmf/3/topology");
     assert_eq!(tets.len(), 4 * ids.len());
@@ -555,7 +572,7 @@ fn time_series_stores_every_level() {
         .collect();
     let dir = scratch("series");
     let files = write_run(&dir.join("heat"), &run(&k, steps)).unwrap();
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     assert_eq!(
         f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
         3
@@ -798,7 +815,7 @@ fn an_older_output_is_replaced_only_by_a_complete_one() {
     // The new output has no edge cochain: the old run.edges.xdmf would point
     // at /steps/0/flux and /xdmf/1, which the new h5 lacks, so it is gone.
     assert!(second.extra_xdmf.is_empty());
-    let f = hdf5::File::open(&second.hdf5).unwrap();
+    let f = open(&second.hdf5);
     assert_eq!(
         f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
         2
@@ -817,7 +834,7 @@ fn a_1d_complex_is_one_polyline_grid() {
         Cochain::new("q", 1, index_cochain(&k, 1)),
     ];
     let files = write_run(&dir.join("line"), &steady(&k, cochains)).unwrap();
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     check_mesh(&f, &k);
     // (N, 3) with y = z = 0 padding and the embedding dimension kept.
     let vertices = f.dataset("mesh/vertices").unwrap();
@@ -862,7 +879,7 @@ fn stems_that_cannot_name_the_files_are_rejected() {
     // No step at all: the mesh alone, an empty `times`, a grid without attributes.
     let mesh_only = run(&k, vec![]);
     let files = write_run(&dir.join("mesh"), &mesh_only).unwrap();
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     assert_eq!(
         f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
         0
@@ -988,7 +1005,7 @@ fn a_refinement_series_stores_each_mesh_with_its_step() {
         ["refine.edges.xdmf", "refine.h5", "refine.xdmf"]
     );
 
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     let root_u64 = |name: &str| f.attr(name).unwrap().read_scalar::<u64>().unwrap();
     assert_eq!(root_u64("mesh_changes"), 1);
     assert_eq!(root_u64("format_version"), 2);
@@ -1138,7 +1155,7 @@ fn a_series_with_split_polyhedra_keeps_the_expanded_values_with_each_mesh() {
     let dir = scratch("mesh-series-split");
     let files = write_mesh_series(&dir.join("split"), &out).unwrap();
     assert!(files.extra_xdmf.is_empty());
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     check_mesh_at(&f, "steps/0/mesh", &prisms);
     check_mesh_at(&f, "steps/1/mesh", &hexes);
     let ids = usizes(&read_u64(&f, "steps/0/mesh/xdmf/3/cell_ids"));
@@ -1273,7 +1290,7 @@ fn a_bad_mesh_series_is_rejected_before_anything_is_written() {
     // A complete series then replaces it.
     let files = write_mesh_series(&stem, &good()).unwrap();
     assert_eq!(files.extra_xdmf, [dir.join("bad.edges.xdmf")]);
-    let f = hdf5::File::open(&files.hdf5).unwrap();
+    let f = open(&files.hdf5);
     assert_eq!(
         f.attr("mesh_changes")
             .unwrap()
