@@ -2,6 +2,7 @@
 //! it; its reported error is below a stated bound, and where the case has a
 //! closed-form or hand-derived answer the written field is compared with it.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq};
 use hasse_complex::generate;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -100,7 +101,7 @@ fn poisson_square_every_method() {
     // Cell-centred FV on a uniform grid is the five-point FD scheme: the
     // same matrix, so the same solution to rounding.
     for (a, b) in fd_fv[0].iter().zip(&fd_fv[1]) {
-        assert!((a - b).abs() <= 1e-12, "fd {a} vs fv {b}");
+        assert!(abs_diff_eq!(a, b, epsilon = 1e-12), "fd {a} vs fv {b}");
     }
 }
 
@@ -118,7 +119,11 @@ fn l_shape_anisotropic_gmsh() {
     .unwrap();
     let boundary = k.boundary_subcomplex();
     for &v in boundary.cells(0) {
-        assert!(error[v].abs() < 1e-14, "boundary vertex {v}: {}", error[v]);
+        assert!(
+            abs_diff_eq!(error[v], 0.0, epsilon = 1e-14),
+            "boundary vertex {v}: {}",
+            error[v]
+        );
     }
 }
 
@@ -147,10 +152,7 @@ fn poisson_multigrid_matches_the_direct_solve() {
     );
     let l2 = reported(&multigrid, "error", "L2");
     let expected = reported(&direct, "error", "L2");
-    assert!(
-        (l2 - expected).abs() <= 1e-6 * expected,
-        "{l2} vs {expected}"
-    );
+    assert_relative_eq!(l2, expected, epsilon = 0.0, max_relative = 1e-6);
     let iterations = reported(&multigrid, "iterative", "):");
     assert!((1.0..=15.0).contains(&iterations), "{multigrid}");
     // The timing line names the multigrid setup for what it is.
@@ -273,7 +275,7 @@ fn five_point_block_matches_the_hand_built_system() {
         let j = (centre[2 * c + 1] / hy).floor() as usize;
         let want = expected[index(i, j)];
         assert!(
-            (u[c] - want).abs() < 1e-13,
+            abs_diff_eq!(u[c], want, epsilon = 1e-13),
             "cell ({i}, {j}): {} vs {want}",
             u[c]
         );
@@ -317,7 +319,7 @@ fn torus_diagonal_normal_gradient() {
     let g = read(&stem, "normal_gradient");
     let f_written = read(&stem, "f");
     for (a, b) in f_written.iter().zip(&t.f) {
-        assert!((a - b).abs() < 1e-12);
+        assert_abs_diff_eq!(a, b, epsilon = 1e-12);
     }
     let k = &t.complex;
     let centre = k.centroid(2);
@@ -333,7 +335,7 @@ fn torus_diagonal_normal_gradient() {
         };
         let want = (t.f[to] - t.f[from]) / 5.0;
         assert!(
-            (g[face] - want).abs() < 1e-13,
+            abs_diff_eq!(g[face], want, epsilon = 1e-13),
             "face {face}: {} vs {want}",
             g[face]
         );
@@ -367,7 +369,7 @@ fn torus_diagonal_normal_gradient() {
             let sampling = wave * (offset(to) - offset(from)).abs() / 5.0;
             let bound = 1.001 * (truncation + sampling);
             assert!(
-                (g[face] - exact).abs() <= bound,
+                abs_diff_eq!(g[face], exact, epsilon = bound),
                 "face {face}: {} vs ∂f/∂η·n = {exact} (bound {bound})",
                 g[face]
             );
@@ -451,7 +453,7 @@ fn torus_banded_normal_gradient() {
             }
             want *= sign / 5.0;
             assert!(
-                (g[face] - want).abs() < 1e-13,
+                abs_diff_eq!(g[face], want, epsilon = 1e-13),
                 "long face {face}: {} vs {want}",
                 g[face]
             );
@@ -482,7 +484,7 @@ fn torus_pure_neumann() {
     )
     .unwrap();
     let mean: f64 = u.iter().zip(k.measure(2)).map(|(a, w)| a * w).sum::<f64>();
-    assert!(mean.abs() < 1e-10, "mean {mean}");
+    assert_abs_diff_eq!(mean, 0.0, epsilon = 1e-10);
 }
 
 #[test]

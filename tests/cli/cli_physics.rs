@@ -4,6 +4,7 @@
 //! grid, the output holds the time series and the modes, and bad
 //! problem-kind input is refused with the key named.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq, relative_eq};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -83,7 +84,10 @@ fn heat_square_converges_at_second_order_in_space() {
     println!("heat-square, P1 + CN, n = 8, 16, 32: {errors:?}");
     for pair in errors.windows(2) {
         let p = order(pair[0], pair[1], 2.0);
-        assert!((p - 2.0).abs() <= 0.15, "spatial order {p}: {errors:?}");
+        assert!(
+            abs_diff_eq!(p, 2.0, epsilon = 0.15),
+            "spatial order {p}: {errors:?}"
+        );
     }
 }
 
@@ -139,7 +143,7 @@ fn heat_time_orders_are_one_and_two() {
         for pair in errors.windows(2) {
             let p = order(pair[0], pair[1], 2.0);
             assert!(
-                (p - expected).abs() <= 0.15,
+                abs_diff_eq!(p, expected, epsilon = 0.15),
                 "{scheme}: order {p}, errors {errors:?}"
             );
         }
@@ -166,7 +170,10 @@ fn heat_output_is_a_time_series_from_the_initial_field() {
     let times: Vec<f64> = file.attr("times").unwrap().read_raw().unwrap();
     assert_eq!(times.len(), 11);
     for (k, t) in times.iter().enumerate() {
-        assert!((t - 0.01 * k as f64).abs() < 1e-12, "{times:?}");
+        assert!(
+            abs_diff_eq!(*t, 0.01 * k as f64, epsilon = 1e-12),
+            "{times:?}"
+        );
     }
     let vertices: Vec<f64> = file.dataset("mesh/vertices").unwrap().read_raw().unwrap();
     let u0: Vec<f64> = file.dataset("steps/0/u").unwrap().read_raw().unwrap();
@@ -174,18 +181,24 @@ fn heat_output_is_a_time_series_from_the_initial_field() {
     for (v, u) in u0.iter().enumerate() {
         let (x, y) = (vertices[3 * v], vertices[3 * v + 1]);
         let want = (PI * x).sin() * (PI * y).sin();
-        assert!((u - want).abs() < 1e-14, "vertex {v}: {u} vs {want}");
+        assert!(
+            abs_diff_eq!(*u, want, epsilon = 1e-14),
+            "vertex {v}: {u} vs {want}"
+        );
     }
     // The last level's error field is the one summarised on stdout, and
     // the boundary vertices carry the Dirichlet value t (x + y) exactly.
     let last: Vec<f64> = file.dataset("steps/10/u").unwrap().read_raw().unwrap();
     let error: Vec<f64> = file.dataset("steps/10/error").unwrap().read_raw().unwrap();
     let max = error.iter().fold(0.0f64, |m, e| m.max(e.abs()));
-    assert!((max - printed_max).abs() <= 1e-6 * printed_max);
+    assert_relative_eq!(max, printed_max, epsilon = 0.0, max_relative = 1e-6);
     for (v, u) in last.iter().enumerate() {
         let (x, y) = (vertices[3 * v], vertices[3 * v + 1]);
         if x == 0.0 || y == 0.0 || x == 1.0 || y == 1.0 {
-            assert!((u - 0.1 * (x + y)).abs() < 1e-14, "vertex {v}");
+            assert!(
+                abs_diff_eq!(*u, 0.1 * (x + y), epsilon = 1e-14),
+                "vertex {v}"
+            );
         }
     }
 }
@@ -206,7 +219,10 @@ fn darcy_layered_converges_and_conserves_mass() {
     println!("darcy-layered: pressure {pressure:?}, flux {flux:?}");
     let p = order(pressure[0], pressure[3], 8.0);
     let u = order(flux[0], flux[3], 8.0);
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}: {pressure:?}");
+    assert!(
+        abs_diff_eq!(p, 2.0, epsilon = 0.15),
+        "pressure order {p}: {pressure:?}"
+    );
     assert!(u >= 1.0 - 0.15, "flux order {u}: {flux:?}");
 }
 
@@ -229,7 +245,10 @@ fn darcy_layered_converges_in_3d() {
     }
     println!("darcy-layered 3D: pressure {pressure:?}");
     let p = order(pressure[0], pressure[2], 4.0);
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}: {pressure:?}");
+    assert!(
+        abs_diff_eq!(p, 2.0, epsilon = 0.15),
+        "pressure order {p}: {pressure:?}"
+    );
 }
 
 #[test]
@@ -291,7 +310,7 @@ fn maxwell_square_modes_are_the_yee_values() {
     assert_eq!(got.len(), 7, "{out}");
     for (k, ((value, _), w)) in got.iter().zip(want).enumerate() {
         assert!(
-            (value - w).abs() <= 1e-8 * w,
+            relative_eq!(*value, w, epsilon = 0.0, max_relative = 1e-8),
             "mode {}: {value} vs {w}",
             k + 1
         );
@@ -308,7 +327,11 @@ fn maxwell_square_converges_at_second_order_without_spurious_modes() {
     for (k, (c, f)) in coarse.iter().zip(&fine).enumerate() {
         let (ec, ef) = (c.1.unwrap(), f.1.unwrap());
         let p = order(ec, ef, 2.0);
-        assert!((p - 2.0).abs() <= 0.15, "mode {}: order {p}", k + 1);
+        assert!(
+            abs_diff_eq!(p, 2.0, epsilon = 0.15),
+            "mode {}: order {p}",
+            k + 1
+        );
         // The relative error is small: no spurious mode slipped in.
         assert!(ef < 5e-3, "mode {}: {ef}", k + 1);
     }
@@ -365,7 +388,7 @@ fn maxwell_cube_modes_are_the_yee_values() {
     assert_eq!(got.len(), 5, "{out}");
     for (k, ((value, _), w)) in got.iter().zip(want).enumerate() {
         assert!(
-            (value - w).abs() <= 1e-8 * w,
+            relative_eq!(*value, w, epsilon = 0.0, max_relative = 1e-8),
             "mode {}: {value} vs {w}",
             k + 1
         );
@@ -392,7 +415,10 @@ fn elasticity_square_converges_at_second_order() {
         .collect();
     println!("elasticity-square: {errors:?}");
     let p = order(errors[0], errors[3], 8.0);
-    assert!((p - 2.0).abs() <= 0.15, "order {p}: {errors:?}");
+    assert!(
+        abs_diff_eq!(p, 2.0, epsilon = 0.15),
+        "order {p}: {errors:?}"
+    );
     let clamped = run(
         "cases/elasticity-square.toml",
         &[
@@ -404,7 +430,7 @@ fn elasticity_square_converges_at_second_order() {
         ],
     );
     let l2 = reported(&clamped, "error", "L2");
-    assert!((l2 - 7.118e-3).abs() < 1e-6, "{l2}");
+    assert_abs_diff_eq!(l2, 7.118e-3, epsilon = 1e-6);
 }
 
 /// A linear displacement is reproduced to rounding through the case file
@@ -478,7 +504,10 @@ fn coupled_reaction_converges_and_the_coupling_matters() {
     println!("coupled-reaction: u {u:?}, v {v:?}");
     for (name, e) in [("u", &u), ("v", &v)] {
         let p = order(e[0], e[3], 8.0);
-        assert!((p - 2.0).abs() <= 0.15, "{name}: order {p}, {e:?}");
+        assert!(
+            abs_diff_eq!(p, 2.0, epsilon = 0.15),
+            "{name}: order {p}, {e:?}"
+        );
     }
     // The sources belong to b = 2.5: solving with b = 0 misses by O(1)
     // relative to the discretisation error.
@@ -500,7 +529,7 @@ fn multigrid_solver_types_match_the_direct_solution() {
         // A relative residual of 1e-8 moves the discrete solution by far
         // less than the printed 7 digits of a 2e-3 error.
         assert!(
-            (l2 - direct).abs() <= 1e-6 * direct,
+            relative_eq!(l2, direct, epsilon = 0.0, max_relative = 1e-6),
             "{kind}: {l2} vs {direct}"
         );
         let iterations = reported(&out, "iterative", "):");
@@ -515,7 +544,7 @@ fn multigrid_solver_types_match_the_direct_solution() {
         args.extend_from_slice(extra);
         let out = run("cases/box-3d.toml", &args);
         let l2 = reported(&out, "error", "L2");
-        assert!((l2 - direct).abs() <= 1e-6 * direct, "{l2} vs {direct}");
+        assert_relative_eq!(l2, direct, epsilon = 0.0, max_relative = 1e-6);
         reported(&out, "iterative", "):")
     };
     let smoothed = iterations(&[]);

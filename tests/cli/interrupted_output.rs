@@ -11,6 +11,7 @@
 //! are readable and where; a re-run replaces the partial output by the
 //! final one.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -213,7 +214,7 @@ fn a_killed_heat_run_keeps_its_completed_levels_and_a_rerun_replaces_them() {
     for (j, &t) in times.iter().enumerate() {
         let expected = j as f64 * SAVE_EVERY * DT;
         assert!(
-            (t - expected).abs() < 1e-12,
+            abs_diff_eq!(t, expected, epsilon = 1e-12),
             "level {j}: t = {t}, expected {expected}"
         );
     }
@@ -237,7 +238,10 @@ fn a_killed_heat_run_keeps_its_completed_levels_and_a_rerun_replaces_them() {
     assert_eq!(u0.len(), 41 * 41);
     for (v, &u) in u0.iter().enumerate() {
         let (x, y) = (vertices[3 * v], vertices[3 * v + 1]);
-        assert!((u - mode(x, y)).abs() < 1e-12, "vertex {v} ({x}, {y}): {u}");
+        assert!(
+            abs_diff_eq!(u, mode(x, y), epsilon = 1e-12),
+            "vertex {v} ({x}, {y}): {u}"
+        );
     }
     for (j, &t) in times.iter().enumerate() {
         let level = dir.join(format!("out.partial/level-{j}.h5"));
@@ -247,8 +251,11 @@ fn a_killed_heat_run_keeps_its_completed_levels_and_a_rerun_replaces_them() {
         for v in 0..exact.len() {
             let (x, y) = (vertices[3 * v], vertices[3 * v + 1]);
             let formula = (-2.0 * pi * pi * t).exp() * mode(x, y) + t * (x + y);
-            assert!((exact[v] - formula).abs() < 1e-12, "level {j} vertex {v}");
-            assert!((error[v] - (u[v] - exact[v])).abs() < 1e-12);
+            assert!(
+                abs_diff_eq!(exact[v], formula, epsilon = 1e-12),
+                "level {j} vertex {v}"
+            );
+            assert_abs_diff_eq!(error[v], u[v] - exact[v], epsilon = 1e-12);
         }
     }
     // A reader that knows nothing of hasse opens the partial series.
@@ -376,7 +383,10 @@ save_every = 20
         let level = dir.join(format!("out.partial/level-{j}.h5"));
         let u = read_f64(&level, &format!("steps/{j}/u"));
         assert!(u.iter().all(|v| v.is_finite()), "level {j}");
-        assert!((t - j as f64).abs() < 1e-12, "level {j}: t = {t}");
+        assert!(
+            abs_diff_eq!(t, j as f64, epsilon = 1e-12),
+            "level {j}: t = {t}"
+        );
     }
     assert!(!names(&dir).contains(&"out.h5".to_string()));
     std::fs::remove_dir_all(&dir).unwrap();

@@ -6,6 +6,7 @@
 //! (exactness for linear solutions, the divergence theorem, symmetry and
 //! kernels), never by re-running the metric code.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, relative_eq};
 use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::generate::{
     box3, delaunay, graded_axis, grid, perturb, rectangle, uniform_axis,
@@ -49,7 +50,7 @@ fn assert_relative_eq(a: &DMatrix<f64>, b: &DMatrix<f64>, tol: f64, what: &str) 
         for j in 0..a.ncols() {
             let (x, y) = (a[(i, j)], b[(i, j)]);
             assert!(
-                (x - y).abs() <= tol * x.abs().max(y.abs()),
+                relative_eq!(x, y, epsilon = 0.0, max_relative = tol),
                 "{what}: entry ({i}, {j}) is {x} vs {y}"
             );
         }
@@ -333,7 +334,7 @@ fn thesis_five_point_example_entry_by_entry() {
     let s65 = lambda(6, 5) / hx;
     let s95 = lambda(9, 5) / hy;
     let s45 = lambda(4, 5) / hx;
-    let close = |x: f64, y: f64| (x - y).abs() <= 1e-14 * y.abs().max(1.0);
+    let close = |x: f64, y: f64| relative_eq!(x, y, epsilon = 1e-14, max_relative = 1e-14);
     assert!(close(m[(c5, c5)], s15 + s65 + s95 + s45));
     for (l, s) in [(1, s15), (6, s65), (9, s95), (4, s45)] {
         assert!(close(m[(c5, cell(l))], -s), "row 5, column {l}");
@@ -407,14 +408,20 @@ fn two_point_rows_on_a_uniform_grid_match_the_hand_formula() {
     // An interior row is λ(2/h_x² + 2/h_y²)|K| on the diagonal.
     let interior = 2 + nx;
     let volume = hx * hy;
-    assert!(
-        (m[(interior, interior)] - lambda * (2.0 / (hx * hx) + 2.0 / (hy * hy)) * volume).abs()
-            < 1e-12
+    assert_abs_diff_eq!(
+        m[(interior, interior)],
+        lambda * (2.0 / (hx * hx) + 2.0 / (hy * hy)) * volume,
+        epsilon = 1e-12
     );
     for i in 0..nx * ny {
         for j in 0..nx * ny {
             assert!(
-                (m[(i, j)] - expected[(i, j)]).abs() <= 1e-12 * expected[(i, j)].abs().max(1.0),
+                relative_eq!(
+                    m[(i, j)],
+                    expected[(i, j)],
+                    epsilon = 1e-12,
+                    max_relative = 1e-12
+                ),
                 "({i}, {j})"
             );
         }
@@ -586,11 +593,7 @@ fn mimetic_hybrid_matrix_is_symmetric_semidefinite_with_constant_kernel() {
         assert!(ones.iter().all(|v| v.abs() <= 1e-13 * scale), "M·1 ≠ 0");
         let mut eigen: Vec<f64> = m.symmetric_eigen().eigenvalues.iter().copied().collect();
         eigen.sort_by(f64::total_cmp);
-        assert!(
-            eigen[0].abs() <= 1e-12 * scale,
-            "smallest eigenvalue {:e}",
-            eigen[0]
-        );
+        assert_abs_diff_eq!(eigen[0], 0.0, epsilon = 1e-12 * scale);
         assert!(
             eigen[1] > 1e-6 * scale,
             "kernel larger than the constants: {:e}",
@@ -638,7 +641,7 @@ fn mimetic_hybrid_reduces_to_two_point_on_a_graded_grid() {
     let (tpfa, _) = direct::solve(&op.assemble(), &rhs, Factorization::Llt).unwrap();
     for c in 0..cells {
         assert!(
-            (hybrid[c] - tpfa[c]).abs() < 1e-10,
+            abs_diff_eq!(hybrid[c], tpfa[c], epsilon = 1e-10),
             "cell {c}: {} vs {}",
             hybrid[c],
             tpfa[c]

@@ -3,6 +3,7 @@
 //! Expected values are derived by hand in the comments, never read back
 //! from the code under test.
 
+use approx::{assert_abs_diff_eq, assert_relative_eq};
 use hasse_complex::{generate, gmsh, Complex, TopCells, Vertices};
 use sprs::CsMat;
 use std::path::PathBuf;
@@ -285,10 +286,10 @@ fn measures_sum_to_the_domain_measure() {
     let tol = 1e-12;
     let quads = generate::rectangle(7, 5, [0.0, 2.0], [-1.0, 0.5]).unwrap();
     let total: f64 = quads.measure(2).iter().sum();
-    assert!((total - 3.0).abs() < tol * 3.0, "{total}");
+    assert_relative_eq!(total, 3.0, epsilon = 0.0, max_relative = tol);
     let perturbed = generate::perturb(&quads, 0.3, 9).unwrap();
     let total: f64 = perturbed.measure(2).iter().sum();
-    assert!((total - 3.0).abs() < tol * 3.0, "{total}");
+    assert_relative_eq!(total, 3.0, epsilon = 0.0, max_relative = tol);
     let tets = generate::kuhn(&[
         generate::uniform_axis(3, 0.0, 1.0).unwrap(),
         generate::uniform_axis(2, 0.0, 2.0).unwrap(),
@@ -296,18 +297,18 @@ fn measures_sum_to_the_domain_measure() {
     ])
     .unwrap();
     let total: f64 = tets.measure(3).iter().sum();
-    assert!((total - 6.0).abs() < tol * 6.0, "{total}");
+    assert_relative_eq!(total, 6.0, epsilon = 0.0, max_relative = tol);
     // Polygonal annulus with m sectors: m/2 · sin(2π/m) · (R² − r²).
     let m = 16;
     let annulus = generate::annulus(0.5, 1.0, 4, m).unwrap();
     let exact = m as f64 / 2.0 * (2.0 * std::f64::consts::PI / m as f64).sin() * (1.0 - 0.25);
     let total: f64 = annulus.measure(2).iter().sum();
-    assert!((total - exact).abs() < tol, "{total} vs {exact}");
+    assert_abs_diff_eq!(total, exact, epsilon = tol);
     // The cavity range is half-open: cells 1 and 2 in each direction, a
     // 2×2×2 block of cells of side 1/5.
     let hollow = generate::hollow_box(5, [1, 3]).unwrap();
     let total: f64 = hollow.measure(3).iter().sum();
-    assert!((total - (1.0 - 8.0 / 125.0)).abs() < tol, "{total}");
+    assert_abs_diff_eq!(total, 1.0 - 8.0 / 125.0, epsilon = tol);
 }
 
 #[test]
@@ -365,9 +366,9 @@ fn polygon_mesh_counts_and_area() {
     assert_eq!(k.cell_counts(), vec![14, 19, 6]);
     assert_eq!(k.betti_numbers(), vec![1, 0, 0]);
     let total: f64 = k.measure(2).iter().sum();
-    assert!((total - 2.0).abs() < 1e-14, "{total}");
+    assert_abs_diff_eq!(total, 2.0, epsilon = 1e-14);
     // Octagon: unit square minus four corner triangles of area 1/18.
-    assert!((k.measure(2)[0] - (1.0 - 4.0 / 18.0)).abs() < 1e-14);
+    assert_abs_diff_eq!(k.measure(2)[0], 1.0 - 4.0 / 18.0, epsilon = 1e-14);
 }
 
 #[test]

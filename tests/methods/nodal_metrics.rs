@@ -8,6 +8,7 @@
 //! properties that hold for any correct method (linear patch test,
 //! constants in the kernel, symmetry, exact integrals of linear loads).
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_abs_diff_ne, relative_eq};
 use hasse_complex::dual::DualKind;
 use hasse_complex::generate::{box3, delaunay, kuhn, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
@@ -38,7 +39,7 @@ fn assert_close(a: &DMatrix<f64>, b: &DMatrix<f64>, tol: f64, what: &str) {
     for i in 0..a.nrows() {
         for j in 0..a.ncols() {
             assert!(
-                (a[(i, j)] - b[(i, j)]).abs() <= tol * scale,
+                abs_diff_eq!(a[(i, j)], b[(i, j)], epsilon = tol * scale),
                 "{what}: entry ({i}, {j}) is {} vs {}",
                 a[(i, j)],
                 b[(i, j)]
@@ -136,7 +137,7 @@ fn assert_patch_test(complex: &Complex, m: &DMatrix<f64>, what: &str) {
     for (v, &b) in on_boundary.iter().enumerate() {
         if !b {
             assert!(
-                mu[v].abs() <= 1e-12 * scale,
+                abs_diff_eq!(mu[v], 0.0, epsilon = 1e-12 * scale),
                 "{what}: (M u)_{v} = {:e} for linear u",
                 mu[v]
             );
@@ -351,7 +352,7 @@ fn dec_laplacian_equals_p1_on_a_non_delaunay_triangulation() {
     };
     let expected = 0.5 * (cot([1.0, 0.3]) + cot([1.1, -0.25]));
     assert!(expected < -1.0);
-    assert!((weight - expected).abs() < 1e-14, "{weight} vs {expected}");
+    assert_abs_diff_eq!(weight, expected, epsilon = 1e-14);
     assert_dec_and_fe_are_p1(&k, &tensors, "non-Delaunay");
 }
 
@@ -390,12 +391,18 @@ fn diagonal_circumcentric_star_in_3d_is_the_seven_point_stencil_inside_a_kuhn_bo
                 (1, true) => -h,
                 _ => 0.0,
             };
-            assert!((dec[(v, w)] - expected).abs() < 1e-14, "DEC ({v}, {w})");
-            assert!((p1[(v, w)] - expected).abs() < 1e-14, "P1 ({v}, {w})");
+            assert!(
+                abs_diff_eq!(dec[(v, w)], expected, epsilon = 1e-14),
+                "DEC ({v}, {w})"
+            );
+            assert!(
+                abs_diff_eq!(p1[(v, w)], expected, epsilon = 1e-14),
+                "P1 ({v}, {w})"
+            );
         }
     }
     // Near the boundary, and on any perturbed grid, the two differ.
-    assert!((dec[(0, 0)] - p1[(0, 0)]).abs() > 0.05);
+    assert_abs_diff_ne!(dec[(0, 0)], p1[(0, 0)], epsilon = 0.05);
     let p = perturb(&k, 0.3, 11).unwrap();
     let tensors = constant(&p, isotropic(1.0));
     let dec = assemble(
@@ -430,7 +437,7 @@ fn hodge_weights_sum_to_the_dual_measures() {
             let dense = omega.to_dense();
             for (e, s) in k.hodge_star(kind, 1).unwrap().iter().enumerate() {
                 assert!(
-                    (dense[e][e] - s).abs() <= 1e-13 * s.abs().max(1.0),
+                    relative_eq!(dense[e][e], s, epsilon = 1e-13, max_relative = 1e-13),
                     "{kind:?} {e}"
                 );
             }
@@ -452,7 +459,7 @@ fn hodge_weights_sum_to_the_dual_measures() {
             let dense = omega.to_dense();
             for (e, s) in k.hodge_star(kind, 1).unwrap().iter().enumerate() {
                 assert!(
-                    (dense[e][e] - s).abs() <= 1e-13 * s.abs().max(1.0),
+                    relative_eq!(dense[e][e], s, epsilon = 1e-13, max_relative = 1e-13),
                     "3D {kind:?} {e}"
                 );
             }
@@ -530,7 +537,7 @@ fn q1_on_a_uniform_grid_is_the_nine_point_stencil() {
                     _ => 0.0,
                 };
                 assert!(
-                    (m[(row, col)] - expected).abs() < 1e-14,
+                    abs_diff_eq!(m[(row, col)], expected, epsilon = 1e-14),
                     "row {row} col {col}: {} vs {expected}",
                     m[(row, col)]
                 );
@@ -599,7 +606,10 @@ fn q1_on_rectangular_grids_is_the_tensor_product_stiffness() {
             2 => -2.0 / 12.0,
             _ => -1.0 / 12.0,
         };
-        assert!((m[(centre, col)] - expected).abs() < 1e-14, "col {col}");
+        assert!(
+            abs_diff_eq!(m[(centre, col)], expected, epsilon = 1e-14),
+            "col {col}"
+        );
     }
 }
 
@@ -746,10 +756,14 @@ fn dec_patch_test() {
     );
     let centre = 1 + 5;
     let (hx, hy) = (0.5, 1.0 / 3.0);
-    assert!((m[(centre, centre)] - 2.0 * (hy / hx + hx / hy)).abs() < 1e-14);
-    assert!((m[(centre, centre + 1)] + hy / hx).abs() < 1e-14);
-    assert!((m[(centre, centre + 5)] + hx / hy).abs() < 1e-14);
-    assert!(m[(centre, centre + 6)].abs() < 1e-14);
+    assert_abs_diff_eq!(
+        m[(centre, centre)],
+        2.0 * (hy / hx + hx / hy),
+        epsilon = 1e-14
+    );
+    assert_abs_diff_eq!(m[(centre, centre + 1)], -(hy / hx), epsilon = 1e-14);
+    assert_abs_diff_eq!(m[(centre, centre + 5)], -(hx / hy), epsilon = 1e-14);
+    assert_abs_diff_eq!(m[(centre, centre + 6)], 0.0, epsilon = 1e-14);
 }
 
 #[test]
@@ -848,7 +862,7 @@ fn integral_over_simplices(k: &Complex, f: &dyn Fn(&[f64]) -> f64) -> f64 {
 fn assert_total(load: &[f64], expected: f64, what: &str) {
     let total: f64 = load.iter().sum();
     assert!(
-        (total - expected).abs() <= 1e-13 * expected.abs().max(1.0),
+        relative_eq!(total, expected, epsilon = 1e-13, max_relative = 1e-13),
         "{what}: Σ load = {total}, ∫ f = {expected}"
     );
 }
@@ -885,7 +899,10 @@ fn fe_load_integrates_constants_and_linear_functions() {
     let area = 0.5 * ((1.3f64) * 1.1 - 0.2 * 0.2);
     for (v, bv) in b.iter().enumerate() {
         let expected = area * (values.iter().sum::<f64>() + values[v]) / 12.0;
-        assert!((bv - expected).abs() < 1e-14, "{v}: {bv} vs {expected}");
+        assert!(
+            abs_diff_eq!(*bv, expected, epsilon = 1e-14),
+            "{v}: {bv} vs {expected}"
+        );
     }
     // Q1 on distorted quads of [0, 2] × [0, 1] and hexes of the unit cube.
     let q = perturb(&rectangle(5, 4, [0.0, 2.0], [0.0, 1.0]).unwrap(), 0.3, 8).unwrap();
@@ -982,6 +999,9 @@ fn one_dimensional_fe_and_dec_are_the_three_point_stencil() {
         let left = (v > 0).then(|| (x[v] - x[v - 1]) * (2.0 * x[v] + x[v - 1]) / 6.0);
         let right = (v < 5).then(|| (x[v + 1] - x[v]) * (2.0 * x[v] + x[v + 1]) / 6.0);
         let expected = left.unwrap_or(0.0) + right.unwrap_or(0.0);
-        assert!((bv - expected).abs() < 1e-14, "{v}: {bv} vs {expected}");
+        assert!(
+            abs_diff_eq!(*bv, expected, epsilon = 1e-14),
+            "{v}: {bv} vs {expected}"
+        );
     }
 }

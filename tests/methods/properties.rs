@@ -17,6 +17,7 @@
 //! Case counts are small so the suite stays fast; PROPTEST_CASES=N runs N
 //! cases of each property instead.
 
+use approx::relative_eq;
 use hasse_complex::generate::{delaunay, grid, kuhn, perturb, rectangle, uniform_axis, voronoi};
 use hasse_complex::split::{split, Hyperplane, Refinement, SplitOptions};
 use hasse_complex::{Complex, DualKind, Vertices};
@@ -134,7 +135,7 @@ fn check_refinement(coarse: &Complex, fine: &Complex, r: &Refinement) -> Result<
         }
         for (j, (s, m)) in sum.iter().zip(coarse.measure(p)).enumerate() {
             prop_assert!(
-                (s - m).abs() <= 1e-11 * m,
+                relative_eq!(s, m, epsilon = 0.0, max_relative = 1e-11),
                 "{p}-cell {j}: pieces {s}, cell {m}"
             );
         }

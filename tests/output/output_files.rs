@@ -6,6 +6,7 @@
 //! older output untouched.
 
 use crate::scratch::Scratch;
+use approx::assert_abs_diff_eq;
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
 use hasse_solver::frontend::output::{
@@ -367,7 +368,7 @@ fn triangles_and_hexes_get_reader_vertex_order() {
             .iter()
             .map(|&v| point(&tri, v as usize))
             .collect();
-        assert!((shoelace(&pts) - 0.125).abs() < 1e-15);
+        assert_abs_diff_eq!(shoelace(&pts), 0.125, epsilon = 1e-15);
     }
     let xml = std::fs::read_to_string(&files.xdmf).unwrap();
     assert!(xml.contains("TopologyType=\"Triangle\" NumberOfElements=\"18\" NodesPerElement=\"3\""));
@@ -402,7 +403,7 @@ fn triangles_and_hexes_get_reader_vertex_order() {
             assert!(v > 0.0);
             total += v / 6.0;
         }
-        assert!((total - 2.0).abs() < 1e-12);
+        assert_abs_diff_eq!(total, 2.0, epsilon = 1e-12);
     }
     // Faces: every 2-cell of a box is a quad with area of its axis-aligned sides.
     let faces = f.dataset("xdmf/2/topology").unwrap();
@@ -483,7 +484,7 @@ fn polygons_mix_in_one_topology_array() {
             4 => areas[1],
             _ => areas[2],
         };
-        assert!((shoelace(&pts) - expected).abs() < 1e-12);
+        assert_abs_diff_eq!(shoelace(&pts), expected, epsilon = 1e-12);
         r = start + count;
         cell += 1;
     }
@@ -542,7 +543,8 @@ fn polyhedra_are_written_as_tetrahedra_with_their_cell_ids() {
         verts.retain(|v| k.cell_vertices(3, cell).contains(v));
         assert_eq!(verts.len(), 4);
     }
-    assert!((volume[0] - 0.5).abs() < 1e-12 && (volume[1] - 0.5).abs() < 1e-12);
+    assert_abs_diff_eq!(volume[0], 0.5, epsilon = 1e-12);
+    assert_abs_diff_eq!(volume[1], 0.5, epsilon = 1e-12);
     let expanded = read_f64(&f, "xdmf/3/steps/0/p");
     let expected: Vec<f64> = ids.iter().map(|&c| values[c]).collect();
     assert_eq!(expanded, expected);

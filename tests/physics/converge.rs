@@ -2,6 +2,7 @@
 //! `hasse converge` end to end (tables, CSV, JSON, PNG, SVG, `--expect`
 //! exit codes), and uniform refinement of the generators.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use hasse_solver::frontend::converge::{Study, StudyError};
 use hasse_solver::frontend::output::study::write_plot;
 use hasse_solver::metric::Method;
@@ -41,10 +42,16 @@ fn exact_power_laws_give_their_slope_pairwise_and_by_least_squares() {
         let pairwise = pairwise_orders(&h, &e).unwrap();
         assert_eq!(pairwise.len(), h.len() - 1);
         for q in pairwise {
-            assert!((q - p).abs() < 1e-12, "pairwise {q} for slope {p}");
+            assert!(
+                abs_diff_eq!(q, p, epsilon = 1e-12),
+                "pairwise {q} for slope {p}"
+            );
         }
         let fitted = least_squares_order(&h, &e).unwrap();
-        assert!((fitted - p).abs() < 1e-12, "least squares {fitted} for {p}");
+        assert!(
+            abs_diff_eq!(fitted, p, epsilon = 1e-12),
+            "least squares {fitted} for {p}"
+        );
     }
 }
 
@@ -58,10 +65,10 @@ fn least_squares_differs_from_pairwise_as_computed_by_hand() {
     let e = [1.0, 0.25, 0.0625, 0.03125];
     let pairwise = pairwise_orders(&h, &e).unwrap();
     for (q, want) in pairwise.iter().zip([2.0, 2.0, 1.0]) {
-        assert!((q - want).abs() < 1e-12, "{pairwise:?}");
+        assert!(abs_diff_eq!(*q, want, epsilon = 1e-12), "{pairwise:?}");
     }
     let p = least_squares_order(&h, &e).unwrap();
-    assert!((p - 1.7).abs() < 1e-12, "{p}");
+    assert_abs_diff_eq!(p, 1.7, epsilon = 1e-12);
 }
 
 #[test]
@@ -191,7 +198,7 @@ fn csv_json_png_and_svg_are_written_with_the_stated_shape() {
     let fd_l2 = methods[0]["orders"]["l2"]["least_squares"]
         .as_f64()
         .unwrap();
-    assert!((fd_l2 - 2.0).abs() < 0.15, "{fd_l2}");
+    assert_abs_diff_eq!(fd_l2, 2.0, epsilon = 0.15);
     assert_eq!(methods[0]["rows"].as_array().unwrap().len(), 3);
     assert!(methods[1]["orders"].get("flux").is_none(), "fe has no flux");
 
@@ -403,7 +410,7 @@ fn uniform_refinement_scales_each_generator_resolution() {
         .unwrap();
     assert_eq!(seen, [(0, 1), (1, 1), (2, 1)]);
     assert_eq!(r.rows[2].resolution, vec![12, 20]);
-    assert!((r.rows[0].h / r.rows[2].h - 4.0).abs() < 1e-12);
+    assert_abs_diff_eq!(r.rows[0].h / r.rows[2].h, 4.0, epsilon = 1e-12);
     assert_eq!(r.rows[1].unknowns, 7 * 11);
 }
 

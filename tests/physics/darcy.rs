@@ -7,6 +7,7 @@
 //! over four levels; expected: pressure 2 (cell values at the cell
 //! points, L²), flux ≥ 1.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, relative_eq};
 use hasse_complex::generate::{delaunay, grid, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, DualKind};
 use hasse_solver::la::direct::Factorization;
@@ -253,7 +254,7 @@ fn mimetic_uniform_grid_orders() {
         FluxMass::Mimetic,
         &smooth(),
     );
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}");
+    assert!(abs_diff_eq!(p, 2.0, epsilon = 0.15), "pressure order {p}");
     assert!(u >= 1.0 - 0.15, "flux order {u}");
 }
 
@@ -269,7 +270,7 @@ fn mimetic_distorted_quad_orders() {
         FluxMass::Mimetic,
         &smooth(),
     );
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}");
+    assert!(abs_diff_eq!(p, 2.0, epsilon = 0.15), "pressure order {p}");
     assert!(u >= 1.0 - 0.15, "flux order {u}");
 }
 
@@ -277,7 +278,7 @@ fn mimetic_distorted_quad_orders() {
 fn dec_uniform_grid_orders() {
     let mass = FluxMass::Dec(DualKind::Barycentric);
     let (p, u) = study("DEC, uniform", &squares(&[8, 16, 32, 64]), mass, &smooth());
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}");
+    assert!(abs_diff_eq!(p, 2.0, epsilon = 0.15), "pressure order {p}");
     assert!(u >= 1.0 - 0.15, "flux order {u}");
 }
 
@@ -289,7 +290,7 @@ fn dec_delaunay_orders() {
         .collect();
     let mass = FluxMass::Dec(DualKind::Circumcentric);
     let (p, u) = study("DEC, Delaunay (circumcentres)", &meshes, mass, &smooth());
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}");
+    assert!(abs_diff_eq!(p, 2.0, epsilon = 0.15), "pressure order {p}");
     assert!(u >= 1.0 - 0.15, "flux order {u}");
 }
 
@@ -312,7 +313,7 @@ fn dec_mass_is_dual_edge_over_face() {
         assert_eq!(i, j);
         let expected = dual[i] / (2.5 * k.measure(1)[i]);
         assert!(
-            (v - expected).abs() <= 1e-12 * expected.abs(),
+            relative_eq!(v, expected, epsilon = 0.0, max_relative = 1e-12),
             "face {i}: {v} vs {expected}"
         );
     }
@@ -355,7 +356,7 @@ fn local_mass_conservation_is_exact() {
         let div = darcy::divergence(&k, &s.flux);
         for (c, (d, f)) in div.iter().zip(&source).enumerate() {
             assert!(
-                (d - f).abs() <= 1e-12 * scale,
+                abs_diff_eq!(d, f, epsilon = 1e-12 * scale),
                 "{mass:?} cell {c}: {d} vs {f}"
             );
         }
@@ -391,7 +392,7 @@ fn layered_medium_is_exact() {
         }
     };
     // The interface pressure by hand: p_I = 1 − (1/(½ + 5000))·½ = 5000/5000.5.
-    assert!((p_interface - 5000.0 / 5000.5).abs() < 1e-15);
+    assert_abs_diff_eq!(p_interface, 5000.0 / 5000.5, epsilon = 1e-15);
     let mut left = uniform_axis(3, 0.0, 0.5).unwrap();
     let right: Vec<f64> = [0.5, 0.55, 0.7, 0.9, 1.0].to_vec();
     left.extend_from_slice(&right[1..]);
@@ -418,7 +419,7 @@ fn layered_medium_is_exact() {
             for c in 0..k.cell_count(2) {
                 let x = k.centroid_of(2, c)[0];
                 assert!(
-                    (s.pressure[c] - exact(x)).abs() <= 1e-10,
+                    abs_diff_eq!(s.pressure[c], exact(x), epsilon = 1e-10),
                     "{mass:?} cell {c} at x = {x}: {} vs {}",
                     s.pressure[c],
                     exact(x)
@@ -428,7 +429,7 @@ fn layered_medium_is_exact() {
                 let n = &k.normal()[2 * f..2 * f + 2];
                 let expected = q * n[0] * k.measure(1)[f];
                 assert!(
-                    (s.flux[f] - expected).abs() <= 1e-10 * q,
+                    abs_diff_eq!(s.flux[f], expected, epsilon = 1e-10 * q),
                     "{mass:?} face {f}"
                 );
             }
@@ -446,7 +447,7 @@ fn permeability_jump_manufactured_orders() {
         FluxMass::Mimetic,
         &m,
     );
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}");
+    assert!(abs_diff_eq!(p, 2.0, epsilon = 0.15), "pressure order {p}");
     assert!(u >= 1.0 - 0.15, "flux order {u}");
     let (p, u) = study(
         "DEC, jump 1e4",
@@ -454,7 +455,7 @@ fn permeability_jump_manufactured_orders() {
         FluxMass::Dec(DualKind::Barycentric),
         &m,
     );
-    assert!((p - 2.0).abs() <= 0.15, "pressure order {p}");
+    assert!(abs_diff_eq!(p, 2.0, epsilon = 0.15), "pressure order {p}");
     assert!(u >= 1.0 - 0.15, "flux order {u}");
 }
 
@@ -487,7 +488,7 @@ fn pure_flux_problem_has_zero_mean_pressure() {
         .zip(k.measure(2))
         .map(|(p, a)| p * a)
         .sum();
-    assert!(mean.abs() < 1e-12);
+    assert_abs_diff_eq!(mean, 0.0, epsilon = 1e-12);
     let err = (0..256)
         .map(|c| {
             let x = k.centroid_of(2, c);
@@ -610,7 +611,7 @@ fn constrained_ldlt_matches_lu() {
         .zip(&lu.pressure)
         .chain(ldlt.flux.iter().zip(&lu.flux))
     {
-        assert!((a - b).abs() <= 1e-10 * scale, "{a} vs {b}");
+        assert_abs_diff_eq!(a, b, epsilon = 1e-10 * scale);
     }
     assert!(ldlt.report.relative_residual < 1e-12);
 }

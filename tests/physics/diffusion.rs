@@ -6,6 +6,7 @@
 //! uniform/admissible meshes, first order for gradients); observed orders
 //! are least-squares slopes of log(error) against log(h) over four levels.
 
+use approx::abs_diff_eq;
 use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
 use hasse_solver::metric::Method;
@@ -100,7 +101,7 @@ fn study(
 fn assert_order(name: &str, s: &Study, field: f64, gradient: Option<f64>) {
     let observed = order(&s.h, &s.l2);
     assert!(
-        (observed - field).abs() <= 0.15,
+        abs_diff_eq!(observed, field, epsilon = 0.15),
         "{name}: L² order {observed:.3}, expected {field} ± 0.15 (errors {:?})",
         s.l2
     );
@@ -868,7 +869,7 @@ fn analysis_beside_the_assembly_gives_the_plain_solution() {
             // cond(M) stays below 1e4 on these meshes: a different order of
             // the factor's parallel sums moves x by well under 1e-12.
             assert!(
-                (a - b).abs() <= 1e-12 * scale,
+                abs_diff_eq!(a, b, epsilon = 1e-12 * scale),
                 "{name}: unknown {k}: {a} vs {b}"
             );
         }
@@ -878,7 +879,7 @@ fn analysis_beside_the_assembly_gives_the_plain_solution() {
         let bound = 1e4 * plain.len() as f64 * f64::EPSILON * scale;
         for (k, (a, b)) in automatic.values.iter().zip(&plain).enumerate() {
             assert!(
-                (a - b).abs() <= bound,
+                abs_diff_eq!(a, b, epsilon = bound),
                 "{name}, automatic ordering: unknown {k}: {a} vs {b}"
             );
         }

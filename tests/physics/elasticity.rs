@@ -16,6 +16,7 @@
 //!   μ = 1) and the unit square in plane stress (the closed form used by
 //!   Sigmund's 99-line topology optimisation code).
 
+use approx::abs_diff_eq;
 use hasse_complex::generate::{box3, kuhn, perturb, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
 use hasse_solver::physics::elasticity::{
@@ -284,7 +285,7 @@ fn hand_written_body_forces_are_minus_the_divergence_of_the_stress() {
                 // Central differences: O(h²) ≈ 1e-10 relative, plus rounding
                 // of about ε/h ≈ 1e-11 times the stress.
                 assert!(
-                    (fa + div).abs() < 1e-6,
+                    abs_diff_eq!(*fa, -div, epsilon = 1e-6),
                     "d = {d}, component {a}: {fa} vs {}",
                     -div
                 );
@@ -355,7 +356,10 @@ fn manufactured_displacement_converges_at_second_order_in_2d() {
             convergence("P1 triangles", &levels, triangles, true),
         ),
     ] {
-        assert!((observed - 2.0).abs() < 0.15, "{name}: order {observed}");
+        assert!(
+            abs_diff_eq!(observed, 2.0, epsilon = 0.15),
+            "{name}: order {observed}"
+        );
     }
 }
 
@@ -364,7 +368,7 @@ fn manufactured_displacement_converges_at_second_order_on_hexahedra() {
     let hexes = |n| box3(n, n, n, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
     let observed = convergence("Q1 hexahedra", &[4, 6, 8, 10], hexes, false);
     assert!(
-        (observed - 2.0).abs() < 0.15,
+        abs_diff_eq!(observed, 2.0, epsilon = 0.15),
         "Q1 hexahedra: order {observed}"
     );
 }
@@ -383,7 +387,7 @@ fn manufactured_displacement_converges_at_second_order_on_tetrahedra() {
     };
     let observed = convergence("P1 tetrahedra", &[10, 12, 16, 20], tets, false);
     assert!(
-        (observed - 2.0).abs() < 0.15,
+        abs_diff_eq!(observed, 2.0, epsilon = 0.15),
         "P1 tetrahedra: order {observed}"
     );
 }
@@ -523,7 +527,7 @@ fn right_triangle_stiffness_matches_the_hand_computed_element() {
                 (k[(3 + j, i)], kxy[i][j]),
             ] {
                 assert!(
-                    (got - expected).abs() < 1e-14,
+                    abs_diff_eq!(got, expected, epsilon = 1e-14),
                     "({i},{j}): {got} vs {expected}"
                 );
             }
@@ -574,7 +578,7 @@ fn unit_square_plane_stress_stiffness_matches_the_closed_form() {
             let expected = scale * k[pattern[r][s] - 1];
             let got = ours[(dof(r), dof(s))];
             assert!(
-                (got - expected).abs() < 1e-14,
+                abs_diff_eq!(got, expected, epsilon = 1e-14),
                 "({r},{s}): {got} vs {expected}"
             );
         }

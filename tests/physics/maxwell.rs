@@ -8,6 +8,7 @@
 //! second-order accurate. The spurious-mode checks compare the Krylov
 //! solver with a dense generalised eigensolve (nalgebra) of the same K, M.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq, relative_eq};
 use hasse_complex::dual::DualKind;
 use hasse_complex::generate::{box3, delaunay, interval, kuhn, rectangle, uniform_axis};
 use hasse_solver::la::eigen::EigenError;
@@ -80,7 +81,7 @@ fn square_cavity_converges_at_second_order() {
         for (got, want) in modes.eigenvalues.iter().zip(&discrete) {
             // The solver finds the grid's own spectrum to solver accuracy.
             assert!(
-                (got - want).abs() < 1e-7 * want,
+                relative_eq!(got, want, epsilon = 0.0, max_relative = 1e-7),
                 "n={n}: {got} vs grid {want}"
             );
         }
@@ -102,7 +103,10 @@ fn square_cavity_converges_at_second_order() {
                 levels[l],
                 levels[l + 1]
             );
-            assert!((order - 2.0).abs() <= 0.15, "mode {j}: order {order}");
+            assert!(
+                abs_diff_eq!(order, 2.0, epsilon = 0.15),
+                "mode {j}: order {order}"
+            );
         }
     }
 }
@@ -123,7 +127,7 @@ fn cube_cavity_eigenvalues_and_multiplicities() {
         );
         for (got, want) in modes.eigenvalues.iter().zip(&discrete) {
             assert!(
-                (got - want).abs() < 1e-7 * want,
+                relative_eq!(got, want, epsilon = 0.0, max_relative = 1e-7),
                 "n={n}: {got} vs grid {want}"
             );
         }
@@ -141,7 +145,7 @@ fn cube_cavity_eigenvalues_and_multiplicities() {
         if let Some(coarse) = previous {
             for (c, f) in coarse.iter().zip(&errors) {
                 let order = (c / f).log2();
-                assert!((order - 2.0).abs() <= 0.15, "order {order}");
+                assert!(abs_diff_eq!(order, 2.0, epsilon = 0.15), "order {order}");
             }
         }
         previous = Some(errors);
@@ -184,10 +188,7 @@ fn check_no_spurious(cavity: &Cavity, count: usize) {
     assert!(all[zeros] > 1e-3 * first);
     // … and the next `count` are the Krylov ones, multiplicities included.
     for (dense, krylov) in all[zeros..zeros + count].iter().zip(&modes.eigenvalues) {
-        assert!(
-            (dense - krylov).abs() < 1e-7 * krylov,
-            "{dense} vs {krylov}"
-        );
+        assert_relative_eq!(dense, krylov, epsilon = 0.0, max_relative = 1e-7);
     }
     // The physical fields are M-orthogonal to every interior gradient.
     for field in &modes.fields {
@@ -197,7 +198,7 @@ fn check_no_spurious(cavity: &Cavity, count: usize) {
             phi[v] = 1.0;
             let g = cavity.gradient(&phi);
             let overlap: f64 = g.iter().zip(&me).map(|(a, b)| a * b).sum();
-            assert!(overlap.abs() < 1e-9, "overlap {overlap}");
+            assert_abs_diff_eq!(overlap, 0.0, epsilon = 1e-9);
         }
     }
 }
@@ -278,7 +279,7 @@ fn nedelec_kuhn_converges_to_the_square_eigenvalues() {
             for (c, f) in coarse.iter().zip(&errors) {
                 let order = (c / f).log2();
                 assert!(
-                    (order - 2.0).abs() <= 0.15,
+                    abs_diff_eq!(order, 2.0, epsilon = 0.15),
                     "order {order}: {coarse:?} → {errors:?}"
                 );
             }
@@ -307,7 +308,7 @@ fn bad_input_is_a_typed_error() {
     let all = cavity.modes(3, &options).unwrap();
     let s = 4.0 / (PI / 2.0).powi(2) * (PI / 4.0).sin().powi(2);
     for (got, want) in all.eigenvalues.iter().zip([s, s, 2.0 * s]) {
-        assert!((got - want).abs() < 1e-9 * want);
+        assert_relative_eq!(*got, want, epsilon = 0.0, max_relative = 1e-9);
     }
 
     let line = interval(4, 0.0, 1.0).unwrap();

@@ -2,6 +2,7 @@
 //! against uniform refinement at a corner singularity, warm starts, and
 //! the tissue-division case.
 
+use approx::abs_diff_eq;
 use hasse_solver::frontend::case::Case;
 use hasse_solver::frontend::run::refine::refine_case;
 use hasse_solver::refine::{RefineSpec, Strategy};
@@ -49,7 +50,7 @@ fn uniform_split_keeps_second_order_on_cut_cells() {
         for k in first..l2.len() - 1 {
             let p = order(l2[k], l2[k + 1]);
             assert!(
-                (p - 2.0).abs() <= 0.15,
+                abs_diff_eq!(p, 2.0, epsilon = 0.15),
                 "{method}: order {p:.3} between steps {k} and {}: {l2:?}",
                 k + 1
             );
@@ -138,7 +139,7 @@ fn tissue_divides_to_3200_cells_and_conserves_area() {
         .collect();
     assert_eq!(cells, vec![50, 100, 200, 400]);
     let area: f64 = study.complex.measure(2).iter().sum();
-    assert!((area - 1.0).abs() < 1e-12, "area {area}");
+    assert!(abs_diff_eq!(area, 1.0, epsilon = 1e-12), "area {area}");
     assert_eq!(study.complex.euler_characteristic(), 1);
     // The concentration is positive inside (a positive source, zero wall).
     let u = &study

@@ -19,6 +19,7 @@
 //!   leaves CN exact and gives backward Euler the error Δt Σ₁ᴺ 2t_k − T² =
 //!   T Δt exactly.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq};
 use hasse_complex::generate::{kuhn, rectangle, uniform_axis};
 use hasse_complex::Complex;
 use hasse_solver::metric::Method;
@@ -126,7 +127,7 @@ fn temporal_error(case: &Case, theta: f64, t_end: f64, steps: usize) -> f64 {
     let heat =
         zero_boundary(Heat::new(case.method, unit(), t_end / steps as f64).with_theta(theta));
     let history = heat.run(&case.mesh, &*sine(), steps, 0).unwrap();
-    assert!((history.times[1] - t_end).abs() < 1e-12);
+    assert_abs_diff_eq!(history.times[1], t_end, epsilon = 1e-12);
     let decay = (-case.lambda * t_end).exp();
     let phi = &history.fields[0];
     let diff: Vec<f64> = history.fields[1]
@@ -161,7 +162,7 @@ fn backward_euler_is_first_and_crank_nicolson_second_order_in_time() {
                 let order = (errors[k - 1] / e).log2();
                 println!("  {s:>6} {e:>12.4e} {order:>7.3}");
                 assert!(
-                    (order - expected).abs() < 0.15,
+                    abs_diff_eq!(order, expected, epsilon = 0.15),
                     "{} {scheme}: order {order} between {} and {s} steps",
                     case.name,
                     levels[k - 1]
@@ -227,7 +228,7 @@ fn linear_in_space_and_time_is_reproduced_exactly_with_moving_boundary_values() 
                 for (x, u) in xs.iter().zip(field) {
                     let exact = (1.0 + t) * (x[0] + x[1]);
                     assert!(
-                        (u - exact).abs() < 1e-12,
+                        abs_diff_eq!(*u, exact, epsilon = 1e-12),
                         "{name} θ = {theta} t = {t} at {x:?}: {u} vs {exact}"
                     );
                 }
@@ -273,7 +274,7 @@ fn a_quadratic_in_time_part_gives_backward_euler_exactly_t_dt_and_crank_nicolson
             for (x, u) in xs.iter().zip(&history.fields[1]) {
                 let error = u - exact(x, t_end);
                 assert!(
-                    (error - expected_error).abs() < 1e-12,
+                    abs_diff_eq!(error, expected_error, epsilon = 1e-12),
                     "{name} θ = {theta} at {x:?}: error {error:e}, expected {expected_error:e}"
                 );
             }
@@ -288,7 +289,7 @@ fn saved_levels_are_cochains_of_the_unknowns_degree() {
     let history = heat.run(&mesh, &*sine(), 7, 3).unwrap();
     // t₀, steps 3 and 6, and the last one (7).
     assert_eq!(history.times.len(), 4);
-    assert!((history.times[3] - 0.07).abs() < 1e-15);
+    assert_abs_diff_eq!(history.times[3], 0.07, epsilon = 1e-15);
     // Nodal: 0-cochains on the 25 vertices; cell-centred: 2-cochains on
     // the 16 squares.
     assert_eq!((history.degree, history.fields[2].len()), (0, 25));
@@ -334,7 +335,7 @@ fn data_on_the_kept_operator_equal_a_full_assembly() {
             assert!(scale > 0.1, "{method:?}: the data must matter");
             for (i, (a, b)) in rhs.iter().zip(&full.rhs).enumerate() {
                 assert!(
-                    (a - b).abs() <= 1e-14 * scale,
+                    abs_diff_eq!(a, b, epsilon = 1e-14 * scale),
                     "{method:?}, t = {t}, unknown {i}: {a} vs {b}"
                 );
             }

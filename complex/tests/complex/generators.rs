@@ -4,6 +4,7 @@
 //! orientation, perturbation invariants, and for Voronoi meshes convexity,
 //! exact tiling of the rectangle and the nearest-site property.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq, relative_eq};
 use hasse_complex::generate::{
     annulus, box3, delaunay, graded_axis, grid, hollow_box, interval, kuhn, perturb, rectangle,
     sphere, torus, uniform_axis, voronoi, voronoi_with_sites,
@@ -192,16 +193,19 @@ fn uniform_and_graded_axes() {
     assert_eq!(x.len(), 6);
     assert_eq!((x[0], x[5]), (-1.0, 1.5));
     for w in x.windows(2) {
-        assert!((w[1] - w[0] - 0.5).abs() < 1e-15);
+        assert_abs_diff_eq!(w[1] - w[0], 0.5, epsilon = 1e-15);
     }
     let g = graded_axis(6, 0.0, 2.0, 1.3).unwrap();
     assert_eq!((g[0], g[6]), (0.0, 2.0));
     // Closed form of the first spacing: (b − a)(r − 1)/(r^n − 1).
     let h0 = 2.0 * 0.3 / (1.3f64.powi(6) - 1.0);
-    assert!((g[1] - h0).abs() < 1e-14);
+    assert_abs_diff_eq!(g[1], h0, epsilon = 1e-14);
     for k in 1..6 {
         let ratio = (g[k + 1] - g[k]) / (g[k] - g[k - 1]);
-        assert!((ratio - 1.3).abs() < 1e-12, "spacing ratio {ratio}");
+        assert!(
+            abs_diff_eq!(ratio, 1.3, epsilon = 1e-12),
+            "spacing ratio {ratio}"
+        );
     }
     assert_eq!(
         graded_axis(4, 0.0, 1.0, 1.0).unwrap(),
@@ -310,9 +314,9 @@ fn kuhn_tetrahedra_fill_the_cube() {
         let x: Vec<P3> = vs.iter().map(|&v| point3(&k, v)).collect();
         let vol = dot(sub(x[1], x[0]), cross(sub(x[2], x[0]), sub(x[3], x[0]))).abs() / 6.0;
         total += vol;
-        assert!((vol - 1.0 / 6.0).abs() < 1e-15);
+        assert_abs_diff_eq!(vol, 1.0 / 6.0, epsilon = 1e-15);
     }
-    assert!((total - 1.0).abs() < 1e-14);
+    assert_abs_diff_eq!(total, 1.0, epsilon = 1e-14);
 }
 
 #[test]
@@ -478,7 +482,7 @@ fn annulus_tags_and_area() {
         for &e in &k.tag(name).unwrap().cells {
             for &v in k.cell_vertices(1, e) {
                 let p = k.vertices().point(v);
-                assert!((p[0].hypot(p[1]) - r).abs() < 1e-14, "{name}");
+                assert!(abs_diff_eq!(p[0].hypot(p[1]), r, epsilon = 1e-14), "{name}");
             }
         }
     }
@@ -500,9 +504,14 @@ fn annulus_tags_and_area() {
         }
     }
     let exact = 0.5 * na as f64 * (2.0 * PI / na as f64).sin() * (ro * ro - ri * ri);
-    assert!((area - exact).abs() < 1e-12 * exact, "{area} vs {exact}");
+    assert_relative_eq!(area, exact, epsilon = 0.0, max_relative = 1e-12);
     // and it approaches π(ro² − ri²) as n_angular grows
-    assert!((area - PI * (ro * ro - ri * ri)).abs() < 0.02 * area);
+    assert_relative_eq!(
+        area,
+        PI * (ro * ro - ri * ri),
+        epsilon = 0.0,
+        max_relative = 0.02
+    );
 }
 
 #[test]
@@ -514,7 +523,10 @@ fn sphere_counts_and_radius() {
         assert_eq!(k.cell_counts(), vec![10 * f + 2, 30 * f, 20 * f]);
         for v in 0..k.cell_count(0) {
             let r = norm(point3(&k, v));
-            assert!((r - radius).abs() <= 1e-14 * radius, "vertex {v} at {r}");
+            assert!(
+                relative_eq!(r, radius, epsilon = 0.0, max_relative = 1e-14),
+                "vertex {v} at {r}"
+            );
         }
         // Outward orientation and acute (well-centred) triangles.
         for (c, n) in vector_areas(&k).into_iter().enumerate() {
@@ -707,14 +719,14 @@ fn voronoi_cells_are_convex_and_tile_the_rectangle() {
                 );
             }
             assert!(
-                (area.abs() - k.measure(2)[c]).abs() <= 1e-12 * rect,
+                abs_diff_eq!(area.abs(), k.measure(2)[c], epsilon = 1e-12 * rect),
                 "n = {n}: cell {c} measure {} vs shoelace {area}",
                 k.measure(2)[c]
             );
             total += area.abs();
         }
         assert!(
-            (total - rect).abs() <= 1e-12 * rect,
+            relative_eq!(total, rect, epsilon = 0.0, max_relative = 1e-12),
             "n = {n}: areas sum to {total}"
         );
         // Boundary edges lie exactly on the sides, and the side tags cover them.
@@ -728,7 +740,7 @@ fn voronoi_cells_are_convex_and_tile_the_rectangle() {
         };
         for (name, length) in [("xmin", 1.0), ("xmax", 1.0), ("ymin", 3.0), ("ymax", 3.0)] {
             assert!(
-                (side_length(name) - length).abs() < 1e-12,
+                abs_diff_eq!(side_length(name), length, epsilon = 1e-12),
                 "n = {n}: {name}"
             );
         }
@@ -840,7 +852,7 @@ fn perturb_moves_interior_vertices_only() {
             } else {
                 assert_ne!(x, y, "interior vertex {v} did not move");
                 for (a, b) in x.iter().zip(y) {
-                    assert!((a - b).abs() <= amplitude * h * (1.0 + 1e-12));
+                    assert_abs_diff_eq!(a, b, epsilon = amplitude * h * (1.0 + 1e-12));
                 }
             }
         }

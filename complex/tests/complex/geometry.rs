@@ -6,6 +6,7 @@
 //! cell values carries a relative rounding error of a few ε ≈ 2.2e-16 and
 //! their sum at most N times that (≈ 2e-13).
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, relative_eq};
 use hasse_complex::{Complex, DualKind, TopCells, Vertices};
 
 // ---------------------------------------------------------------- helpers
@@ -204,8 +205,9 @@ fn norm(a: &[f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// |a − b| ≤ rel · max(|a|, |b|, f64::MIN_POSITIVE).
 fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
+    relative_eq!(a, b, epsilon = rel * f64::MIN_POSITIVE, max_relative = rel)
 }
 
 fn assert_close(a: f64, b: f64, rel: f64) {
@@ -215,7 +217,7 @@ fn assert_close(a: f64, b: f64, rel: f64) {
 fn assert_point(got: &[f64], want: &[f64], tol: f64) {
     assert_eq!(got.len(), want.len());
     for (g, w) in got.iter().zip(want) {
-        assert!((g - w).abs() <= tol, "{got:?} vs {want:?}");
+        assert!(abs_diff_eq!(g, w, epsilon = tol), "{got:?} vs {want:?}");
     }
 }
 
@@ -612,7 +614,7 @@ fn normals_of_curves_and_surfaces_are_tangent() {
     let plane_normal = [s, 0.0, s];
     for f in 0..k.cell_count(1) {
         let nf = sub(&k.normal()[3 * f..3 * f + 3], &[0.0; 3]);
-        assert!(dot(&nf, &plane_normal).abs() < 1e-15);
+        assert_abs_diff_eq!(dot(&nf, &plane_normal), 0.0, epsilon = 1e-15);
     }
     assert_normals_follow_boundary_signs(&k);
     assert_closed(&k);
@@ -725,7 +727,7 @@ fn circumcentric_star1_is_the_cotangent_formula() {
         let star = k.hodge_star(DualKind::Circumcentric, 1).unwrap();
         let expected = cotangent_weights(&k);
         for (e, (s, w)) in star.iter().zip(&expected).enumerate() {
-            assert!((s - w).abs() <= 1e-13, "edge {e}: {s} vs {w}");
+            assert!(abs_diff_eq!(s, w, epsilon = 1e-13), "edge {e}: {s} vs {w}");
         }
     }
     // The obtuse mesh has negative weights (and dual edges).
@@ -946,5 +948,5 @@ fn timing_of_a_million_hexahedra() {
         rayon::current_num_threads(),
         k.cell_counts()
     );
-    assert!((volume - 1.0).abs() < 1e-9);
+    assert_abs_diff_eq!(volume, 1.0, epsilon = 1e-9);
 }

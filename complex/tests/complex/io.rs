@@ -4,6 +4,7 @@
 //! Measures are computed here from the boundary matrices alone (Green /
 //! divergence theorem), independently of the geometry module.
 
+use approx::abs_diff_eq;
 use hasse_complex::gmsh::{read_msh, read_msh_bytes, GmshError};
 use hasse_complex::json::{from_json_str, read_json, to_json, write_json, JsonError};
 use hasse_complex::{Complex, TopCells, Vertices};
@@ -114,7 +115,7 @@ fn boundary_faces(k: &Complex, inside: impl Fn(&[f64]) -> bool) -> Vec<usize> {
 }
 
 fn assert_close(a: f64, b: f64) {
-    assert!((a - b).abs() < 1e-12, "{a} != {b}");
+    assert!(abs_diff_eq!(a, b, epsilon = 1e-12), "{a} != {b}");
 }
 
 fn bits(k: &Complex) -> Vec<u64> {

@@ -5,6 +5,7 @@
 //! χ and Betti numbers, ∂ζ = ζ∂, measures, the orientation a fresh
 //! `Complex::from_lar` computes from geometry alone.
 
+use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq};
 use hasse_complex::euler::{cell_counts, hasse_matrix, make};
 use sprs::{CsMat, TriMat};
 
@@ -216,7 +217,7 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
                 .sqrt();
             let scale = m.max(diagonal.powi(p as i32));
             assert!(
-                (s - m).abs() <= 1e-12 * scale,
+                abs_diff_eq!(s, m, epsilon = 1e-12 * scale),
                 "p = {p}, cell {j}: pieces {s} vs {m} (size {diagonal})"
             );
         }
@@ -225,7 +226,7 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
     }
     let total: f64 = fine.measure(n).iter().sum();
     let coarse_total: f64 = coarse.measure(n).iter().sum();
-    assert!((total - coarse_total).abs() <= 1e-12 * coarse_total);
+    assert_relative_eq!(total, coarse_total, epsilon = 0.0, max_relative = 1e-12);
     check_convex(fine, 1e-9);
     // Tags: every piece of a tagged cell is tagged, nothing else.
     for (name, tag) in coarse.tags().iter() {
@@ -604,7 +605,7 @@ fn transfers_conserve_and_interpolate() {
             }
         }
         for (b, c) in back.iter().zip(&coarse) {
-            assert!((b - c).abs() <= 1e-14, "p = {p}: {b} vs {c}");
+            assert!(abs_diff_eq!(b, c, epsilon = 1e-14), "p = {p}: {b} vs {c}");
         }
         let int = r.intensive(p, &coarse).unwrap();
         for (i, v) in int.iter().enumerate() {
@@ -621,7 +622,7 @@ fn transfers_conserve_and_interpolate() {
         .collect();
     let fine_u = r.nodal(&coarse).unwrap();
     for (v, u) in fine_u.iter().enumerate() {
-        assert!((u - f(fine.vertices().point(v))).abs() < 1e-13);
+        assert_abs_diff_eq!(*u, f(fine.vertices().point(v)), epsilon = 1e-13);
     }
 }
 
@@ -913,7 +914,7 @@ fn division_rules() {
     let v = Vertices::from_points(&[[0.0, 0.0], [4.0, 1.0], [5.0, 3.0], [1.0, 2.0]]).unwrap();
     let p = Complex::build(v, TopCells::polygons([[0, 1, 2, 3]])).unwrap();
     let (fine, r) = divide_longest_axis(&p, &[0]).unwrap();
-    assert!((fine.measure(2)[0] - fine.measure(2)[1]).abs() < 1e-12);
+    assert_abs_diff_eq!(fine.measure(2)[0], fine.measure(2)[1], epsilon = 1e-12);
     let lambda = 11.0 + 72f64.sqrt();
     let axis = [6.0, lambda - 17.0];
     let wall = fine.cell_vertices(1, fine.cell_count(1) - 1);
@@ -923,7 +924,7 @@ fn division_rules() {
     );
     let along = (b[0] - a[0]) * axis[0] + (b[1] - a[1]) * axis[1];
     assert!(
-        along.abs() < 1e-12,
+        abs_diff_eq!(along, 0.0, epsilon = 1e-12),
         "wall not normal to the long axis: {along}"
     );
     check_split(&p, &fine, &r);
@@ -945,7 +946,7 @@ fn division_rules() {
         divide_shortest_wall(&b, &[0], 200).unwrap(),
     ] {
         assert_eq!(fine.cell_count(3), 2);
-        assert!((fine.measure(3)[0] - 1.5).abs() < 1e-12);
+        assert_abs_diff_eq!(fine.measure(3)[0], 1.5, epsilon = 1e-12);
         check_split(&b, &fine, &r);
     }
     assert!(divide_shortest_wall(&b, &[0], 0).is_err());
