@@ -70,10 +70,11 @@ fn read(stem: &Path, name: &str) -> Vec<f64> {
 
 #[test]
 fn poisson_square_every_method() {
-    // u = sin(πx) sin(πy) on a 32 × 32 grid, h = 1/32: the second-order
-    // methods' L² error is C h² with C ≈ 0.4 here (4.0e-4); the bound 1e-3
-    // allows C ≤ 1 and still fails for a first-order or broken method
-    // (C h ≈ 3e-2).
+    // u = sin(πx) sin(πy) on the shipped 32 × 32 grid and on 16 × 16:
+    // every method is second order in L² on uniform grids, so the observed
+    // order between the two is 2 ± 0.15 (a first-order or inconsistent
+    // method gives 1 or 0). README records the 32² errors of fd, fe and
+    // fv-mimetic (4.0179e-4, its convergence table).
     let cases: [(&str, &[&str]); 6] = [
         ("fe", &[]),
         ("fd", &[]),
@@ -89,7 +90,18 @@ fn poisson_square_every_method() {
         let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
         let (stdout, stem) = run_case("cases/poisson-square.toml", &sets, method);
         let l2 = reported(&stdout, "error", "L2");
-        assert!(l2 < 1e-3, "{method}: L2 error {l2}");
+        let coarse_sets: Vec<&str> = sets.iter().copied().chain(["mesh.n=[16,16]"]).collect();
+        let (coarse, _) = run_case(
+            "cases/poisson-square.toml",
+            &coarse_sets,
+            &format!("{method}-16"),
+        );
+        let coarse = reported(&coarse, "error", "L2");
+        let p = (coarse / l2).log2();
+        assert!(
+            abs_diff_eq!(p, 2.0, epsilon = 0.15),
+            "{method}: L2 order {p} ({coarse} then {l2})"
+        );
         assert!(
             stdout.contains(&format!("diffusion ({method})")),
             "{stdout}"
@@ -107,10 +119,28 @@ fn poisson_square_every_method() {
 
 #[test]
 fn l_shape_anisotropic_gmsh() {
-    // P1 on the shipped Gmsh mesh (h = 1/8 legs): interpolation-order error
-    // bound C h² with C ≤ 0.06 → 1e-3 (observed 6.6e-5).
-    let (stdout, stem) = run_case("cases/l-shape.toml", &[], "l-shape");
-    assert!(reported(&stdout, "error", "L2") < 1e-3, "{stdout}");
+    // The mesh comes from a file, so it cannot be refined for an order
+    // (and a SPLIT refinement changes P1 triangles into cut polygons).
+    // Instead the patch test through the same case, mesh and anisotropic
+    // tensor: u = 1 + 2x − y solves −∇·(K∇u) = 0 for constant K, and P1
+    // reproduces a linear solution exactly, so the errors are rounding
+    // (values O(1), 65 unknowns).
+    let (linear, _) = run_case(
+        "cases/l-shape.toml",
+        &[
+            "problem.source=0",
+            "boundary.0.value=\"1 + 2*x - y\"",
+            "exact.solution=\"1 + 2*x - y\"",
+            "exact.gradient=[\"2\", \"-1\"]",
+        ],
+        "l-shape-linear",
+    );
+    assert!(reported(&linear, "error", "max") < 1e-12, "{linear}");
+    assert!(
+        reported(&linear, "error", "gradient L2") < 1e-12,
+        "{linear}"
+    );
+    let (_, stem) = run_case("cases/l-shape.toml", &[], "l-shape");
     // Dirichlet vertices carry the exact value exactly.
     let error = read(&stem, "error");
     let k = hasse_complex::gmsh::read_msh(
@@ -129,20 +159,32 @@ fn l_shape_anisotropic_gmsh() {
 
 #[test]
 fn box_3d_mixed_boundaries() {
-    // TPFA on 16³ cubes: field second order (2.2e-3 = C h², C ≈ 0.57), and
-    // face fluxes supraconvergent on the uniform grid (3.6e-3). A Neumann or
-    // Robin face with a wrong sign or a missing data flux gives O(1) errors
-    // on a boundary layer, i.e. flux errors ≥ 0.1 at this h.
-    let (stdout, _) = run_case("cases/box-3d.toml", &[], "box");
-    assert!(reported(&stdout, "error", "L2") < 5e-3, "{stdout}");
-    assert!(reported(&stdout, "flux error", "L2") < 1e-2, "{stdout}");
+    // TPFA on the shipped 16³ cubes and on 8³: the field is second order,
+    // the face fluxes at least first order (on the uniform grid they are
+    // face-centred differences and superconverge). A Neumann or Robin face
+    // with a wrong sign or a missing data flux leaves an O(1) error on a
+    // boundary layer that does not converge.
+    let (fine, _) = run_case("cases/box-3d.toml", &[], "box");
+    let (coarse, _) = run_case("cases/box-3d.toml", &["mesh.n=[8,8,8]"], "box-8");
+    let order = |line: &str, label: &str| {
+        (reported(&coarse, line, label) / reported(&fine, line, label)).log2()
+    };
+    let p = order("error", "L2");
+    assert!(
+        abs_diff_eq!(p, 2.0, epsilon = 0.15),
+        "field order {p}\n{fine}"
+    );
+    let q = order("flux error", "L2");
+    assert!(q >= 1.0 - 0.15, "flux order {q}\n{fine}");
 }
 
 #[test]
 fn poisson_multigrid_matches_the_direct_solve() {
-    // The shipped 10⁶-cell case at 64²: multigrid-CG to 1e-8 moves the
-    // discrete solution by far less than the 7 printed digits of its error,
-    // so it must report poisson-square's direct FV error at the same grid.
+    // The shipped 10⁶-cell case at 64² must report poisson-square's direct
+    // FV error at the same grid to the 7 printed digits (1e-6 relative).
+    // That is stricter than what multigrid-CG's relative residual 1e-8
+    // guarantees (κ·1e-8·‖u‖ with κ ≈ 4/(π²h²) ≈ 1700): it states what the
+    // solver does, its error being far below the worst case, not a bound.
     let grid = "mesh.n=[64, 64]";
     let (multigrid, _) = run_case("cases/poisson-multigrid.toml", &[grid], "poisson-mg");
     let (direct, _) = run_case(
@@ -154,6 +196,9 @@ fn poisson_multigrid_matches_the_direct_solve() {
     let expected = reported(&direct, "error", "L2");
     assert_relative_eq!(l2, expected, epsilon = 0.0, max_relative = 1e-6);
     let iterations = reported(&multigrid, "iterative", "):");
+    // README's table records 7 iterations to 1e-8 for FV on 64² (smoothed
+    // prolongation) and one or two more with the constant one this case
+    // uses; 15 leaves about a factor two.
     assert!((1.0..=15.0).contains(&iterations), "{multigrid}");
     // The timing line names the multigrid setup for what it is.
     assert!(reported(&multigrid, "timing", "preconditioner setup") >= 0.0);
@@ -162,8 +207,24 @@ fn poisson_multigrid_matches_the_direct_solve() {
 
 #[test]
 fn distorted_quads_mimetic() {
-    let (stdout, _) = run_case("cases/distorted-quads.toml", &[], "distorted");
-    assert!(reported(&stdout, "error", "L2") < 1e-3, "{stdout}");
+    // Mimetic FV is consistent on distorted quads: second order in L², here
+    // between the shipped 32² mesh and 64² (the same perturbation amplitude,
+    // relative to the local edge length, and seed).
+    let (fine, _) = run_case(
+        "cases/distorted-quads.toml",
+        &["mesh.n=[64,64]"],
+        "distorted-64",
+    );
+    let (coarse, _) = run_case("cases/distorted-quads.toml", &[], "distorted");
+    let (coarse, fine) = (
+        reported(&coarse, "error", "L2"),
+        reported(&fine, "error", "L2"),
+    );
+    let p = (coarse / fine).log2();
+    assert!(
+        abs_diff_eq!(p, 2.0, epsilon = 0.15),
+        "order {p} ({coarse} then {fine})"
+    );
 }
 
 #[test]
@@ -468,11 +529,26 @@ fn torus_banded_normal_gradient() {
 
 #[test]
 fn torus_pure_neumann() {
-    // u = y/ρ on a 50 × 5 torus: the error is dominated by the 5-cell tube
-    // resolution; observed L² 0.35 against ‖u‖ = √(1250/2) ≈ 25 (1.4%).
-    // The bound 0.5 (2%) fails for a sign error in the source (error ~ 2‖u‖).
+    // u = y/ρ on the torus: two-point FV on the surface's quads is second
+    // order, checked between 100 × 10 and 200 × 20 cells (the shipped
+    // 50 × 5 has a 5-cell tube, short of the asymptotic range). A sign
+    // error in the source gives an error of about 2‖u‖ that does not
+    // shrink.
+    let l2 = |n: &str| {
+        let (out, _) = run_case(
+            "cases/torus-neumann.toml",
+            &[&format!("mesh.n={n}"), "output.write=false"],
+            &format!("torus-neumann-{n}"),
+        );
+        reported(&out, "error", "L2")
+    };
+    let (coarse, fine) = (l2("[100,10]"), l2("[200,20]"));
+    let p = (coarse / fine).log2();
+    assert!(
+        abs_diff_eq!(p, 2.0, epsilon = 0.15),
+        "order {p} ({coarse} then {fine})"
+    );
     let (stdout, stem) = run_case("cases/torus-neumann.toml", &[], "torus-neumann");
-    assert!(reported(&stdout, "error", "L2") < 0.5, "{stdout}");
     assert!(stdout.contains("pure Neumann"), "{stdout}");
     // Zero mean: Σ |c| u_c = 0.
     let u = read(&stem, "u");
@@ -489,27 +565,81 @@ fn torus_pure_neumann() {
 
 #[test]
 fn voronoi_virtual_elements() {
-    // 400 Voronoi cells, h = 1/20 (mean cell size): VEM is second order in
-    // L² on these meshes (least-squares slope 1.95 in tests/physics/diffusion.rs);
-    // observed 1.2e-3 = C h² with C ≈ 0.47, bound C ≤ 1.2.
-    let (stdout, _) = run_case("cases/voronoi.toml", &[], "voronoi");
-    assert!(reported(&stdout, "error", "L2") < 3e-3, "{stdout}");
+    // The shipped 400 Voronoi cells and 1600 (same seed and smoothing): the
+    // mean cell size 1/√N halves, and VEM is second order in L² on these
+    // meshes (tests/physics/diffusion.rs fits it over five levels).
+    let (coarse, _) = run_case("cases/voronoi.toml", &[], "voronoi");
+    let (fine, _) = run_case("cases/voronoi.toml", &["mesh.n=[1600]"], "voronoi-1600");
+    let (coarse, fine) = (
+        reported(&coarse, "error", "L2"),
+        reported(&fine, "error", "L2"),
+    );
+    let p = (coarse / fine).log2();
+    assert!(
+        abs_diff_eq!(p, 2.0, epsilon = 0.15),
+        "order {p} ({coarse} then {fine})"
+    );
 }
 
 #[test]
 fn refinement_cases_run_as_shipped() {
-    // l-shape-adaptive: 8 Dörfler steps, the last with 2136 cells and
-    // gradient error 3.9e-3 (tests/physics/refinement.rs compares with uniform).
+    // l-shape-adaptive: 8 Dörfler steps. Columns: step, cells, unknowns,
+    // L2, max and gradient errors, CG iterations cold and warm, marked.
     let (stdout, _) = run_case("cases/l-shape-adaptive.toml", &[], "l-shape-adaptive");
-    let rows: Vec<&str> = stdout
+    let rows: Vec<Vec<&str>> = stdout
         .lines()
         .filter(|l| l.starts_with("           "))
+        .map(|l| l.split_whitespace().collect())
         .collect();
     assert_eq!(rows.len(), 9, "{stdout}");
-    assert!(reported(&stdout, "error", "gradient L2") < 5e-3, "{stdout}");
-    // tissue-growth: 50 cells dividing six times.
+    // The gradient error falls at least at the optimal adaptive rate
+    // N^{−1/2} (N unknowns; the rate of uniform refinement at this corner
+    // is N^{−1/3}), within ±0.075 on the exponent (±0.15 on an order in
+    // h), fitted from step 1 on (step 0 is the unsplit P1 mesh; see
+    // tests/physics/refinement.rs for the rates and their sources).
+    let (x, y): (Vec<f64>, Vec<f64>) = rows[1..]
+        .iter()
+        .map(|r| {
+            let unknowns: f64 = r[2].parse().unwrap();
+            let gradient: f64 = r[5].parse().unwrap();
+            (unknowns.ln(), gradient.ln())
+        })
+        .unzip();
+    let (mx, my) = (x.iter().sum::<f64>() / 8.0, y.iter().sum::<f64>() / 8.0);
+    let rate = x
+        .iter()
+        .zip(&y)
+        .map(|(a, b)| (a - mx) * (b - my))
+        .sum::<f64>()
+        / x.iter().map(|a| (a - mx) * (a - mx)).sum::<f64>();
+    assert!(
+        rate <= -0.5 + 0.075,
+        "gradient error ∝ N^{rate:.3}\n{stdout}"
+    );
+    // tissue-growth: 50 cells dividing six times, 3150 divisions. Each
+    // division cuts a cell by a wall between two points inside two of its
+    // edges: 2 new vertices, 3 new edges (two halves replace each cut edge,
+    // plus the wall) and 1 new cell. From the initial Voronoi mesh's
+    // counts (V₀, E₀, 50): (V₀ + 2·3150, E₀ + 3·3150, 50·2⁶).
+    let case = hasse_solver::frontend::case::Case::read(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/tissue-growth.toml"),
+        &[],
+    )
+    .unwrap();
+    let initial = case.build_mesh().unwrap();
+    assert_eq!(initial.cell_count(2), 50);
+    let divisions = 50 * (64 - 1);
+    let counts = format!(
+        "[{}, {}, {}]",
+        initial.cell_count(0) + 2 * divisions,
+        initial.cell_count(1) + 3 * divisions,
+        50 * 64
+    );
     let (stdout, stem) = run_case("cases/tissue-growth.toml", &[], "tissue");
-    assert!(stdout.contains("[6402, 9601, 3200]"), "{stdout}");
+    assert!(
+        stdout.contains(&format!("cells per dimension {counts}")),
+        "{counts}\n{stdout}"
+    );
     // The output is a time series whose mesh changes: level k at time k.
     let file = hdf5::File::open(stem.with_extension("h5")).unwrap();
     assert_eq!(
