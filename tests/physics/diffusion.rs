@@ -514,18 +514,24 @@ fn two_point_flux_at_voronoi_sites_converges_where_centroids_do_not() {
         );
         // The same unknowns at the centroids: the segment between two
         // centroids is not orthogonal to the common edge, the flux is not
-        // consistent, and without smoothing the error stalls; Lloyd steps
-        // shrink the site–centroid offsets (relative to h) but do not remove
-        // them, so the order stays well below two.
+        // consistent, and without smoothing the error stalls: it tends to
+        // a non-zero limit, so its order tends to 0, and the last two
+        // pairwise orders (h halves per level) are at most 0 + 0.15 (the
+        // README records this run: −0.07 and −0.15). Lloyd steps shrink
+        // the site–centroid offsets (relative to h) but do not remove them,
+        // so the order stays out of second order's band 2 ± 0.15, by the
+        // tolerance again.
         let at_centroids = study_with(&levels, |_, _| problem.clone(), &exact, &gradient);
         let observed = order(&at_centroids.h, &at_centroids.l2);
-        let finest = VORONOI_SITES.len() - 1;
         if lloyd == 0 {
-            assert!(
-                observed < 0.6 && at_centroids.l2[finest] > 10.0 * at_sites.l2[finest],
-                "centroid TPFA order {observed:.3}, errors {:?}",
-                at_centroids.l2
-            );
+            for pair in at_centroids.l2[VORONOI_SITES.len() - 3..].windows(2) {
+                let p = (pair[0] / pair[1]).log2();
+                assert!(
+                    p <= 0.15,
+                    "centroid TPFA converges (pairwise order {p:.3}), errors {:?}",
+                    at_centroids.l2
+                );
+            }
         } else {
             assert!(
                 observed < 1.85 - 0.15,
