@@ -325,7 +325,9 @@ fn dec_mass_is_dual_edge_over_face() {
 #[test]
 fn local_mass_conservation_is_exact() {
     let m = smooth();
-    let families: [(fn(usize) -> Complex, FluxMass); 2] = [
+    // A mesh family: k = 1, 2 gives the mesh and its halving.
+    type Family = fn(usize) -> Complex;
+    let families: [(Family, FluxMass); 2] = [
         (
             |k| {
                 let grid = rectangle(12 * k, 10 * k, [0.0, 1.0], [0.0, 1.0]).unwrap();
