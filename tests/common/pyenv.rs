@@ -2,8 +2,8 @@
 //! user would: a venv at `<target>/pyenv` with h5py and meshio, created
 //! with `pip install h5py meshio` when missing.
 //!
-//! Include it from a test file with
-//! `#[path = "common/pyenv.rs"] mod pyenv;` and call
+//! Declare it once in a test binary's `main.rs` with
+//! `#[path = "../common/pyenv.rs"] mod pyenv;` and call
 //! [`python_or_skip`] at the start of each test that needs Python.
 
 use std::path::{Path, PathBuf};

@@ -2,7 +2,7 @@
 
 Usage: check_output.py MANIFEST.json
 
-The manifest (written by tests/output_python.rs) lists output files and the
+The manifest (written by tests/output/output_python.rs) lists output files and the
 values expected in them, computed in Rust from analytic formulas. Every
 check raises AssertionError with a message; the script prints one line per
 case (and one per edges file read) and exits non-zero on the first failure.

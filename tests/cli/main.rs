@@ -1,0 +1,25 @@
+//! Integration tests of the `hasse` binary as a user runs it: shipped
+//! cases, physics kinds, `check`, `info`, the case documentation, bad
+//! input, interrupted output and the replayed fuzz inputs.
+//!
+//! One test binary per area (methods, physics, cli, output); the former
+//! test files are the modules below, e.g.
+//! `cargo test -p hasse-solver --test cli bad_input::`. The tests of one
+//! binary run on parallel threads of one process: each writes into its
+//! own scratch directory (test name and process id) and hands environment
+//! variables to the child `hasse` process, never to this one.
+
+#[path = "../common/pyenv.rs"]
+mod pyenv;
+#[path = "../common/scratch.rs"]
+mod scratch;
+
+mod bad_input;
+mod case_docs;
+mod cli_cases;
+mod cli_check;
+mod cli_info;
+mod cli_output;
+mod cli_physics;
+mod fuzz_regressions;
+mod interrupted_output;

@@ -1,0 +1,19 @@
+//! Integration tests of the physics through the library: diffusion by
+//! every method, Darcy, Maxwell, transient heat, elasticity, coupled
+//! fields, re-solving on refined meshes and convergence studies.
+//!
+//! One test binary per area (methods, physics, cli, output); the former
+//! test files are the modules below, e.g.
+//! `cargo test -p hasse-solver --test physics darcy::`.
+
+#[path = "../common/orders.rs"]
+mod orders;
+
+mod converge;
+mod coupled;
+mod darcy;
+mod diffusion;
+mod elasticity;
+mod maxwell;
+mod refinement;
+mod transient;
