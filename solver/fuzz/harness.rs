@@ -1,5 +1,5 @@
 //! What each fuzz target does with its bytes. Shared by the cargo-fuzz
-//! targets (nightly, `scripts/fuzz`) and by `tests/fuzz_regressions.rs`,
+//! targets (nightly, `scripts/fuzz`) and by `tests/cli/fuzz_regressions.rs`,
 //! which replays every kept input on stable. A harness may return early on
 //! input it cannot use, but any panic is a bug: all of this is reachable
 //! from a case file or a mesh file.

@@ -55,7 +55,7 @@
 //!   `hasse` command line (`main.rs`); nothing in the library depends on
 //!   it.
 //!
-//! The rule is checked by the test `tests/layers.rs`: it fails when a
+//! The rule is checked by the test `tests/methods/layers.rs`: it fails when a
 //! lower layer names a higher one.
 
 #![warn(missing_docs)]

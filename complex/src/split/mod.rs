@@ -47,6 +47,7 @@
 //! assert_eq!(left.to_dense(), right.to_dense());
 //! ```
 
+mod cut;
 mod round;
 mod transfer;
 

@@ -18,10 +18,11 @@
 //! parent, to orient a new cut polygon, and for the positivity flag of new
 //! top cells.
 
+use super::cut::{cut_cell, union_sets, Pieces, Scratch};
 use super::{Hyperplane, Refinement};
 use crate::cells::{FlatSets, Vertices};
 use crate::complex::Complex;
-use crate::error::{ComplexError, SplitError};
+use crate::error::SplitError;
 use crate::frame::{self, Frame, Point};
 use crate::lar::{characteristic_matrix, Lar};
 use crate::tags::{CellTag, Tags};
@@ -33,7 +34,7 @@ use std::ops::Range;
 const NONE: u32 = u32::MAX;
 
 /// A signed list of cells (a chain), sorted by cell id.
-type Chain = Vec<(usize, i8)>;
+pub(super) type Chain = Vec<(usize, i8)>;
 
 pub(super) struct Round {
     pub complex: Complex,
@@ -46,7 +47,7 @@ pub(super) struct Round {
 /// Columns of one ∂_p under construction (CSC) together with the vertex
 /// sets of the p-cells (rows of M_p).
 #[derive(Default)]
-struct Level {
+pub(super) struct Level {
     ptr: Vec<usize>,
     rows: Vec<usize>,
     signs: Vec<i8>,
@@ -83,12 +84,12 @@ impl Level {
         self.set_ptr.push(self.set.len());
     }
 
-    fn column(&self, j: usize) -> (&[usize], &[i8]) {
+    pub(super) fn column(&self, j: usize) -> (&[usize], &[i8]) {
         let r = self.ptr[j]..self.ptr[j + 1];
         (&self.rows[r.clone()], &self.signs[r])
     }
 
-    fn set(&self, j: usize) -> &[u32] {
+    pub(super) fn set(&self, j: usize) -> &[u32] {
         &self.set[self.set_ptr[j]..self.set_ptr[j + 1]]
     }
 
@@ -107,7 +108,7 @@ impl Level {
 /// Signed distances and classes of vertices with respect to the planes of
 /// this round. Classes depend only on (vertex, plane), so every cell that
 /// shares a vertex sees the same class.
-struct Classifier<'a> {
+pub(super) struct Classifier<'a> {
     planes: &'a [Hyperplane],
     coords: &'a [f64],
     dim: usize,
@@ -139,7 +140,11 @@ impl Classifier<'_> {
     }
 
     /// (has a vertex strictly below, has one strictly above).
-    fn sides<I: IntoIterator<Item = usize>>(&self, verts: I, plane: u32) -> (bool, bool) {
+    pub(super) fn sides<I: IntoIterator<Item = usize>>(
+        &self,
+        verts: I,
+        plane: u32,
+    ) -> (bool, bool) {
         let (mut neg, mut pos) = (false, false);
         for v in verts {
             match self.class(v, plane) {
@@ -158,7 +163,7 @@ impl Classifier<'_> {
     }
 }
 
-fn sign_of(x: f64) -> i8 {
+pub(super) fn sign_of(x: f64) -> i8 {
     if x > 0.0 {
         1
     } else {
@@ -167,7 +172,7 @@ fn sign_of(x: f64) -> i8 {
 }
 
 /// Orientation of frame `a` relative to frame `b` spanning the same p-plane.
-fn relative_orientation(a: &Frame, b: &Frame) -> i8 {
+pub(super) fn relative_orientation(a: &Frame, b: &Frame) -> i8 {
     let mut m = [[0.0; 3]; 3];
     for (i, row) in m.iter_mut().enumerate().take(a.dim) {
         for (j, slot) in row.iter_mut().enumerate().take(b.dim) {
@@ -711,236 +716,6 @@ fn collect_straddled(
             }
         }
     }
-}
-
-#[derive(Default)]
-struct Scratch {
-    column: Vec<(usize, i8)>,
-    set: Vec<u32>,
-    tally: Vec<(usize, i8, u8)>,
-}
-
-#[derive(Default)]
-struct Pieces {
-    ids: Vec<usize>,
-    cut: Vec<usize>,
-    minus: Vec<(usize, i8)>,
-    plus: Vec<(usize, i8)>,
-    minus_set: Vec<u32>,
-    plus_set: Vec<u32>,
-    cut_column: Vec<(usize, i8)>,
-    cut_set: Vec<u32>,
-    /// Sign of the cut cell in ∂(negative piece oriented like the parent).
-    cut_sign: i8,
-    eps_minus: i8,
-    eps_plus: i8,
-    top_minus: i8,
-    top_plus: i8,
-}
-
-fn union_sets(level: &Level, cells: impl Iterator<Item = usize>, out: &mut Vec<u32>) {
-    out.clear();
-    for f in cells {
-        out.extend_from_slice(level.set(f));
-    }
-    out.sort_unstable();
-    out.dedup();
-}
-
-/// Cut p-cell `c` (its new boundary chain in `scratch.column`) by plane `id`.
-#[allow(clippy::too_many_arguments)]
-fn cut_cell(
-    k: &Complex,
-    vertices: &Vertices,
-    cls: &Classifier,
-    edges: &Level,
-    lower: &Level,
-    p: usize,
-    n: usize,
-    c: usize,
-    id: u32,
-    scratch: &mut Scratch,
-    out: &mut Pieces,
-) -> Result<(), SplitError> {
-    let ambiguous = || SplitError::AmbiguousCut { dim: p, cell: c };
-    let Pieces {
-        ids,
-        cut,
-        minus,
-        plus,
-        minus_set,
-        plus_set,
-        cut_column,
-        cut_set,
-        ..
-    } = out;
-    minus.clear();
-    plus.clear();
-    // Facets with a vertex strictly below go to the negative piece, the rest
-    // (positive or lying in the plane) to the positive one.
-    scratch.tally.clear();
-    for &(f, r) in &scratch.column {
-        let (neg, pos) = cls.sides(lower.set(f).iter().map(|&v| v as usize), id);
-        if neg && pos {
-            return Err(ambiguous());
-        }
-        let side = if neg { 1u8 } else { 2u8 };
-        if neg {
-            minus.push((f, r));
-        } else {
-            plus.push((f, r));
-        }
-        // The cut is made of the (p−2)-cells met by facets of both sides.
-        for &g in lower.column(f).0 {
-            match scratch.tally.iter_mut().find(|t| t.0 == g) {
-                Some(t) => t.2 |= side,
-                None => scratch.tally.push((g, 0, side)),
-            }
-        }
-    }
-    if minus.is_empty() || plus.is_empty() {
-        return Err(ambiguous());
-    }
-    cut.clear();
-    cut.extend(scratch.tally.iter().filter(|t| t.2 == 3).map(|t| t.0));
-    cut.sort_unstable();
-    // The new (p−1)-cell N and its boundary in its own orientation.
-    if p == 2 {
-        if cut.len() != 2 {
-            return Err(ambiguous());
-        }
-        cut_column.clear();
-        cut_column.extend([(cut[0], -1), (cut[1], 1)]);
-        cut_set.clear();
-        cut_set.extend([cut[0] as u32, cut[1] as u32]);
-    } else {
-        (*cut_column, *cut_set) = cut_polygon(vertices, edges, cut, p, c)?;
-    }
-    // ∂∂ = 0 on the negative piece fixes the sign of N: the coefficient of
-    // the first face g of N in ∂(minus part) must cancel with ∂N.
-    let (g, ng) = cut_column[0];
-    let mut coef: i32 = 0;
-    for &(f, r) in minus.iter() {
-        let (rows, signs) = lower.column(f);
-        if let Ok(pos) = rows.binary_search(&g) {
-            coef += i32::from(r) * i32::from(signs[pos]);
-        }
-    }
-    if coef.abs() != 1 {
-        return Err(ambiguous());
-    }
-    let cut_sign = -(coef as i8) * ng;
-    union_sets(lower, minus.iter().map(|x| x.0), minus_set);
-    union_sets(lower, plus.iter().map(|x| x.0), plus_set);
-    let degenerate = |set: &[u32]| {
-        SplitError::Complex(ComplexError::DegenerateCell {
-            dim: p,
-            cell: c,
-            vertices: set.iter().map(|&v| v as usize).collect(),
-        })
-    };
-    let mut frame_of = |set: &[u32]| {
-        ids.clear();
-        ids.extend(set.iter().map(|&v| v as usize));
-        frame::frame(vertices, ids, p).ok_or_else(|| degenerate(set))
-    };
-    let fm = frame_of(minus_set)?;
-    let fp = frame_of(plus_set)?;
-    let (eps_minus, eps_plus, top_minus, top_plus) = if p == n {
-        // Top cells are stored positively oriented: the pieces keep the
-        // parent's orientation; only the flag relative to the sorted frame is new.
-        (
-            1,
-            1,
-            sign_of(frame::det(n, &fm.basis)),
-            sign_of(frame::det(n, &fp.basis)),
-        )
-    } else {
-        let parent = frame::frame(vertices, k.cell_vertices(p, c), p)
-            .ok_or_else(|| degenerate(minus_set))?;
-        (
-            relative_orientation(&fm, &parent),
-            relative_orientation(&fp, &parent),
-            1,
-            1,
-        )
-    };
-    out.cut_sign = cut_sign;
-    out.eps_minus = eps_minus;
-    out.eps_plus = eps_plus;
-    out.top_minus = top_minus;
-    out.top_plus = top_plus;
-    Ok(())
-}
-
-/// The cut polygon of a polyhedron: its edges `cut` form one cycle; walk it
-/// and orient the chain like the frame of the polygon's sorted vertices.
-fn cut_polygon(
-    vertices: &Vertices,
-    edges: &Level,
-    cut: &[usize],
-    p: usize,
-    c: usize,
-) -> Result<(Chain, Vec<u32>), SplitError> {
-    let ambiguous = || SplitError::AmbiguousCut { dim: p, cell: c };
-    let ends: Vec<[usize; 2]> = cut
-        .iter()
-        .map(|&e| {
-            let s = edges.set(e);
-            [s[0] as usize, s[1] as usize]
-        })
-        .collect();
-    if ends.len() < 3 {
-        return Err(ambiguous());
-    }
-    let mut chain = Vec::with_capacity(cut.len());
-    let mut order = Vec::with_capacity(cut.len());
-    let mut used = vec![false; cut.len()];
-    let start = ends[0][0];
-    let mut at = ends[0][1];
-    used[0] = true;
-    chain.push((cut[0], 1i8));
-    order.push(start);
-    while at != start {
-        order.push(at);
-        let next = (0..cut.len()).find(|&i| !used[i] && (ends[i][0] == at || ends[i][1] == at));
-        let Some(i) = next else {
-            return Err(ambiguous());
-        };
-        used[i] = true;
-        if ends[i][0] == at {
-            chain.push((cut[i], 1));
-            at = ends[i][1];
-        } else {
-            chain.push((cut[i], -1));
-            at = ends[i][0];
-        }
-    }
-    if used.iter().any(|&u| !u) {
-        return Err(ambiguous());
-    }
-    let mut set: Vec<u32> = order.iter().map(|&v| v as u32).collect();
-    set.sort_unstable();
-    let ids: Vec<usize> = set.iter().map(|&v| v as usize).collect();
-    let f = frame::frame(vertices, &ids, 2).ok_or(SplitError::Complex(
-        ComplexError::DegenerateCell {
-            dim: 2,
-            cell: c,
-            vertices: ids.clone(),
-        },
-    ))?;
-    // Newell's normal of the walk against the normal of the sorted frame.
-    let mut newell = Vector3::zeros();
-    for w in 0..order.len() {
-        let a = Vector3::from(frame::point(vertices, order[w]));
-        let b = Vector3::from(frame::point(vertices, order[(w + 1) % order.len()]));
-        newell += a.cross(&b);
-    }
-    let normal = Vector3::from(f.basis[0]).cross(&Vector3::from(f.basis[1]));
-    let eps = sign_of(newell.dot(&normal));
-    let mut column: Vec<(usize, i8)> = chain.into_iter().map(|(e, s)| (e, s * eps)).collect();
-    column.sort_unstable();
-    Ok((column, set))
 }
 
 /// ζ_p as CSR: old cell i ↦ ε⁻ i (+ ε⁺ plus(i) when split), new cut cells empty.

@@ -35,10 +35,10 @@
 
 use crate::la::direct::{Factorization, SolveError, SolveReport};
 use crate::la::ordering::Ordering;
-use crate::metric::fe::{self, Topology};
+use crate::metric::fe;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::MetricError;
-use crate::operator::{BlockMetric, Canonical, CanonicalError};
+use crate::operator::{Canonical, CanonicalError};
 use crate::physics::diffusion::{self, DiffusionError};
 use crate::physics::VectorFn;
 use crate::physics::{
@@ -46,11 +46,15 @@ use crate::physics::{
 };
 use faer::sparse::SparseColMat;
 use hasse_complex::Complex;
-use nalgebra::DMatrix;
-use rayon::prelude::*;
-use sprs::{CsMat, TriMat};
 use std::sync::Arc;
 use std::time::Instant;
+
+mod operator;
+mod rigid;
+
+pub use operator::{incidence, stiffness_metric};
+use rigid::check_rigid_modes;
+pub use rigid::rigid_modes;
 
 /// A material coefficient: a function of position evaluated at each top
 /// cell's centroid, or one value per top cell.
@@ -708,241 +712,4 @@ fn dimension(complex: &Complex) -> Result<usize, ElasticityError> {
         return Err(ElasticityError::Dimension { n, d });
     }
     Ok(d)
-}
-
-/// A = I_d ⊗ δ⁰: row a·|K₁| + e holds edge e's differences of component a,
-/// column a·|K₀| + v is component a at vertex v.
-///
-/// ```
-/// use hasse_complex::generate::rectangle;
-/// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
-/// let a = hasse_solver::physics::elasticity::incidence(&k);
-/// assert_eq!(a.shape(), (8, 8)); // 2 × 4 edges, 2 × 4 vertices
-/// assert_eq!(a.nnz(), 16);
-/// ```
-pub fn incidence(complex: &Complex) -> CsMat<i8> {
-    let d = complex.embedding_dim();
-    let delta = complex.shared_coboundary(0);
-    let (edges, vertices) = delta.shape();
-    let mut tri = TriMat::with_capacity((d * edges, d * vertices), d * delta.nnz());
-    for a in 0..d {
-        for (&s, (e, v)) in delta.iter() {
-            tri.add_triplet(a * edges + e, a * vertices + v, s);
-        }
-    }
-    tri.to_csr()
-}
-
-/// The elastic metric Ω over the rows of [`incidence`]: one dense block per
-/// top cell, Ω_c = (A_c⁺)ᵀ K_c A_c⁺ over the d·|edges of c| rows of its
-/// edges (see the [module documentation](self)).
-///
-/// K_c[(a, i), (b, j)] = Σ_q w_q (λ ∂_a φ_i ∂_b φ_j + μ (δ_ab ∇φ_i·∇φ_j +
-/// ∂_b φ_i ∂_a φ_j)) over the quadrature points of the scalar FE metric
-/// (one point on simplices, Gauss 2ⁿ on quadrilaterals and hexahedra).
-///
-/// ```
-/// use hasse_complex::{Complex, TopCells, Vertices};
-/// use hasse_solver::physics::elasticity::{stiffness_metric, Lame};
-/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]).unwrap();
-/// let k = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
-/// let omega = stiffness_metric(&k, &[Lame { lambda: 2.0, mu: 1.0 }]).unwrap();
-/// assert_eq!((omega.size(), omega.block_count()), (6, 1));
-/// assert!(omega.is_symmetric(1e-14));
-/// ```
-pub fn stiffness_metric(complex: &Complex, lame: &[Lame]) -> Result<BlockMetric, MetricError> {
-    let top = Topology::new(complex, "elasticity")?;
-    let (n, d) = (top.n, top.d);
-    let cells = complex.cell_count(n);
-    if lame.len() != cells {
-        return Err(MetricError::CoefficientCount {
-            count: lame.len(),
-            cells,
-        });
-    }
-    let edges = complex.cell_count(1);
-    let blocks = (0..cells)
-        .into_par_iter()
-        .map(|c| {
-            let points = fe::shape_gradients(&top, c)?.ok_or(MetricError::UnsupportedCell {
-                method: "elasticity",
-                needs: "a triangle, tetrahedron, quadrilateral or hexahedron (P1 or Q1)",
-                cell: c,
-            })?;
-            let m = complex.cell_vertices(n, c).len();
-            let Lame { lambda, mu } = lame[c];
-            let mut kc = DMatrix::zeros(d * m, d * m);
-            for (w, g) in &points {
-                for a in 0..d {
-                    for b in 0..d {
-                        for i in 0..m {
-                            for j in 0..m {
-                                let mut value = lambda * g[i][a] * g[j][b] + mu * g[i][b] * g[j][a];
-                                if a == b {
-                                    value += mu * (0..d).map(|k| g[i][k] * g[j][k]).sum::<f64>();
-                                }
-                                kc[(a * m + i, b * m + j)] += w * value;
-                            }
-                        }
-                    }
-                }
-            }
-            let cell_edges = top.edges_of(c);
-            let pinv =
-                fe::edge_pseudo_inverse(&top, c, &cell_edges, &mut Vec::new(), "elasticity")?;
-            let lift = DMatrix::<f64>::identity(d, d).kronecker(&*pinv);
-            let omega = lift.transpose() * kc * &lift;
-            let size = omega.nrows();
-            let rows: Vec<usize> = (0..d)
-                .flat_map(|a| cell_edges.iter().map(move |&e| a * edges + e))
-                .collect();
-            // Symmetric up to rounding; made exactly so.
-            let values: Vec<f64> = (0..size * size)
-                .map(|k| {
-                    let (i, j) = (k / size, k % size);
-                    0.5 * (omega[(i, j)] + omega[(j, i)])
-                })
-                .collect();
-            if values.iter().any(|v| !v.is_finite()) {
-                return Err(MetricError::UnsupportedCell {
-                    method: "elasticity",
-                    needs: "a non-degenerate cell (finite local stiffness)",
-                    cell: c,
-                });
-            }
-            Ok((rows, values))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut metric = BlockMetric::new(d * edges);
-    for (rows, values) in &blocks {
-        metric.push_symmetric(rows, values);
-    }
-    Ok(metric)
-}
-
-/// The rigid-body modes of the whole mesh, component-major like the
-/// unknowns: d translations, then the rotations about the vertex average
-/// (one in 2D; about the x, y and z axes in 3D).
-pub fn rigid_modes(complex: &Complex) -> Vec<Vec<f64>> {
-    let all: Vec<usize> = (0..complex.cell_count(0)).collect();
-    modes_on(complex, &all)
-}
-
-/// Rigid modes restricted to the vertices `part` (zero elsewhere).
-fn modes_on(complex: &Complex, part: &[usize]) -> Vec<Vec<f64>> {
-    let d = complex.embedding_dim();
-    let vertices = complex.cell_count(0);
-    let mut centre = [0.0; 3];
-    for &v in part {
-        for (a, x) in complex.vertices().point(v).iter().enumerate() {
-            centre[a] += x / part.len() as f64;
-        }
-    }
-    let mut modes = Vec::new();
-    for a in 0..d {
-        let mut m = vec![0.0; d * vertices];
-        for &v in part {
-            m[a * vertices + v] = 1.0;
-        }
-        modes.push(m);
-    }
-    // Rotation in the (p, q) plane: u_p = −x_q, u_q = x_p.
-    let planes: &[(usize, usize)] = if d == 2 {
-        &[(0, 1)]
-    } else {
-        &[(1, 2), (2, 0), (0, 1)]
-    };
-    for &(p, q) in planes {
-        let mut m = vec![0.0; d * vertices];
-        for &v in part {
-            let x = complex.vertices().point(v);
-            m[p * vertices + v] = -(x[q] - centre[q]);
-            m[q * vertices + v] = x[p] - centre[p];
-        }
-        modes.push(m);
-    }
-    modes
-}
-
-/// Connected parts of the edge graph, as vertex lists.
-fn parts(complex: &Complex) -> Vec<Vec<usize>> {
-    let vertices = complex.cell_count(0);
-    let mut parent: Vec<usize> = (0..vertices).collect();
-    fn root(parent: &mut [usize], mut v: usize) -> usize {
-        while parent[v] != v {
-            parent[v] = parent[parent[v]];
-            v = parent[v];
-        }
-        v
-    }
-    for e in 0..complex.cell_count(1) {
-        let ends = complex.cell_vertices(1, e);
-        let (a, b) = (root(&mut parent, ends[0]), root(&mut parent, ends[1]));
-        parent[a] = b;
-    }
-    let mut index = vec![usize::MAX; vertices];
-    let mut out: Vec<Vec<usize>> = Vec::new();
-    for v in 0..vertices {
-        let r = root(&mut parent, v);
-        if index[r] == usize::MAX {
-            index[r] = out.len();
-            out.push(Vec::new());
-        }
-        out[index[r]].push(v);
-    }
-    out
-}
-
-/// Below this, a generalised eigenvalue of (modes on fixed unknowns, modes
-/// on all unknowns) is a free mode. The eigenvalues lie in [0, 1]; a mode
-/// held by a single vertex of a million still has about 1e-6, while one the
-/// constraints miss is zero to rounding (≈ 1e-30).
-const RIGID_TOLERANCE: f64 = 1e-12;
-
-/// Report the first part of the mesh whose prescribed components leave a
-/// rigid-body mode free.
-fn check_rigid_modes(complex: &Complex, fixed: &[Option<f64>]) -> Result<(), ElasticityError> {
-    for (part, vertices) in parts(complex).iter().enumerate() {
-        let modes = modes_on(complex, vertices);
-        let r = modes.len();
-        let gram = |held_only: bool| {
-            DMatrix::from_fn(r, r, |i, j| {
-                modes[i]
-                    .iter()
-                    .zip(&modes[j])
-                    .zip(fixed)
-                    .filter(|(_, g)| !held_only || g.is_some())
-                    .map(|((x, y), _)| x * y)
-                    .sum::<f64>()
-            })
-        };
-        let (held, all) = (gram(true), gram(false));
-        // A single vertex has no rotation (its modes are dependent): then
-        // the held translations decide alone.
-        let free = match all.clone().cholesky() {
-            Some(chol) => {
-                let l_inv = chol
-                    .l()
-                    .try_inverse()
-                    .unwrap_or_else(|| DMatrix::zeros(r, r));
-                let scaled = &l_inv * held * l_inv.transpose();
-                scaled
-                    .symmetric_eigenvalues()
-                    .iter()
-                    .filter(|&&e| e < RIGID_TOLERANCE)
-                    .count()
-            }
-            None => (0..complex.embedding_dim())
-                .filter(|&a| held[(a, a)] == 0.0)
-                .count(),
-        };
-        if free > 0 {
-            return Err(ElasticityError::RigidModes {
-                part,
-                free,
-                modes: r,
-            });
-        }
-    }
-    Ok(())
 }
