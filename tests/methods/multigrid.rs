@@ -238,8 +238,8 @@ fn amg_on_an_unstructured_triangulation_has_bounded_counts() {
     }
     println!("AMG on Delaunay P1: iterations {counts:?}");
     assert_mesh_independent(&counts);
-    // README's table records 15 / 18 / 19 for these three meshes; 20
-    // allows one more.
+    // README's table records 15 / 17 / 18 for these three meshes (the
+    // same before the layering); 20 leaves two iterations of slack.
     assert!(counts.iter().all(|&c| c <= 20), "{counts:?}");
 }
 
