@@ -74,3 +74,8 @@ pub mod study;
 #[cfg(doctest)]
 #[doc = include_str!("../../README.md")]
 struct ReadmeExamples;
+
+/// The Rust examples of the solver and performance notes, run the same way.
+#[cfg(doctest)]
+#[doc = include_str!("../../benches/README.md")]
+struct SolverNotesExamples;

@@ -10,7 +10,15 @@ use std::process::ExitCode;
 
 /// hasse: one canonical form δΩ∂ = AᵀΩA for FD, FE, FV and DEC on any cell complex.
 #[derive(Parser)]
-#[command(version, about, long_about = None)]
+#[command(
+    version,
+    about,
+    long_about = None,
+    after_help = "Case files: every key is documented in cases/README.md, with the shipped \
+                  cases (cases/first-case.toml is the walk-through of README.md); the output \
+                  layout is in cases/OUTPUT.md. `hasse COMMAND --help` explains a command \
+                  with examples."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -633,8 +641,8 @@ fn converge(
             .map(|r| format!("{} {:.2} s", r.method, r.solve_seconds))
             .collect();
         eprintln!(
-            "level {}/{levels}: n = {:?}, h = {:.3e}, {} cells, mesh {:.2} s; {}",
-            level + 1,
+            "level {level} of 0–{}: n = {:?}, h = {:.3e}, {} cells, mesh {:.2} s; {}",
+            levels - 1,
             first.resolution,
             first.h,
             first.cells,

@@ -73,7 +73,7 @@ fn poisson_square_every_method() {
     // u = sin(πx) sin(πy) on the shipped 32 × 32 grid and on 16 × 16:
     // every method is second order in L² on uniform grids, so the observed
     // order between the two is 2 ± 0.15 (a first-order or inconsistent
-    // method gives 1 or 0). README records the 32² errors of fd, fe and
+    // method gives 1 or 0). benches/README.md records the 32² errors of fd, fe and
     // fv-mimetic (4.0179e-4, its convergence table).
     let cases: [(&str, &[&str]); 6] = [
         ("fe", &[]),
@@ -196,7 +196,7 @@ fn poisson_multigrid_matches_the_direct_solve() {
     let expected = reported(&direct, "error", "L2");
     assert_relative_eq!(l2, expected, epsilon = 0.0, max_relative = 1e-6);
     let iterations = reported(&multigrid, "iterative", "):");
-    // README's table records 7 iterations to 1e-8 for FV on 64² (smoothed
+    // benches/README.md's table records 7 iterations to 1e-8 for FV on 64² (smoothed
     // prolongation) and one or two more with the constant one this case
     // uses; 15 leaves about a factor two.
     assert!((1.0..=15.0).contains(&iterations), "{multigrid}");

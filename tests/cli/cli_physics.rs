@@ -597,14 +597,14 @@ fn multigrid_solver_types_match_the_direct_solution() {
             "{kind}: {l2} vs {direct}"
         );
         let iterations = reported(&out, "iterative", "):");
-        // README's table records 7 (grid, smoothed) and 8 (constant
+        // benches/README.md's table records 7 (grid, smoothed) and 8 (constant
         // prolongation) iterations to 1e-8 for FV on the 16³ cube; 15 is
         // about twice that.
         assert!((1.0..=15.0).contains(&iterations), "{kind}: {out}");
         assert!(!out.contains("warning"), "{kind}: {out}");
     }
     // The unsmoothed cell prolongation reaches the same solution; its
-    // sparser coarse levels cost more iterations (README: 8 against 7 on
+    // sparser coarse levels cost more iterations (benches/README.md: 8 against 7 on
     // the 16³ cube), which shows the key reached the solver.
     let iterations = |extra: &[String]| {
         let mut args = vec!["solver.type=\"multigrid\"".to_string()];

@@ -140,7 +140,7 @@ fn fv_3d_poisson_matches_direct_and_counts_do_not_grow() {
     let counts = grid_counts("3D FV", &[16, 32, 64], Method::Fv, cube);
     assert_mesh_independent(&counts);
     // Jacobi-CG needs O(1/h) iterations: ~100 at 32³. Ten times fewer is
-    // what multigrid is for; README's table records 7 / 8 / 8 here.
+    // what multigrid is for; benches/README.md's table records 7 / 8 / 8 here.
     assert!(counts.iter().all(|&c| c <= 12), "{counts:?}");
 }
 
@@ -160,7 +160,7 @@ fn fe_3d_poisson_matches_direct_and_counts_do_not_grow() {
     );
     let counts = grid_counts("3D FE P1 (Kuhn)", &[8, 16, 32], Method::Fe, kuhn_cube);
     assert_mesh_independent(&counts);
-    // The bound of the FV test; README's table records 6 / 6 / 7 here.
+    // The bound of the FV test; benches/README.md's table records 6 / 6 / 7 here.
     assert!(counts.iter().all(|&c| c <= 12), "{counts:?}");
 }
 
@@ -174,7 +174,7 @@ fn poisson_2d_counts_do_not_grow() {
             square,
         );
         assert_mesh_independent(&counts);
-        // The bound of the 3D tests; README's table records 7 / 7 / 7 (FV)
+        // The bound of the 3D tests; benches/README.md's table records 7 / 7 / 7 (FV)
         // and 5 / 5 / 5 (Q1) here.
         assert!(counts.iter().all(|&c| c <= 12), "{counts:?}");
     }
@@ -238,7 +238,7 @@ fn amg_on_an_unstructured_triangulation_has_bounded_counts() {
     }
     println!("AMG on Delaunay P1: iterations {counts:?}");
     assert_mesh_independent(&counts);
-    // README's table records 15 / 17 / 18 for these three meshes (the
+    // benches/README.md's table records 15 / 17 / 18 for these three meshes (the
     // same before the layering); 20 leaves two iterations of slack.
     assert!(counts.iter().all(|&c| c <= 20), "{counts:?}");
 }
@@ -259,7 +259,7 @@ fn split_refinements_give_the_hierarchy() {
         assert_matches_direct(&mesh, method, Hierarchy::Refinements(list.clone()));
         let n = count(&mesh, method, Hierarchy::Refinements(list.clone()));
         // The SPLIT levels of this 32² grid are the 4², 8², 16² grids, the
-        // levels of the grid hierarchy, for which README records 7 (FV)
+        // levels of the grid hierarchy, for which benches/README.md records 7 (FV)
         // and 5 (Q1) iterations on 64² to 256²; 10 leaves three.
         assert!(n <= 10, "{}: {n} iterations", method.name());
     }

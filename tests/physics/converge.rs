@@ -139,12 +139,15 @@ fn expect_fails_the_run_when_an_order_is_missed_and_passes_when_met() {
     let stdout = text(&met.stdout);
     assert!(stdout.contains("fd least squares"), "{stdout}");
     assert!(stdout.contains(": met"), "{stdout}");
-    // One progress line per level on stderr.
+    // One progress line per level on stderr, numbered from 0 as the table
+    // numbers them.
     let progress = text(&met.stderr);
-    assert_eq!(
-        progress.lines().filter(|l| l.starts_with("level ")).count(),
-        3
-    );
+    let numbers: Vec<&str> = progress
+        .lines()
+        .filter_map(|l| l.strip_prefix("level "))
+        .map(|l| l.split_whitespace().next().unwrap_or(""))
+        .collect();
+    assert_eq!(numbers, ["0", "1", "2"], "{progress}");
     let quiet = poisson(&dir, "fd", &["-q"]);
     assert!(quiet.status.success());
     assert!(quiet.stdout.is_empty() && quiet.stderr.is_empty());
@@ -217,6 +220,60 @@ fn csv_json_png_and_svg_are_written_with_the_stated_shape() {
         }
     }
     assert_eq!(labels, want);
+
+    // The methods were chosen on the command line, so the case's title
+    // (which describes its own method, fe) gives way to the methods.
+    let texts = svg_texts(&svg);
+    assert!(
+        texts
+            .iter()
+            .any(|t| t == "fd, fe, fv on poisson-square.toml"),
+        "{texts:?}"
+    );
+    // The reference slopes are named in the legend and at their lines.
+    for label in [
+        "reference slope 1 (h¹)",
+        "reference slope 2 (h²)",
+        "h¹",
+        "h²",
+    ] {
+        assert!(texts.iter().any(|t| t == label), "{label}: {texts:?}");
+    }
+    // h runs from 1.8e-1 (8×8, √2/8) to 4.4e-2: the decade 10⁻¹ lies inside
+    // and is written as a power, the 2 and 5 marks between as 2·10⁻¹ …
+    assert!(texts.iter().any(|t| t == "10⁻¹"), "{texts:?}");
+    assert!(!texts.iter().any(|t| t.contains("e-")), "{texts:?}");
+}
+
+/// Every text element of an SVG, trimmed.
+fn svg_texts(svg: &str) -> Vec<String> {
+    svg.split("<text")
+        .skip(1)
+        .map(|t| {
+            let body = &t[t.find('>').unwrap() + 1..t.find("</text>").unwrap()];
+            body.trim().to_string()
+        })
+        .collect()
+}
+
+#[test]
+fn a_study_of_the_case_s_own_method_keeps_its_title() {
+    let study = Study {
+        levels: 2,
+        refinement: Refinement::Uniform,
+        methods: Vec::new(),
+    };
+    let result = study
+        .run(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("../cases/poisson-square.toml"),
+            &["mesh.n=[4,4]".into()],
+            &mut |_, _| {},
+        )
+        .unwrap();
+    let svg = result.svg(PlotOptions::default()).unwrap();
+    // cases/poisson-square.toml: title and method = "fe".
+    let title = "Poisson on the unit square, manufactured solution (fe)";
+    assert!(svg_texts(&svg).iter().any(|t| t == title));
 }
 
 /// Width and height from the IHDR chunk, after checking the signature.

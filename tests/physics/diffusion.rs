@@ -517,7 +517,7 @@ fn two_point_flux_at_voronoi_sites_converges_where_centroids_do_not() {
         // consistent, and without smoothing the error stalls: it tends to
         // a non-zero limit, so its order tends to 0, and the last two
         // pairwise orders (h halves per level) are at most 0 + 0.15 (the
-        // README records this run: −0.07 and −0.15). Lloyd steps shrink
+        // benches/README.md records this run: −0.07 and −0.15). Lloyd steps shrink
         // the site–centroid offsets (relative to h) but do not remove them,
         // so the order stays out of second order's band 2 ± 0.15, by the
         // tolerance again.

@@ -309,7 +309,13 @@ impl Study {
         }
         Ok(StudyResult {
             case: file.to_string(),
-            title: base.title.clone(),
+            // A case's title describes its own method; a study that swaps
+            // the methods must not carry it onto tables and plots.
+            title: if methods == [own] {
+                base.title.clone()
+            } else {
+                None
+            },
             refinement: self.refinement,
             levels: self.levels,
             methods: methods.iter().map(|m| m.name().to_string()).collect(),

@@ -164,7 +164,8 @@ pub struct Orders {
 pub struct StudyResult {
     /// The case file as named.
     pub case: String,
-    /// The case's title, if it has one.
+    /// The case's title, if it has one and the study runs the case's own
+    /// method (a title describes the case as written, not other methods).
     pub title: Option<String>,
     /// How the meshes of the levels were made.
     pub refinement: Refinement,

@@ -144,9 +144,22 @@ where
     .map_err(draw_error)
 }
 
-/// Axis labels at 1, 2 and 5 × 10ᵏ only: plotters' log axes put key
-/// points at every integer mantissa, and their labels collide inside one
-/// decade.
+/// An integer as Unicode superscript digits (with a superscript minus).
+fn superscript(k: i32) -> String {
+    const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let mut out = String::new();
+    if k < 0 {
+        out.push('⁻');
+    }
+    for c in k.unsigned_abs().to_string().chars() {
+        out.push(DIGITS[c as usize - '0' as usize]);
+    }
+    out
+}
+
+/// Axis labels at 1, 2 and 5 × 10ᵏ only, written as a paper would (10⁻²,
+/// 2·10⁻²): plotters' log axes put key points at every integer mantissa,
+/// and their labels collide inside one decade.
 fn log_label(v: &f64) -> String {
     if !(*v > 0.0 && v.is_finite()) {
         return String::new();
@@ -154,16 +167,47 @@ fn log_label(v: &f64) -> String {
     let exponent = v.log10().floor();
     let mantissa = v / 10f64.powf(exponent);
     let rounded = mantissa.round();
-    if (mantissa - rounded).abs() < 1e-6 && [1.0, 2.0, 5.0].contains(&rounded) {
-        format!("{rounded}e{exponent}")
-    } else if (mantissa - 10.0).abs() < 1e-6 {
-        format!("1e{}", exponent + 1.0)
+    let (mantissa, exponent) = if (mantissa - 10.0).abs() < 1e-6 {
+        (1.0, exponent + 1.0)
+    } else if (mantissa - rounded).abs() < 1e-6 && [1.0, 2.0, 5.0].contains(&rounded) {
+        (rounded, exponent)
     } else {
-        String::new()
+        return String::new();
+    };
+    let power = format!("10{}", superscript(exponent as i32));
+    if mantissa == 1.0 {
+        power
+    } else {
+        format!("{mantissa}·{power}")
+    }
+}
+
+/// How a reference slope is drawn: order 1 dotted, order 2 dashed, so the
+/// two stay apart in print without colour.
+fn reference_dashes(order: f64) -> (u32, u32) {
+    if order < 1.5 {
+        (2, 4)
+    } else {
+        (8, 4)
     }
 }
 
 impl StudyResult {
+    /// The plot's title: the methods compared, after the case's title when
+    /// the study keeps it (its own method), else after the case file's name.
+    fn caption(&self) -> String {
+        let methods = self.methods.join(", ");
+        match &self.title {
+            Some(t) => format!("{t} ({methods})"),
+            None => {
+                let name = std::path::Path::new(&self.case)
+                    .file_name()
+                    .map_or(self.case.clone(), |n| n.to_string_lossy().into_owned());
+                format!("{methods} on {name}")
+            }
+        }
+    }
+
     fn series(&self) -> Vec<Series> {
         let mut out = Vec::new();
         for (i, method) in self.methods.iter().enumerate() {
@@ -223,10 +267,7 @@ impl StudyResult {
         let (width, _) = root.dim_in_pixel();
         let legend_width = 230.min(width / 3);
         let (chart_area, legend_area) = root.split_horizontally(width - legend_width);
-        let title = match &self.title {
-            Some(t) => t.clone(),
-            None => self.case.clone(),
-        };
+        let title = self.caption();
         let mut chart = ChartBuilder::on(&chart_area)
             .caption(title, (FAMILY, 18))
             .margin(12)
@@ -246,15 +287,26 @@ impl StudyResult {
             .draw()
             .map_err(draw_error)?;
         let grey = RGBColor(110, 110, 110);
-        for (_, line) in &references {
+        for (p, line) in &references {
+            let (dash, gap) = reference_dashes(*p);
             chart
                 .draw_series(DashedLineSeries::new(
                     line.iter().copied(),
-                    6,
-                    4,
+                    dash,
+                    gap,
                     grey.stroke_width(1),
                 ))
                 .map_err(draw_error)?;
+            // The slope's name at its fine end, where the lines are apart.
+            if let Some(&(h, e)) = line.last() {
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        format!("h{}", superscript(*p as i32)),
+                        (h, e),
+                        (FAMILY, 13).into_font().color(&grey),
+                    )))
+                    .map_err(draw_error)?;
+            }
         }
         for s in &series {
             chart
@@ -287,19 +339,20 @@ impl StudyResult {
             y += row;
         }
         for (p, _) in &references {
+            let (dash, gap) = reference_dashes(*p);
             let mut x = 8;
             while x < 40 {
                 legend_area
                     .draw(&PathElement::new(
-                        vec![(x, y), ((x + 6).min(40), y)],
+                        vec![(x, y), ((x + dash as i32).min(40), y)],
                         grey.stroke_width(1),
                     ))
                     .map_err(draw_error)?;
-                x += 10;
+                x += (dash + gap) as i32;
             }
             legend_area
                 .draw(&Text::new(
-                    format!("reference slope: order {p:.0}"),
+                    format!("reference slope {p:.0} (h{})", superscript(*p as i32)),
                     (48, y - 7),
                     font.clone(),
                 ))
