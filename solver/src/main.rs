@@ -60,8 +60,9 @@ enum Command {
     /// its centroid; adaptive: the cells holding the fraction θ of the error
     /// indicator; divide-longest-axis / divide-shortest-wall: tissue
     /// division rules), moves the solution to the refined mesh through the
-    /// chain map, and re-solves by conjugate gradients from zero and from
-    /// the transferred solution (the table shows both iteration counts).
+    /// chain map, and re-solves by multigrid-CG from the moved solution,
+    /// the earlier meshes being the coarse levels (the table shows the
+    /// estimator, the errors, the iterations and where CG started).
     /// Options override the case's `[refine]` table. Output: the final mesh.
     ///
     /// Example: hasse refine cases/l-shape-adaptive.toml --steps 4
@@ -558,6 +559,11 @@ fn run_case(
             for step in steps {
                 println!("           {step}");
             }
+            println!("solvers    {}", refinement::solvers_line(steps));
+            println!(
+                "columns    iters: CG iterations; start r: relative residual of the solution moved from the previous mesh, where CG starts"
+            );
+            println!("finest     re-solved with the case's own solver for the output:");
         }
         print!("{result}");
         if let Some(files) = written {

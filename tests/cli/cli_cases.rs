@@ -584,7 +584,8 @@ fn voronoi_virtual_elements() {
 #[test]
 fn refinement_cases_run_as_shipped() {
     // l-shape-adaptive: 8 Dörfler steps. Columns: step, cells, unknowns,
-    // L2, max and gradient errors, CG iterations cold and warm, marked.
+    // estimator, L2, max and gradient errors, CG iterations, start
+    // residual, marked.
     let (stdout, _) = run_case("cases/l-shape-adaptive.toml", &[], "l-shape-adaptive");
     let rows: Vec<Vec<&str>> = stdout
         .lines()
@@ -601,7 +602,7 @@ fn refinement_cases_run_as_shipped() {
         .iter()
         .map(|r| {
             let unknowns: f64 = r[2].parse().unwrap();
-            let gradient: f64 = r[5].parse().unwrap();
+            let gradient: f64 = r[6].parse().unwrap();
             (unknowns.ln(), gradient.ln())
         })
         .unzip();
@@ -615,6 +616,13 @@ fn refinement_cases_run_as_shipped() {
     assert!(
         rate <= -0.5 + 0.075,
         "gradient error ∝ N^{rate:.3}\n{stdout}"
+    );
+    // The summary says which solver ran which level.
+    assert!(
+        stdout.contains(
+            "solvers    step 0: sparse LLᵀ (faer); steps 1–8: multigrid-CG, SPLIT hierarchy"
+        ),
+        "{stdout}"
     );
     // tissue-growth: 50 cells dividing six times, 3150 divisions. Each
     // division cuts a cell by a wall between two points inside two of its

@@ -1,6 +1,7 @@
 //! Re-solving on SPLIT-refined meshes: orders on cut cells, adaptive
-//! against uniform refinement at a corner singularity, warm starts, and
-//! the tissue-division case.
+//! against uniform refinement at a corner singularity, multigrid on the
+//! SPLIT hierarchy with the residual estimator, and the tissue-division
+//! case.
 
 use approx::abs_diff_eq;
 use hasse_solver::frontend::case::Case;
@@ -165,16 +166,81 @@ fn adaptive_refinement_beats_uniform_at_the_corner_singularity() {
         );
     }
 
-    // Warm starts: from the transferred solution CG needs fewer iterations
-    // than from zero on the final refined problems (measured 117→95,
-    // 161→124, 199→152 in the last three steps).
-    for step in &adaptive.steps[6..] {
-        let (cold, warm) = (step.cold_iterations.unwrap(), step.warm_iterations.unwrap());
-        assert!(
-            warm < cold,
-            "step {}: warm {warm} vs cold {cold}",
-            step.step
+    // Every refined level is solved by multigrid-CG on the SPLIT
+    // hierarchy, and the estimator needs no exact solution: it falls with
+    // the gradient error (both at least like N^{−1/2} from step 1 on).
+    assert!(adaptive.steps[1..]
+        .iter()
+        .all(|s| s.solver == "multigrid-CG, SPLIT hierarchy"));
+    let estimator: Vec<f64> = adaptive.steps[1..].iter().map(|s| s.estimator).collect();
+    let rate = slope(&adaptive_n, &estimator);
+    assert!(rate <= -0.5 + 0.075, "estimator ∝ N^{rate:.3}");
+}
+
+#[test]
+fn refined_levels_use_the_split_hierarchy_with_bounded_iterations() {
+    // A source that is not an eigenvector of the Laplacian (u is not a
+    // product of sines), so CG from zero gains nothing from a special
+    // right-hand side. Uniform SPLIT from 16² to 128² cells.
+    let source = "problem.source=\"exp(x) * (1 + 10*y*y)\"";
+    for method in ["fv", "fe"] {
+        let c = case(
+            "poisson-square.toml",
+            &[
+                "mesh.n=[16,16]",
+                source,
+                &format!("problem.method=\"{method}\""),
+            ],
         );
+        let complex = c.build_mesh().unwrap();
+        let spec = RefineSpec {
+            strategy: Strategy::Uniform,
+            steps: 3,
+            ..RefineSpec::default()
+        };
+        let study = refine_case(&c, &complex, &spec, &mut |_| {}).unwrap();
+        assert_eq!(study.steps[0].solver, "sparse LLᵀ (faer)");
+        assert_eq!(study.steps[0].iterations, None);
+        // Levels above the coarse-solve size (4000 unknowns, the multigrid
+        // default) take a handful of V-cycles, independent of h: the
+        // grid-hierarchy counts of benches/README.md are 7–8 (FV) and 5–6
+        // (FE Q1) at these sizes; the SPLIT hierarchy is the same grid
+        // hierarchy, so 10 leaves two iterations of slack.
+        for step in &study.steps[2..] {
+            assert_eq!(step.solver, "multigrid-CG, SPLIT hierarchy");
+            let iterations = step.iterations.unwrap();
+            assert!(
+                iterations <= 10,
+                "{method} step {}: {iterations}",
+                step.step
+            );
+        }
+        // The residual estimator is equivalent to the energy error, O(h)
+        // for a smooth solution: each halving of h halves it (order 1 ±
+        // 0.15, as the orders of the other tests).
+        for pair in study.steps.windows(2) {
+            let p = order(pair[0].estimator, pair[1].estimator);
+            assert!(abs_diff_eq!(p, 1.0, epsilon = 0.15), "{method}: {p}");
+        }
+        // The refined solve is the solution: against a direct solve on the
+        // finest mesh (the case's own solver, run by refine_case for the
+        // output) to the CG tolerance 1e-10 times the condition growth.
+        let u = |fields: &[hasse_solver::frontend::output::Cochain]| {
+            fields
+                .iter()
+                .find(|f| f.name == "u")
+                .unwrap()
+                .values
+                .clone()
+        };
+        let direct = u(&study.result.fields);
+        let multigrid = u(&study.levels.last().unwrap().1);
+        let scale = direct.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let worst = direct
+            .iter()
+            .zip(&multigrid)
+            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+        assert!(worst <= 1e-6 * scale, "{method}: {worst:e} of {scale:e}");
     }
 }
 
