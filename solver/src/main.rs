@@ -132,10 +132,14 @@ enum Command {
     /// orders of convergence.
     ///
     /// For each method and level: the generator's resolution, the mesh size
-    /// h (largest top-cell diameter), unknowns, L² and max errors of the
-    /// solution, the gradient L² error (an energy-norm error; needs
-    /// `exact.gradient`), the face-flux error where the method defines one,
-    /// and seconds. Orders: between consecutive levels, and the
+    /// h (largest top-cell diameter), unknowns, the L² error and the H¹
+    /// (seminorm, energy) error by quadrature of the field each method
+    /// represents (P1/Q1 shape functions, or cell values with their
+    /// reconstructed gradient; the H¹ error needs `exact.gradient`), the
+    /// max error at the unknowns' points, the face-flux error where the
+    /// method defines one, and seconds. `hasse run` also prints the
+    /// sampled figures (L² at the unknowns' points, gradient at the
+    /// centroids), which superconverge on grids. Orders: between consecutive levels, and the
     /// least-squares slope of log e against log h over all levels.
     ///
     /// Refinement `uniform` re-generates the case's mesh with 2^k times its

@@ -165,9 +165,12 @@ pub struct StepReport {
     pub l2: Option<f64>,
     /// Largest pointwise error, when an exact solution was given.
     pub max: Option<f64>,
-    /// L² error of the reconstructed gradient, when an exact gradient was
-    /// given.
+    /// H¹-seminorm error by quadrature, when an exact gradient was given.
     pub gradient_l2: Option<f64>,
+    /// The cell-wise gradient's error sampled at the centroids (see
+    /// [`diffusion::Errors::gradient_sampled`]), when an exact gradient
+    /// was given.
+    pub gradient_sampled: Option<f64>,
     /// CG iterations of the solve (refined steps only: step 0 runs the
     /// problem's own solver, a direct one unless the problem says
     /// otherwise).
@@ -371,6 +374,7 @@ fn report(
         l2: errors.map(|e| e.l2),
         max: errors.map(|e| e.max),
         gradient_l2: errors.map(|e| e.gradient_l2).filter(|g| g.is_finite()),
+        gradient_sampled: errors.map(|e| e.gradient_sampled).filter(|g| g.is_finite()),
         iterations: None,
         start_residual: None,
         seconds,
@@ -534,6 +538,7 @@ pub fn steps_json(steps: &[StepReport]) -> serde_json::Value {
                 "l2": s.l2,
                 "max": s.max,
                 "gradient_l2": s.gradient_l2,
+                "gradient_sampled": s.gradient_sampled,
                 "iterations": s.iterations,
                 "start_residual": s.start_residual,
                 "seconds": s.seconds,

@@ -61,7 +61,7 @@ impl Refinement {
 /// // A nodal method has no face fluxes, and this case no exact gradient.
 /// let present: Vec<&str> = Norm::ALL.iter().filter(|&&n| row.error(n).is_some()).map(|n| n.key()).collect();
 /// assert_eq!(present, ["l2", "max"]);
-/// assert_eq!(Norm::GradientL2.label(), "gradient L²");
+/// assert_eq!(Norm::GradientL2.label(), "H¹ error");
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -96,7 +96,7 @@ impl Norm {
         match self {
             Norm::L2 => "L²",
             Norm::Max => "max",
-            Norm::GradientL2 => "gradient L²",
+            Norm::GradientL2 => "H¹ error",
             Norm::Flux => "flux",
         }
     }
@@ -119,12 +119,13 @@ pub struct StudyRow {
     pub cells: usize,
     /// Unknowns of the solved system.
     pub unknowns: usize,
-    /// Discrete L² error of the primary field (see
+    /// L² error of the method's field, by quadrature on each cell (see
     /// [`Errors::l2`](crate::physics::diffusion::Errors::l2)).
     pub l2: f64,
-    /// Largest pointwise error of the primary field.
+    /// Largest error at the unknowns' points.
     pub max: f64,
-    /// Gradient L² error, when the case gives the exact gradient.
+    /// H¹-seminorm error ‖∇u_h − ∇u‖ by quadrature, when the case gives
+    /// the exact gradient.
     pub gradient_l2: Option<f64>,
     /// Face-flux L² error, where the method defines it.
     pub flux: Option<f64>,

@@ -56,7 +56,7 @@ impl StudyResult {
         }
         writeln!(
             f,
-            "study    {} level{}, {} refinement; h = largest top-cell diameter; p = observed order (from the previous level; least squares over all levels)",
+            "study    {} level{}, {} refinement; h = largest top-cell diameter; p = observed order (from the previous level; least squares over all levels); L² and H¹ error by quadrature of each method's field, max at the unknowns' points",
             self.levels,
             if self.levels == 1 { "" } else { "s" },
             self.refinement.name()
@@ -82,7 +82,7 @@ impl StudyResult {
         let norm_title = |n: Norm| match n {
             Norm::L2 => "L² error",
             Norm::Max => "max error",
-            Norm::GradientL2 => "gradient L²",
+            Norm::GradientL2 => "H¹ error",
             Norm::Flux => "flux error",
         };
         write!(

@@ -169,11 +169,7 @@ pub(super) fn solve(
                         .with_description(format!("u_{axis} − exact")),
                 );
             }
-            Some(Errors {
-                l2,
-                max,
-                gradient_l2: f64::NAN,
-            })
+            Some(Errors::sampled(l2, max))
         }
         None => None,
     };

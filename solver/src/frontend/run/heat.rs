@@ -190,11 +190,9 @@ pub(super) fn solve_streaming<'a>(
 
     phase("post-processing");
     let post = Instant::now();
-    let errors = level_errors.last().map(|&(_, l2, max)| Errors {
-        l2,
-        max,
-        gradient_l2: f64::NAN,
-    });
+    let errors = level_errors
+        .last()
+        .map(|&(_, l2, max)| Errors::sampled(l2, max));
     let fields = series.last().map(|(_, f)| f.clone()).unwrap_or_default();
     let mut report = serde_json::Map::new();
     report.insert("time".into(), time_json(spec, &history));

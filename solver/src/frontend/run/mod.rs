@@ -264,7 +264,27 @@ impl fmt::Display for RunResult {
             if e.gradient_l2.is_finite() {
                 write!(f, ", gradient L2 {:.6e}", e.gradient_l2)?;
             }
-            writeln!(f)?;
+            if e.quadrature {
+                writeln!(
+                    f,
+                    " (L2 norms by quadrature of the method's field, max at the unknowns' points)"
+                )?;
+                write!(
+                    f,
+                    "sampled    L2 {:.6e} at the unknowns' points",
+                    e.l2_sampled
+                )?;
+                if e.gradient_sampled.is_finite() {
+                    write!(
+                        f,
+                        ", gradient L2 {:.6e} at the centroids",
+                        e.gradient_sampled
+                    )?;
+                }
+                writeln!(f)?;
+            } else {
+                writeln!(f, " (at the unknowns' points)")?;
+            }
         }
         if let Some(q) = self.flux_error {
             writeln!(f, "flux error L2 {q:.6e}")?;
@@ -296,6 +316,9 @@ impl RunResult {
                 "l2": e.l2,
                 "max": e.max,
                 "gradient_l2": e.gradient_l2.is_finite().then_some(e.gradient_l2),
+                "by_quadrature": e.quadrature,
+                "l2_sampled": e.l2_sampled,
+                "gradient_sampled": e.gradient_sampled.is_finite().then_some(e.gradient_sampled),
             })
         });
         let timings: serde_json::Map<String, serde_json::Value> = self

@@ -187,6 +187,12 @@ impl<'a> Topology<'a> {
         })
     }
 
+    /// [`Topology::tensor_order`] with its own scratch space.
+    pub(super) fn element_order(&self, c: usize) -> Option<Vec<usize>> {
+        self.tensor_order(c, &mut Vec::new(), &mut Q1Memo::default())
+            .map(|order| order.to_vec())
+    }
+
     /// Local vertex positions of a quadrilateral or hexahedron in tensor
     /// order (bit a of the index = side along local axis a), recovered from
     /// its edge graph; `None` when the graph is not a square or a cube.
