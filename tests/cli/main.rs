@@ -19,6 +19,7 @@ mod case_docs;
 mod cli_cases;
 mod cli_check;
 mod cli_info;
+mod cli_input;
 mod cli_output;
 mod cli_physics;
 mod fuzz_regressions;

@@ -409,12 +409,14 @@ impl MeshSpec {
             "rectangle" => grid(2),
             "box" => grid(3),
             "annulus" => {
+                // n = [angular, radial] (cases/README.md); the generator
+                // takes the radial count first.
                 let n = self.counts(2, key).map_err(Generated::Key)?;
                 generate::annulus(
                     need(self.inner_radius, "inner_radius")?,
                     need(self.outer_radius, "outer_radius")?,
-                    n[0],
                     n[1],
+                    n[0],
                 )
                 .map_err(Generated::Complex)
             }
@@ -691,4 +693,36 @@ fn duplicate_vertices(complex: &Complex) -> Result<(), MeshDefect> {
 enum Generated {
     Key(MeshError),
     Complex(hasse_complex::ComplexError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn annulus(n: [usize; 2]) -> Result<Complex, MeshError> {
+        MeshSpec {
+            generator: Some("annulus".into()),
+            n: Some(n.to_vec()),
+            inner_radius: Some(0.5),
+            outer_radius: Some(1.0),
+            ..MeshSpec::default()
+        }
+        .build(Path::new("annulus.toml"))
+    }
+
+    /// `n = [angular, radial]` as cases/README.md documents it. By hand,
+    /// for a sectors and r rings of quads: a(r + 1) vertices on r + 1
+    /// circles, a·r radial edges plus a(r + 1) circular edges, a·r quads.
+    #[test]
+    fn annulus_reads_n_as_angular_then_radial() {
+        let k = annulus([16, 4]).unwrap();
+        assert_eq!(k.cell_counts(), vec![16 * 5, 16 * 4 + 16 * 5, 16 * 4]);
+        assert_eq!(k.cell_counts(), vec![80, 144, 64]);
+        // Each of the two boundary circles has one edge per sector.
+        assert_eq!(k.tag("inner").unwrap().cells.len(), 16);
+        assert_eq!(k.tag("outer").unwrap().cells.len(), 16);
+        // Two rings are a valid annulus (two sectors would not be).
+        assert_eq!(annulus([16, 2]).unwrap().cell_counts(), vec![48, 80, 32]);
+        assert!(annulus([2, 16]).is_err());
+    }
 }
