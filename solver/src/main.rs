@@ -242,11 +242,9 @@ fn main() -> ExitCode {
                 set.push(format!("refine.theta={t:?}"));
             }
             let case_path = case;
-            let case = match read_case(&case_path, &set) {
-                Ok(case) => case,
-                Err(code) => return code,
-            };
-            if case.refine.is_none() {
+            // Errors and warnings of the case are reported once, by run_case.
+            let no_refine = Case::read(&case_path, &set).is_ok_and(|case| case.refine.is_none());
+            if no_refine {
                 eprintln!(
                     "error: {}: no [refine] table: add one (strategy, steps) or pass --steps N",
                     case_path.display()
@@ -301,13 +299,17 @@ fn main() -> ExitCode {
 }
 
 fn read_case(path: &Path, set: &[String]) -> Result<Case, ExitCode> {
-    Case::read(path, set).map_err(|e| {
+    let case = Case::read(path, set).map_err(|e| {
         match e {
             CaseError::Invalid(diagnostics) => eprintln!("{diagnostics}"),
             other => eprintln!("error: {other}"),
         }
         ExitCode::from(EXIT_BAD_INPUT)
-    })
+    })?;
+    for warning in &case.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(case)
 }
 
 fn check_case(path: &Path, set: &[String]) -> ExitCode {
@@ -328,6 +330,9 @@ fn check_case(path: &Path, set: &[String]) -> ExitCode {
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     };
+    for warning in &case.warnings {
+        eprintln!("warning: {warning}");
+    }
     match case.build_mesh() {
         Ok(complex) => {
             // The data where the solve evaluates them: coefficients and

@@ -55,3 +55,61 @@ fn annulus_n_is_angular_then_radial() {
     assert!(out.status.success(), "{}", text(&out));
     assert!(text(&out).contains("[48, 80, 32]"), "{}", text(&out));
 }
+
+/// The documented comparison of cases/l-shape-adaptive.toml: the file's
+/// `theta` is for its adaptive strategy; with the strategy switched on the
+/// command line it is unused (a warning), not an error. A `theta` with a
+/// non-adaptive strategy from one source is still refused.
+#[test]
+fn a_files_theta_under_a_strategy_from_the_command_line_warns() {
+    let dir = crate::scratch::Scratch::new("theta-uniform");
+    std::fs::create_dir_all(&*dir).unwrap();
+    std::os::unix::fs::symlink(root().join("cases"), dir.join("cases")).unwrap();
+    let case = "cases/l-shape-adaptive.toml";
+    for args in [
+        vec!["check", case, "--set", "refine.strategy=uniform"],
+        vec![
+            "run",
+            case,
+            "--set",
+            "refine.strategy=uniform",
+            "--set",
+            "refine.steps=1",
+        ],
+        vec!["refine", case, "--strategy", "uniform", "--steps", "1"],
+    ] {
+        let out = hasse_in(&dir, &args);
+        let all = text(&out);
+        assert!(out.status.success(), "{args:?}: {all}");
+        assert_eq!(
+            all.matches("warning: cases/l-shape-adaptive.toml:35:1: `refine.theta`: unused")
+                .count(),
+            1,
+            "{args:?}: {all}"
+        );
+    }
+    // Both from the command line: a contradiction.
+    let out = hasse_in(
+        &dir,
+        &[
+            "check",
+            case,
+            "--set",
+            "refine.strategy=uniform",
+            "--set",
+            "refine.theta=0.3",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(text(&out).contains("only the adaptive strategy marks cells"));
+    // Both in the file: the same.
+    let file = dir.join("both.toml");
+    let adaptive = std::fs::read_to_string(root().join(case)).unwrap();
+    let both = adaptive
+        .replace("strategy = \"adaptive\"", "strategy = \"uniform\"")
+        .replace("l-shape.msh", "cases/l-shape.msh");
+    std::fs::write(&file, both).unwrap();
+    let out = hasse_in(&dir, &["check", "both.toml"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(text(&out).contains("both.toml:35:1: `refine.theta`: only the adaptive strategy"));
+}

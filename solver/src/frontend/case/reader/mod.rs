@@ -188,6 +188,7 @@ impl Reader {
                 solver,
                 output,
                 refine,
+                warnings: reader.collector.warnings.clone(),
                 collector: reader.collector,
                 mesh_spans,
             }),
