@@ -22,5 +22,6 @@ mod cli_info;
 mod cli_input;
 mod cli_output;
 mod cli_physics;
+mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
