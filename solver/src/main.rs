@@ -203,11 +203,14 @@ fn load_timed(path: &Path, timing: bool) -> Result<hasse_complex::Complex, mesh_
 }
 
 fn load(path: &Path) -> Result<hasse_complex::Complex, mesh_spec::MeshError> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("msh") => Ok(hasse_complex::gmsh::read_msh(path)?),
-        Some("json") => Ok(hasse_complex::json::read_json(path)?),
-        _ => mesh_spec::read_case_mesh(path)?.build(path),
-    }
+    let mut complex = match path.extension().and_then(|e| e.to_str()) {
+        Some("msh") => hasse_complex::gmsh::read_msh(path)?,
+        Some("json") => hasse_complex::json::read_json(path)?,
+        _ => return mesh_spec::read_case_mesh(path)?.build(path),
+    };
+    // As a case file's mesh would have it.
+    mesh_spec::tag_boundary(&mut complex);
+    Ok(complex)
 }
 
 fn main() -> ExitCode {
