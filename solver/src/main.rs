@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use hasse_solver::frontend::case::{Case, CaseError};
-use hasse_solver::frontend::{info, mesh_spec, run};
+use hasse_solver::frontend::{info, mesh_spec, output, run};
 use hasse_solver::refine as refinement;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -336,6 +336,14 @@ fn check_case(path: &Path, set: &[String]) -> ExitCode {
     for warning in &case.warnings {
         eprintln!("warning: {warning}");
     }
+    // Where `hasse run` would write (without -o): refused here as there.
+    if case.output.write {
+        let stem = case.output.directory.join(&case.output.name);
+        if let Err(code) = check_output_place(path, &stem) {
+            eprintln!("{}: 1 problem found", path.display());
+            return code;
+        }
+    }
     match case.build_mesh() {
         Ok(complex) => {
             // The data where the solve evaluates them: coefficients and
@@ -436,13 +444,8 @@ fn run_case(
         .map(Path::to_path_buf)
         .unwrap_or_else(|| case.output.directory.join(&case.output.name));
     if case.output.write || output.is_some() {
-        if let Err(e) = hasse_solver::frontend::output::check_writable(&stem) {
-            eprintln!(
-                "error: {}: output {}: {e}\n    help: choose a writable place with -o DIR/NAME or [output] directory",
-                path.display(),
-                stem.display()
-            );
-            return ExitCode::from(EXIT_BAD_INPUT);
+        if let Err(code) = prepare_output(path, &stem) {
+            return code;
         }
     }
     let progress = Progress::new(quiet, verbose);
@@ -572,6 +575,33 @@ fn run_case(
         }
     }
     ExitCode::SUCCESS
+}
+
+/// Refuse an output place that cannot take the output, before solving:
+/// the stem, the files and the directory it names ([`output::check_place`]).
+fn check_output_place(case_path: &Path, stem: &Path) -> Result<output::OutputPlace, ExitCode> {
+    output::check_place(stem).map_err(|e| output_refused(case_path, stem, e))
+}
+
+fn output_refused(case_path: &Path, stem: &Path, e: output::OutputError) -> ExitCode {
+    eprintln!(
+        "error: {}: output {}: {e}\n    help: choose a writable place with -o DIR/NAME (run, refine) or [output] directory and name",
+        case_path.display(),
+        stem.display()
+    );
+    ExitCode::from(EXIT_BAD_INPUT)
+}
+
+/// Check the output place, create its directory if missing (saying so),
+/// and probe that a file can be written there.
+fn prepare_output(case_path: &Path, stem: &Path) -> Result<(), ExitCode> {
+    let place = check_output_place(case_path, stem)?;
+    output::check_writable(stem).map_err(|e| output_refused(case_path, stem, e))?;
+    if let Some(first) = place.missing {
+        let dir = stem.parent().unwrap_or(&first);
+        eprintln!("note: created the output directory {}", dir.display());
+    }
+    Ok(())
 }
 
 fn complex_kind(complex: &hasse_complex::Complex) -> String {

@@ -182,3 +182,54 @@ fn a_files_theta_under_a_strategy_from_the_command_line_warns() {
     assert_eq!(out.status.code(), Some(2), "{}", text(&out));
     assert!(text(&out).contains("both.toml:35:1: `refine.theta`: only the adaptive strategy"));
 }
+
+/// Output places are checked before solving, by `run` and by `check`: an
+/// output file whose name is taken by a directory is refused with exit 2
+/// and nothing solved; a missing output directory is created and `run`
+/// says so.
+#[test]
+fn output_places_are_checked_before_solving() {
+    let dir = crate::scratch::Scratch::new("output-places");
+    std::fs::create_dir_all(&*dir).unwrap();
+    let case = format!(
+        "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n\n{POISSON}\n[output]\nname = \"taken\"\n"
+    );
+    std::fs::write(dir.join("c.toml"), case).unwrap();
+    for taken in ["taken.h5", "taken.xdmf", "taken.edges.xdmf"] {
+        std::fs::create_dir_all(dir.join(taken)).unwrap();
+        for command in ["check", "run"] {
+            let out = hasse_in(&dir, &[command, "c.toml"]);
+            let all = text(&out);
+            assert_eq!(out.status.code(), Some(2), "{command} with {taken}: {all}");
+            assert!(
+                all.contains(&format!("{taken}: a directory is in the way")),
+                "{command}: {all}"
+            );
+            assert!(all.contains("help: choose a writable place"), "{all}");
+            // Refused before the solve: no summary.
+            assert!(!all.contains("unknowns"), "{all}");
+        }
+        std::fs::remove_dir(dir.join(taken)).unwrap();
+    }
+    // -o into directories that do not exist: created, and said.
+    let out = hasse_in(&dir, &["run", "c.toml", "-o", "new/deeper/x"]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("created the output directory new/deeper"),
+        "{}",
+        text(&out)
+    );
+    assert!(dir.join("new/deeper/x.h5").exists());
+    // `check` creates nothing.
+    let out = hasse_in(
+        &dir,
+        &[
+            "check",
+            "c.toml",
+            "--set",
+            "output.directory=\"other/place\"",
+        ],
+    );
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(!dir.join("other").exists());
+}
