@@ -282,6 +282,21 @@ const CATALOGUE: &[Bad] = &[
         line: None,
         says: &["the matrix is singular (a zero pivot)", "Check the boundary conditions and coefficients"],
     },
+    // ---- time
+    Bad {
+        set: &[],
+        file: "time-cannot-advance",
+        exit: 2,
+        line: Some(19),
+        says: &["`time.dt`: time.start + time.dt = time.start in floating point (start = 1e0, dt = 1e-300)"],
+    },
+    Bad {
+        set: &[],
+        file: "time-levels-repeat",
+        exit: 2,
+        line: Some(21),
+        says: &["`time.dt`: the saved levels after step 1 and step 2 both have time 1.0000000000000002e0"],
+    },
     // ---- output
     Bad {
         set: &[],
