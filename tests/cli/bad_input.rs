@@ -291,6 +291,22 @@ const CATALOGUE: &[Bad] = &[
         line: Some(9),
         says: &["`problem.conductivity`: `nan` is not a finite number", "help: give a finite value"],
     },
+    // (b) A bad coordinate names its node, and no cells.
+    Bad {
+        set: &[],
+        file: "mesh-nonfinite-vertex",
+        exit: 2,
+        line: Some(4),
+        says: &["vertex 2 has a non-finite coordinate NaN on axis 0", "(vertex 2 is Gmsh node 3)"],
+    },
+    // (c) A repeated element is a duplicate, named by its element tags.
+    Bad {
+        set: &[],
+        file: "mesh-duplicate-element",
+        exit: 2,
+        line: Some(4),
+        says: &["element 3 duplicates element 1"],
+    },
     // (d) A 198 002-character source: about 80 characters around the
     // unclosed `(` (character 198 001, the file's last but one), with a caret.
     Bad {
@@ -333,6 +349,8 @@ const CATALOGUE: &[Bad] = &[
 /// fault is a node, the library's value names instead of the case keys,
 /// the whole of a 200 kB expression.
 const NEVER: &[(&str, &[&str])] = &[
+    ("mesh-nonfinite-vertex", &["inverted", "overlapping"]),
+    ("mesh-duplicate-element", &["overlap"]),
     ("nan-conductivity-literal", &["unknown variable"]),
     (
         "long-expression",
