@@ -320,6 +320,14 @@ const CATALOGUE: &[Bad] = &[
             " + x*y + (x\n",
         ],
     },
+    // (e) The case keys, not the library's value names.
+    Bad {
+        set: &[],
+        file: "maxwell-zero-star",
+        exit: 2,
+        line: Some(11),
+        says: &["⋆1 of 1-cell 2 is 0e0 ≤ 0", "`mass = \"whitney\"`", "`method = \"dec-barycentric\"`"],
+    },
     // ---- time
     Bad {
         set: &[],
@@ -352,6 +360,7 @@ const NEVER: &[(&str, &[&str])] = &[
     ("mesh-nonfinite-vertex", &["inverted", "overlapping"]),
     ("mesh-duplicate-element", &["overlap"]),
     ("nan-conductivity-literal", &["unknown variable"]),
+    ("maxwell-zero-star", &["Mass::"]),
     (
         "long-expression",
         &["x*y + x*y + x*y + x*y + x*y + x*y + x*y + x*y + x*y + x*y + x*y + x*y + x*y + x*y"],
@@ -463,6 +472,7 @@ fn check_finds_what_needs_no_solve() {
         "disconnected",
         "incompatible-neumann",
         "singular-system",
+        "maxwell-zero-star",
     ];
     for bad in CATALOGUE {
         let file = format!("tests/bad-input/{}.toml", bad.file);
