@@ -328,6 +328,14 @@ const CATALOGUE: &[Bad] = &[
         line: Some(11),
         says: &["⋆1 of 1-cell 2 is 0e0 ≤ 0", "`mass = \"whitney\"`", "`method = \"dec-barycentric\"`"],
     },
+    // (f) A negative constant permeability.
+    Bad {
+        set: &[],
+        file: "negative-permeability",
+        exit: 2,
+        line: Some(13),
+        says: &["`problem.permeability`: coefficient in top cell 0 is not symmetric positive definite"],
+    },
     // ---- time
     Bad {
         set: &[],
