@@ -547,9 +547,8 @@ pub struct OutputPlace {
 /// solved and without creating anything: the stem must name files
 /// (UTF-8, no `:`), the nearest existing directory on its way must be a
 /// directory, `<stem>.h5` and every `<stem>[.<grid>].xdmf` must not be
-/// directories (they are written to a temporary name and renamed over),
-/// and `<stem>.partial` (a transient run's completed levels) must not be
-/// a file. Whether a directory is writable is found by
+/// directories (they are written to a temporary name and renamed over).
+/// Whether a directory is writable is found by
 /// [`check_writable`], which creates it.
 ///
 /// ```
@@ -607,13 +606,8 @@ pub fn check_place(stem: &Path) -> Result<OutputPlace, OutputError> {
             });
         }
     }
-    let partial = dir.join(format!("{file_name}.partial"));
-    if partial.exists() && !partial.is_dir() {
-        return Err(OutputError::Place {
-            path: partial,
-            reason: "a file is in the way of the directory of completed time levels".into(),
-        });
-    }
+    // A file in the way of `<stem>.partial` only costs the partial output
+    // of a transient run (a warning), not the run.
     Ok(OutputPlace { missing })
 }
 
