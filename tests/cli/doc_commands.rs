@@ -1,5 +1,6 @@
 //! Every `hasse …` command line the documentation prints runs as printed:
-//! the lines of the `sh` code blocks of `README.md` and `cases/README.md`,
+//! the lines of the code blocks (but Rust's) of `README.md` and
+//! `cases/README.md` that start with `hasse` and a subcommand,
 //! the `hasse …` commands in the comments of `cases/*.toml`, and the
 //! examples of `hasse --help` and of each subcommand's help.
 //!
@@ -115,14 +116,21 @@ fn documented() -> Vec<(String, String)> {
     let mut found = Vec::new();
     for doc in ["README.md", "cases/README.md"] {
         let text = std::fs::read_to_string(root().join(doc)).unwrap();
-        let mut in_sh = false;
+        // Any code block but Rust's: a line that starts with `hasse` and a
+        // subcommand.
+        let mut in_block = false;
+        let mut rust = false;
         for (i, line) in text.lines().enumerate() {
             if let Some(fence) = line.trim_start().strip_prefix("```") {
-                in_sh = !in_sh && fence.trim() == "sh";
+                in_block = !in_block;
+                rust = fence.trim().starts_with("rust");
                 continue;
             }
-            if in_sh && line.trim_start().starts_with("hasse ") {
-                found.push((format!("{doc}:{}", i + 1), line.trim().to_string()));
+            let command = line.trim_start();
+            if in_block && !rust && command.starts_with("hasse ") {
+                if let Some(command) = command_in(command) {
+                    found.push((format!("{doc}:{}", i + 1), command));
+                }
             }
         }
     }
