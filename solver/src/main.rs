@@ -2,7 +2,7 @@
 
 use clap::{Parser, Subcommand};
 use hasse_solver::frontend::case::{Case, CaseError};
-use hasse_solver::frontend::{info, mesh_spec, run};
+use hasse_solver::frontend::{info, mesh_spec, output, run};
 use hasse_solver::refine as refinement;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -216,11 +216,14 @@ fn load_timed(path: &Path, timing: bool) -> Result<hasse_complex::Complex, mesh_
 }
 
 fn load(path: &Path) -> Result<hasse_complex::Complex, mesh_spec::MeshError> {
-    match path.extension().and_then(|e| e.to_str()) {
-        Some("msh") => Ok(hasse_complex::gmsh::read_msh(path)?),
-        Some("json") => Ok(hasse_complex::json::read_json(path)?),
-        _ => mesh_spec::read_case_mesh(path)?.build(path),
-    }
+    let mut complex = match path.extension().and_then(|e| e.to_str()) {
+        Some("msh") => hasse_complex::gmsh::read_msh(path)?,
+        Some("json") => hasse_complex::json::read_json(path)?,
+        _ => return mesh_spec::read_case_mesh(path)?.build(path),
+    };
+    // As a case file's mesh would have it.
+    mesh_spec::tag_boundary(&mut complex);
+    Ok(complex)
 }
 
 fn main() -> ExitCode {
@@ -255,11 +258,9 @@ fn main() -> ExitCode {
                 set.push(format!("refine.theta={t:?}"));
             }
             let case_path = case;
-            let case = match read_case(&case_path, &set) {
-                Ok(case) => case,
-                Err(code) => return code,
-            };
-            if case.refine.is_none() {
+            // Errors and warnings of the case are reported once, by run_case.
+            let no_refine = Case::read(&case_path, &set).is_ok_and(|case| case.refine.is_none());
+            if no_refine {
                 eprintln!(
                     "error: {}: no [refine] table: add one (strategy, steps) or pass --steps N",
                     case_path.display()
@@ -314,13 +315,17 @@ fn main() -> ExitCode {
 }
 
 fn read_case(path: &Path, set: &[String]) -> Result<Case, ExitCode> {
-    Case::read(path, set).map_err(|e| {
+    let case = Case::read(path, set).map_err(|e| {
         match e {
             CaseError::Invalid(diagnostics) => eprintln!("{diagnostics}"),
             other => eprintln!("error: {other}"),
         }
         ExitCode::from(EXIT_BAD_INPUT)
-    })
+    })?;
+    for warning in &case.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(case)
 }
 
 fn check_case(path: &Path, set: &[String]) -> ExitCode {
@@ -341,6 +346,17 @@ fn check_case(path: &Path, set: &[String]) -> ExitCode {
             return ExitCode::from(EXIT_BAD_INPUT);
         }
     };
+    for warning in &case.warnings {
+        eprintln!("warning: {warning}");
+    }
+    // Where `hasse run` would write (without -o): refused here as there.
+    if case.output.write {
+        let stem = case.output.directory.join(&case.output.name);
+        if let Err(code) = check_output_place(path, &stem) {
+            eprintln!("{}: 1 problem found", path.display());
+            return code;
+        }
+    }
     match case.build_mesh() {
         Ok(complex) => {
             // The data where the solve evaluates them: coefficients and
@@ -441,13 +457,8 @@ fn run_case(
         .map(Path::to_path_buf)
         .unwrap_or_else(|| case.output.directory.join(&case.output.name));
     if case.output.write || output.is_some() {
-        if let Err(e) = hasse_solver::frontend::output::check_writable(&stem) {
-            eprintln!(
-                "error: {}: output {}: {e}\n    help: choose a writable place with -o DIR/NAME or [output] directory",
-                path.display(),
-                stem.display()
-            );
-            return ExitCode::from(EXIT_BAD_INPUT);
+        if let Err(code) = prepare_output(path, &stem) {
+            return code;
         }
     }
     let progress = Progress::new(quiet, verbose);
@@ -582,6 +593,33 @@ fn run_case(
         }
     }
     ExitCode::SUCCESS
+}
+
+/// Refuse an output place that cannot take the output, before solving:
+/// the stem, the files and the directory it names ([`output::check_place`]).
+fn check_output_place(case_path: &Path, stem: &Path) -> Result<output::OutputPlace, ExitCode> {
+    output::check_place(stem).map_err(|e| output_refused(case_path, stem, e))
+}
+
+fn output_refused(case_path: &Path, stem: &Path, e: output::OutputError) -> ExitCode {
+    eprintln!(
+        "error: {}: output {}: {e}\n    help: choose a writable place with -o DIR/NAME (run, refine) or [output] directory and name",
+        case_path.display(),
+        stem.display()
+    );
+    ExitCode::from(EXIT_BAD_INPUT)
+}
+
+/// Check the output place, create its directory if missing (saying so),
+/// and probe that a file can be written there.
+fn prepare_output(case_path: &Path, stem: &Path) -> Result<(), ExitCode> {
+    let place = check_output_place(case_path, stem)?;
+    output::check_writable(stem).map_err(|e| output_refused(case_path, stem, e))?;
+    if let Some(first) = place.missing {
+        let dir = stem.parent().unwrap_or(&first);
+        eprintln!("note: created the output directory {}", dir.display());
+    }
+    Ok(())
 }
 
 fn complex_kind(complex: &hasse_complex::Complex) -> String {

@@ -15,6 +15,7 @@
 //! | [`grid`], [`interval`], [`rectangle`], [`box3`] | segments / quads / hexes | `xmin` … `zmax`, `boundary` |
 //! | [`kuhn`] | segments / triangles / tetrahedra | as [`grid`] |
 //! | [`delaunay`] | triangles | `boundary` |
+//! | [`delaunay_rectangle`] | triangles (random points in a rectangle) | `xmin` … `ymax`, `boundary` |
 //! | [`voronoi`] | convex polygons (clipped Voronoi cells of random sites) | `xmin` … `ymax`, `boundary` |
 //! | [`annulus`] | quads | `inner`, `outer`, `boundary` |
 //! | [`torus`], [`sphere`] | closed quad / triangle surfaces in R^3 | none (no boundary) |
@@ -36,7 +37,7 @@ mod perturb;
 mod surfaces;
 mod voronoi;
 
-pub use delaunay::delaunay;
+pub use delaunay::{delaunay, delaunay_rectangle};
 pub use grid::{box3, graded_axis, grid, hollow_box, interval, kuhn, rectangle, uniform_axis};
 pub use perturb::perturb;
 pub use surfaces::{annulus, sphere, torus};

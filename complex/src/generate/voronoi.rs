@@ -116,7 +116,7 @@ pub fn voronoi_with_sites(
 
 /// A uniform draw from the open interval (lo, hi): a site on the boundary
 /// would coincide with its own mirror image.
-fn open(rng: &mut ChaCha8Rng, [lo, hi]: [f64; 2]) -> f64 {
+pub(super) fn open(rng: &mut ChaCha8Rng, [lo, hi]: [f64; 2]) -> f64 {
     loop {
         let t: f64 = rng.gen_range(lo..hi);
         if t > lo {

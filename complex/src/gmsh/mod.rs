@@ -87,6 +87,14 @@ pub enum GmshError {
         dim: usize,
         group: String,
     },
+    #[error("'{}': element {element} duplicates element {first} (the same nodes, listed twice); remove one of them (Gmsh: Coherence Mesh) or remesh", path.display())]
+    DuplicateElement {
+        path: PathBuf,
+        /// The later element's tag.
+        element: u64,
+        /// The tag of the element it repeats.
+        first: u64,
+    },
     #[error("'{}' contains no mesh: {hint}", path.display())]
     Empty { path: PathBuf, hint: String },
     #[error("'{}': the elements do not form a valid cell complex: {source}{hint}", path.display())]
@@ -109,6 +117,7 @@ impl GmshError {
             | Self::UnsupportedElement { path, .. }
             | Self::MissingNode { path, .. }
             | Self::NotACell { path, .. }
+            | Self::DuplicateElement { path, .. }
             | Self::Empty { path, .. }
             | Self::Complex { path, .. } => path,
         }
@@ -359,10 +368,12 @@ fn read(bytes: &[u8], path: &Path) -> Result<Complex, GmshError> {
     }
     let mut new_id = vec![usize::MAX; coords.len()];
     let mut kept = Vec::new();
+    let mut kept_tags = Vec::new();
     for (i, &u) in used.iter().enumerate() {
         if u {
             new_id[i] = kept.len();
             kept.push(coords[i]);
+            kept_tags.push(tags[i]);
         }
     }
     let renumber = |nodes: &[u64]| -> Option<Vec<usize>> {
@@ -374,9 +385,22 @@ fn read(bytes: &[u8], path: &Path) -> Result<Complex, GmshError> {
 
     let mut cells = TopCells::default();
     let mut top_tags = Vec::new();
+    // A top element listed twice would otherwise be reported as two
+    // overlapping cells.
+    let mut seen: HashMap<Vec<u64>, u64> = HashMap::new();
     for (block, kind) in elements.element_blocks.iter().zip(&kinds) {
         if kind.dim() == n {
             for e in &block.elements {
+                let mut key = e.nodes.clone();
+                key.sort_unstable();
+                if let Some(&first) = seen.get(&key) {
+                    return Err(GmshError::DuplicateElement {
+                        path: path.to_path_buf(),
+                        element: e.element_tag,
+                        first,
+                    });
+                }
+                seen.insert(key, e.element_tag);
                 // Every node of a top element exists (checked above) and is kept.
                 let v = renumber(&e.nodes).ok_or_else(|| {
                     parse_error(
@@ -402,7 +426,7 @@ fn read(bytes: &[u8], path: &Path) -> Result<Complex, GmshError> {
     .max(n);
     let flat: Vec<f64> = kept.iter().flat_map(|p| p[..d].to_vec()).collect();
     let complex_error = |source: ComplexError| {
-        let hint = complex_error_hint(&source, n, &top_tags);
+        let hint = complex_error_hint(&source, n, &top_tags, &kept_tags);
         GmshError::Complex {
             path: path.to_path_buf(),
             source,
@@ -499,7 +523,20 @@ fn read(bytes: &[u8], path: &Path) -> Result<Complex, GmshError> {
 }
 
 /// Points a complex-building error at the Gmsh element it came from.
-fn complex_error_hint(error: &ComplexError, n: usize, top_tags: &[u64]) -> String {
+fn complex_error_hint(
+    error: &ComplexError,
+    n: usize,
+    top_tags: &[u64],
+    node_tags: &[u64],
+) -> String {
+    // A bad coordinate is the node's, not an element's: no hint about
+    // cells.
+    if let ComplexError::NonFiniteCoordinate { vertex, .. } = error {
+        return match node_tags.get(*vertex) {
+            Some(t) => format!(" (vertex {vertex} is Gmsh node {t})"),
+            None => String::new(),
+        };
+    }
     let cell = match error {
         ComplexError::VertexOutOfRange { cell, .. }
         | ComplexError::RepeatedVertex { cell, .. }

@@ -162,8 +162,13 @@ fn uniform_overrides(
     let n = mesh.n.as_ref().ok_or_else(|| {
         refuse("mesh.n is missing: uniform refinement multiplies the case's n".into())
     })?;
-    // A voronoi n counts sites in the plane: 4× the sites halve h.
-    let factor = if generator == "voronoi" { 4 } else { 2 };
+    // A voronoi or delaunay n counts points in the plane: 4× the points
+    // halve h.
+    let factor = if matches!(generator, "voronoi" | "delaunay") {
+        4
+    } else {
+        2
+    };
     let refined = n
         .iter()
         .map(|&c| scale(c, factor))

@@ -3,7 +3,7 @@
 //!
 //! ```toml
 //! [mesh]
-//! generator = "rectangle"   # interval | rectangle | box | annulus | torus | sphere | hollow-box | voronoi
+//! generator = "rectangle"   # interval | rectangle | box | annulus | torus | sphere | hollow-box | voronoi | delaunay
 //! n = [32, 32]              # cells per axis
 //! x = [0.0, 1.0]            # extent per axis (default [0, 1])
 //! y = [0.0, 1.0]
@@ -23,11 +23,26 @@
 //! seed = 3                  # site positions (default 0)
 //! lloyd = 5                 # optional, default 0
 //! ```
+//! or a Delaunay triangulation of `n` random points in the rectangle
+//! (seeded) and of points along its sides at about their spacing:
+//! ```toml
+//! [mesh]
+//! generator = "delaunay"
+//! n = [500]                 # interior points
+//! x = [0.0, 1.0]
+//! y = [0.0, 1.0]
+//! seed = 3                  # point positions (default 0)
+//! ```
 //! or
 //! ```toml
 //! [mesh]
 //! file = "l-shape.msh"
 //! ```
+//!
+//! Every mesh with a boundary, generated or read (also a Gmsh file without
+//! physical groups), has a `boundary` tag on the (n−1)-cells of its
+//! boundary; a physical group named `boundary` takes precedence. Closed
+//! surfaces (torus, sphere) have none.
 
 use hasse_complex::{generate, gmsh, json, Complex};
 use serde::Deserialize;
@@ -119,7 +134,7 @@ pub struct MeshSpec {
     /// Move interior vertices randomly by up to this fraction of the local
     /// mesh size (default 0).
     pub perturb: Option<f64>,
-    /// Seed of the perturbation, or of the Voronoi sites.
+    /// Seed of the perturbation, or of the Voronoi sites / Delaunay points.
     pub seed: Option<u64>,
     /// Lloyd iterations of the Voronoi generator.
     pub lloyd: Option<usize>,
@@ -280,12 +295,15 @@ impl MeshSpec {
             })?
             }
         };
-        match self.perturb {
+        let mut complex = match self.perturb {
             Some(amplitude) if amplitude != 0.0 => {
-                generate::perturb(&complex, amplitude, self.seed.unwrap_or(0)).map_err(complex_err)
+                generate::perturb(&complex, amplitude, self.seed.unwrap_or(0))
+                    .map_err(complex_err)?
             }
-            _ => Ok(complex),
-        }
+            _ => complex,
+        };
+        tag_boundary(&mut complex);
+        Ok(complex)
     }
 
     /// A lower bound on what a generated mesh costs, from its parameters
@@ -305,6 +323,8 @@ impl MeshSpec {
             ("box", [a, b, c]) if simplex => (6.0 * a * b * c, 26.0 / 6.0, 3, "n"),
             ("box", [a, b, c]) => (a * b * c, 8.0, 3, "n"),
             ("voronoi", [a]) => (*a, 6.0, 2, "n"),
+            // About 2 triangles per point, 1 + 3 + 2 cells per point.
+            ("delaunay", [a]) => (2.0 * a, 3.0, 2, "n"),
             ("sphere", _) => (
                 20.0 * 4f64.powi(self.subdivisions.unwrap_or(2).min(64) as i32),
                 3.0,
@@ -409,12 +429,14 @@ impl MeshSpec {
             "rectangle" => grid(2),
             "box" => grid(3),
             "annulus" => {
+                // n = [angular, radial] (cases/README.md); the generator
+                // takes the radial count first.
                 let n = self.counts(2, key).map_err(Generated::Key)?;
                 generate::annulus(
                     need(self.inner_radius, "inner_radius")?,
                     need(self.outer_radius, "outer_radius")?,
-                    n[0],
                     n[1],
+                    n[0],
                 )
                 .map_err(Generated::Complex)
             }
@@ -443,7 +465,7 @@ impl MeshSpec {
                 })?;
                 generate::hollow_box(n[0], cavity).map_err(Generated::Complex)
             }
-            "voronoi" => {
+            "voronoi" | "delaunay" => {
                 let n = self.counts(1, key).map_err(Generated::Key)?;
                 let extent = |e: Option<[f64; 2]>, k: &'static str| {
                     let [lo, hi] = e.unwrap_or([0.0, 1.0]);
@@ -455,22 +477,64 @@ impl MeshSpec {
                     }
                     Ok([lo, hi])
                 };
-                generate::voronoi(
-                    n[0],
-                    extent(self.x, "x")?,
-                    extent(self.y, "y")?,
-                    self.seed.unwrap_or(0),
-                    self.lloyd.unwrap_or(0),
-                )
+                let (x, y) = (extent(self.x, "x")?, extent(self.y, "y")?);
+                let seed = self.seed.unwrap_or(0);
+                if name == "voronoi" {
+                    generate::voronoi(n[0], x, y, seed, self.lloyd.unwrap_or(0))
+                } else if self.lloyd.is_some() {
+                    return Err(Generated::Key(key(
+                        "lloyd",
+                        "Lloyd smoothing is for generator = \"voronoi\"; remove it".into(),
+                    )));
+                } else {
+                    generate::delaunay_rectangle(n[0], x, y, seed)
+                }
                 .map_err(Generated::Complex)
             }
             other => Err(Generated::Key(key(
                 "generator",
                 format!(
-                    "unknown generator \"{other}\"; known: interval, rectangle, box, annulus, torus, sphere, hollow-box, voronoi"
+                    "unknown generator \"{other}\"; known: interval, rectangle, box, annulus, torus, sphere, hollow-box, voronoi, delaunay"
                 ),
             ))),
         }
+    }
+}
+
+/// Give `complex` the tag `boundary` (the (n−1)-cells on exactly one top
+/// cell, the top cells of its boundary subcomplex) when it has none and
+/// its boundary is not empty, so that boundary conditions on `boundary`
+/// work on every mesh: a Gmsh file without physical groups has no tags at
+/// all. An existing `boundary` tag (a physical group of that name) is
+/// kept.
+///
+/// ```
+/// use hasse_complex::{Complex, TopCells, Vertices};
+/// use hasse_solver::frontend::mesh_spec::tag_boundary;
+/// // Two triangles of the unit square, built without tags: the four sides
+/// // are the boundary, the diagonal is not.
+/// let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]]).unwrap();
+/// let mut k = Complex::build(v, TopCells::simplices([[0, 1, 2], [0, 2, 3]])).unwrap();
+/// assert!(k.tag("boundary").is_none());
+/// tag_boundary(&mut k);
+/// let tag = k.tag("boundary").unwrap();
+/// assert_eq!((tag.dim, tag.cells.len()), (1, 4));
+/// ```
+pub fn tag_boundary(complex: &mut Complex) {
+    let n = complex.dim();
+    if n == 0 || complex.tag("boundary").is_some() {
+        return;
+    }
+    let facets: Vec<usize> = complex
+        .boundary(n)
+        .outer_iterator()
+        .enumerate()
+        .filter(|(_, row)| row.nnz() == 1)
+        .map(|(i, _)| i)
+        .collect();
+    if !facets.is_empty() {
+        // The dimension is in range and the facets are rows of ∂_n.
+        let _ = complex.set_tag("boundary", n - 1, facets);
     }
 }
 
@@ -691,4 +755,36 @@ fn duplicate_vertices(complex: &Complex) -> Result<(), MeshDefect> {
 enum Generated {
     Key(MeshError),
     Complex(hasse_complex::ComplexError),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn annulus(n: [usize; 2]) -> Result<Complex, MeshError> {
+        MeshSpec {
+            generator: Some("annulus".into()),
+            n: Some(n.to_vec()),
+            inner_radius: Some(0.5),
+            outer_radius: Some(1.0),
+            ..MeshSpec::default()
+        }
+        .build(Path::new("annulus.toml"))
+    }
+
+    /// `n = [angular, radial]` as cases/README.md documents it. By hand,
+    /// for a sectors and r rings of quads: a(r + 1) vertices on r + 1
+    /// circles, a·r radial edges plus a(r + 1) circular edges, a·r quads.
+    #[test]
+    fn annulus_reads_n_as_angular_then_radial() {
+        let k = annulus([16, 4]).unwrap();
+        assert_eq!(k.cell_counts(), vec![16 * 5, 16 * 4 + 16 * 5, 16 * 4]);
+        assert_eq!(k.cell_counts(), vec![80, 144, 64]);
+        // Each of the two boundary circles has one edge per sector.
+        assert_eq!(k.tag("inner").unwrap().cells.len(), 16);
+        assert_eq!(k.tag("outer").unwrap().cells.len(), 16);
+        // Two rings are a valid annulus (two sectors would not be).
+        assert_eq!(annulus([16, 2]).unwrap().cell_counts(), vec![48, 80, 32]);
+        assert!(annulus([2, 16]).is_err());
+    }
 }

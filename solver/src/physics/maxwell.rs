@@ -269,7 +269,7 @@ impl Cavity {
                         cell: e,
                         value: star1[e],
                         what: "mass M",
-                        hint: " or the Whitney mass (Mass::Whitney)",
+                        hint: " or the Whitney mass",
                     });
                 }
                 BlockMetric::diagonal(&star1)

@@ -93,3 +93,11 @@ msh(
     [(0, 0, 0), (1, 0, 0), (0.5, 1, 0), (0.5, -1, 0), (0.5, 2, 0)],
     (2, [[1, 2, 3], [1, 2, 4], [1, 2, 5]]),
 )
+
+# Node 3's x coordinate is not a number: the message names the node, not
+# the cells.
+msh("nonfinite-vertex.msh", [(0, 0, 0), (1, 0, 0), (math.nan, 1, 0), (0, 1, 0)], (2, [[1, 2, 3], [1, 3, 4]]))
+
+# Element 3 repeats element 1 (same nodes): a duplicate, not an overlap.
+msh("duplicate-element.msh", square, (2, [[1, 2, 3], [1, 3, 4], [1, 2, 3]]))
+

@@ -120,6 +120,9 @@ pub(crate) struct Collector {
     /// (filled while reading, through a shared reference).
     spans: std::cell::RefCell<std::collections::BTreeMap<String, Range<usize>>>,
     pub diagnostics: Vec<Diagnostic>,
+    /// Things that do not stop the case but that the user should know
+    /// (a key the overrides made unused).
+    pub warnings: Vec<Diagnostic>,
 }
 
 impl Collector {
@@ -134,6 +137,7 @@ impl Collector {
             overrides: Vec::new(),
             spans: Default::default(),
             diagnostics: Vec::new(),
+            warnings: Vec::new(),
         }
     }
 
@@ -156,6 +160,12 @@ impl Collector {
     /// Where key `key` is written, if the reader saw it.
     pub(crate) fn span_of(&self, key: &str) -> Option<Range<usize>> {
         self.spans.borrow().get(key).cloned()
+    }
+
+    /// Whether `key` (or a table above it) was given by a `--set`
+    /// assignment rather than by the file.
+    pub(crate) fn is_set(&self, key: &str) -> bool {
+        self.set_text(key).is_some()
     }
 
     /// The `--set` assignment that gave `key` (or a table above it) its
@@ -216,6 +226,18 @@ impl Collector {
     ) {
         let diagnostic = self.diagnostic(span, key, message, help);
         self.diagnostics.push(diagnostic);
+    }
+
+    /// Record a warning at `span`: printed, but the case still runs.
+    pub fn warning(
+        &mut self,
+        span: Option<Range<usize>>,
+        key: &str,
+        message: impl Into<String>,
+        help: Option<String>,
+    ) {
+        let diagnostic = self.diagnostic(span, key, message, help);
+        self.warnings.push(diagnostic);
     }
 }
 

@@ -225,6 +225,10 @@ pub struct Case {
     pub output: OutputSpec,
     /// SPLIT refinement steps after the first solve, if any.
     pub refine: Option<crate::refine::RefineSpec>,
+    /// What reading found worth saying that does not stop the case (a
+    /// key left unused by a `--set` override), each with its position;
+    /// `hasse check`, `run` and `refine` print them as `warning: …`.
+    pub warnings: Vec<Diagnostic>,
     /// Keeps spans for messages found after reading (mesh problems).
     collector: Collector,
     mesh_spans: BTreeMap<String, Range<usize>>,

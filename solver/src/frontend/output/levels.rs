@@ -171,7 +171,7 @@ impl<'a> Levels<'a> {
 }
 
 /// Every name a lower-degree grid file can have (see `xdmf::grid_name`).
-const LOWER_GRID_NAMES: [&str; 2] = ["edges", "faces"];
+pub(super) const LOWER_GRID_NAMES: [&str; 2] = ["edges", "faces"];
 
 pub(super) fn validate(levels: &Levels) -> Result<(), OutputError> {
     if levels.meshes.is_empty() {

@@ -383,6 +383,15 @@ pub enum OutputError {
         /// The dimension of step 0's complex.
         expected: usize,
     },
+    /// An output file's place is taken by something that is not a file
+    /// (a directory), or the output directory's place by a file.
+    #[error("{}: {reason}", path.display())]
+    Place {
+        /// The path that is taken.
+        path: PathBuf,
+        /// What is there instead, and what to do.
+        reason: String,
+    },
     /// The output stem cannot name the output files.
     #[error("output stem '{path}': {reason}")]
     Stem {
@@ -521,6 +530,85 @@ pub fn check_writable(stem: &Path) -> Result<(), OutputError> {
     let probe = dir.join(format!(".hasse-probe.tmp-{}", std::process::id()));
     std::fs::write(&probe, b"").map_err(io(&dir))?;
     std::fs::remove_file(&probe).map_err(io(&probe))
+}
+
+/// Where the output of `stem` would go, found without writing anything:
+/// the directories that do not exist yet (the writer creates them, the
+/// nearest existing one first).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OutputPlace {
+    /// The first directory on the way to the stem's that does not exist
+    /// (creating it creates the ones below too); `None` when the stem's
+    /// directory exists.
+    pub missing: Option<PathBuf>,
+}
+
+/// Check every path the output under `stem` can take, before anything is
+/// solved and without creating anything: the stem must name files
+/// (UTF-8, no `:`), the nearest existing directory on its way must be a
+/// directory, `<stem>.h5` and every `<stem>[.<grid>].xdmf` must not be
+/// directories (they are written to a temporary name and renamed over).
+/// Whether a directory is writable is found by
+/// [`check_writable`], which creates it.
+///
+/// ```
+/// use hasse_solver::frontend::output::check_place;
+/// let dir = std::env::temp_dir().join(format!("hasse-doc-place-{}", std::process::id()));
+/// std::fs::create_dir_all(dir.join("run.h5")).unwrap();
+/// // `run.h5` is a directory: the output could not be renamed into place.
+/// let error = check_place(&dir.join("run")).unwrap_err();
+/// assert!(error.to_string().contains("run.h5: a directory is in the way"));
+/// // A stem under directories that do not exist names the first of them.
+/// let place = check_place(&dir.join("a/b/run")).unwrap();
+/// assert_eq!(place.missing, Some(dir.join("a")));
+/// assert!(!dir.join("a").exists());
+/// std::fs::remove_dir_all(&dir).unwrap();
+/// ```
+pub fn check_place(stem: &Path) -> Result<OutputPlace, OutputError> {
+    let (dir, file_name) = split_stem(stem)?;
+    let mut missing = None;
+    let mut existing = dir.as_path();
+    loop {
+        match std::fs::metadata(existing) {
+            Ok(meta) if meta.is_dir() => break,
+            Ok(_) => {
+                return Err(OutputError::Place {
+                    path: existing.to_path_buf(),
+                    reason: "a file is in the way of the output directory: Not a directory".into(),
+                })
+            }
+            Err(_) => {
+                missing = Some(existing.to_path_buf());
+                match existing.parent() {
+                    Some(parent) if !parent.as_os_str().is_empty() => existing = parent,
+                    _ => break,
+                }
+            }
+        }
+    }
+    if missing.is_some() {
+        return Ok(OutputPlace { missing });
+    }
+    let mut files = vec![
+        dir.join(format!("{file_name}.h5")),
+        dir.join(format!("{file_name}.xdmf")),
+    ];
+    files.extend(
+        levels::LOWER_GRID_NAMES
+            .iter()
+            .map(|grid| dir.join(format!("{file_name}.{grid}.xdmf"))),
+    );
+    for file in files {
+        if file.is_dir() {
+            return Err(OutputError::Place {
+                path: file,
+                reason: "a directory is in the way of this output file".into(),
+            });
+        }
+    }
+    // A file in the way of `<stem>.partial` only costs the partial output
+    // of a transient run (a warning), not the run.
+    Ok(OutputPlace { missing })
 }
 
 /// The directory of `stem` (`.` when it has none) and its file name, which

@@ -372,7 +372,11 @@ pub(super) fn check(case: &Case, spec: &DarcySpec, complex: &Complex) -> Result<
     if n == 0 || n != complex.embedding_dim() {
         return Ok(());
     }
-    tensors(case, &spec.permeability, complex)?;
+    // Positive definite as the assembly will demand: a negative constant
+    // permeability is refused here, not after `hasse check` said ok.
+    let permeability = tensors(case, &spec.permeability, complex)?;
+    crate::metric::check_tensors(&permeability, complex.cell_count(n), n)
+        .map_err(|e| run_error(case, DarcyError::Metric(e)))?;
     let source = darcy::cell_integrals(complex, |x| spec.source.eval(x, 0.0));
     if let Some(c) = source.iter().position(|v| !v.is_finite()) {
         return Err(source_error(case, complex, c, source[c]));

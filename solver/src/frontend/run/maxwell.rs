@@ -26,9 +26,16 @@ fn run_error(case: &Case, e: MaxwellError) -> RunError {
         | MaxwellError::Eigen(EigenError::Solve(_))
         | MaxwellError::Eigen(EigenError::Dense(_))
         | MaxwellError::DependentGradients(_) => RunError::solve(case, message, None),
-        MaxwellError::NonPositiveStar { .. } => {
-            RunError::input_at(case, "problem.method", message, None)
-        }
+        // The library names its own values; the help names the case keys.
+        MaxwellError::NonPositiveStar { .. } => RunError::input_at(
+            case,
+            "problem.method",
+            message,
+            Some(
+                "set `method = \"dec-barycentric\"`, or `mass = \"whitney\"` (simplices) under [problem]"
+                    .into(),
+            ),
+        ),
         _ => RunError::input(case, message),
     };
     located.because(e)

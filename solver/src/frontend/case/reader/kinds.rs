@@ -242,13 +242,58 @@ impl Reader {
                 }
             },
         };
-        Some(TimeSpec {
+        let time = TimeSpec {
             dt: dt?,
             steps: steps?,
             start: start?,
             theta: theta?,
             save_every: save_every?,
-        })
+        };
+        self.time_advances(table, &time).then_some(time)
+    }
+
+    /// Whether every saved time t₀ + k·dt is a distinct floating-point
+    /// number, as the run computes them; refuses (naming `time.dt` and
+    /// `time.start`) a step too small to move t₀, or levels whose times
+    /// round to the same number.
+    fn time_advances(&mut self, table: &dyn TableLike, time: &TimeSpec) -> bool {
+        let span = self.entry(table, "time", "dt").and_then(|e| e.span());
+        let (start, dt) = (time.start, time.dt);
+        let help = Some(
+            "give a larger time.dt, or a time.start nearer 0 (floating-point numbers near t have a spacing of about 2.2e-16 × |t|)"
+                .into(),
+        );
+        if start + dt == start {
+            self.error(
+                span,
+                "time.dt",
+                format!(
+                    "time.start + time.dt = time.start in floating point (start = {start:e}, dt = {dt:e}): time cannot advance"
+                ),
+                help,
+            );
+            return false;
+        }
+        let saved = (1..=time.steps)
+            .filter(|&k| k == time.steps || (time.save_every > 0 && k % time.save_every == 0));
+        let mut previous = (0, start);
+        for k in saved {
+            let t = start + k as f64 * dt;
+            if t <= previous.1 {
+                self.error(
+                    span,
+                    "time.dt",
+                    format!(
+                        "the saved levels after step {} and step {k} both have time {t:e} in floating point (time.start = {start:e}, time.dt = {dt:e}): the steps are too small to tell their times apart",
+                        previous.0
+                    ),
+                    help,
+                );
+                return false;
+            }
+            previous = (k, t);
+        }
+        true
     }
 
     /// `steps`, or `end` turned into a whole number of steps of `dt`.

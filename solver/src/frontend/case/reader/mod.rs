@@ -188,6 +188,7 @@ impl Reader {
                 solver,
                 output,
                 refine,
+                warnings: reader.collector.warnings.clone(),
                 collector: reader.collector,
                 mesh_spans,
             }),
@@ -296,6 +297,22 @@ impl Reader {
     ) -> Option<Expression> {
         let text = match item.as_value() {
             Some(Value::String(s)) => s.value().clone(),
+            // TOML's nan and inf are numbers, but not values a coefficient
+            // can take; said as such rather than as an unknown name `NaN`.
+            Some(Value::Float(f)) if !f.value().is_finite() => {
+                let written = match *f.value() {
+                    v if v.is_nan() => "nan",
+                    v if v > 0.0 => "inf",
+                    _ => "-inf",
+                };
+                self.error(
+                    span,
+                    name,
+                    format!("`{written}` is not a finite number"),
+                    Some("give a finite value".into()),
+                );
+                return None;
+            }
             Some(Value::Float(f)) => format_number(*f.value()),
             Some(Value::Integer(i)) => i.value().to_string(),
             _ => {
@@ -316,7 +333,10 @@ impl Reader {
                 self.error(
                     span,
                     name,
-                    format!("`{text}` evaluates to {}", e.eval(&[], 0.0)),
+                    {
+                        let (head, tail) = super::expr::quote(&text, None);
+                        format!("{head} evaluates to {}{tail}", e.eval(&[], 0.0))
+                    },
                     Some(
                         "give a finite value (check square roots, logarithms and divisions)".into(),
                     ),

@@ -336,12 +336,33 @@ impl Reader {
             let span = self
                 .entry(table, "refine", "theta")
                 .and_then(|e| e.key_span.clone());
-            self.error(
-                span,
-                "refine.theta",
-                "only the adaptive strategy marks cells",
-                None,
-            );
+            // A θ written in the file for its adaptive strategy is left
+            // unused, not wrong, when the command line chose another
+            // strategy (`--set refine.strategy=uniform`, `--strategy
+            // uniform`): the file still reads as written. A θ and a
+            // non-adaptive strategy from the same source contradict.
+            let strategy_from_command_line =
+                self.collector.is_set("refine.strategy") && !self.collector.is_set("refine.theta");
+            if strategy_from_command_line {
+                let strategy = self
+                    .string_at(table, "refine", "strategy")
+                    .unwrap_or_default();
+                self.collector.warning(
+                    span,
+                    "refine.theta",
+                    format!(
+                        "unused: the command line sets strategy \"{strategy}\", and only the adaptive strategy marks cells"
+                    ),
+                    None,
+                );
+            } else {
+                self.error(
+                    span,
+                    "refine.theta",
+                    "only the adaptive strategy marks cells",
+                    Some("remove `theta`, or set `strategy = \"adaptive\"`".into()),
+                );
+            }
         }
         match self.entry(table, "refine", "steps") {
             Some(e) => match e.item.as_integer() {
