@@ -23,3 +23,4 @@ mod cli_output;
 mod cli_physics;
 mod fuzz_regressions;
 mod interrupted_output;
+mod method_warnings;

@@ -44,6 +44,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod consistency;
 mod coupled;
 mod darcy;
 mod diffusion;
