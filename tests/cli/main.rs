@@ -21,6 +21,7 @@ mod cli_check;
 mod cli_info;
 mod cli_output;
 mod cli_physics;
+mod darcy_reports;
 mod fuzz_regressions;
 mod interrupted_output;
 mod method_warnings;
