@@ -736,6 +736,30 @@ fn bad_problem_kind_input_names_the_key() {
         2,
         &["`boundary[0].alpha`", "may not depend on t"],
     );
+    // The conductivity is refused as α is (issue 30, item 5): it used to be
+    // evaluated at t = 0 and frozen, even with time.start ≠ 0. Scalar and
+    // tensor forms; the error points at the key (line 9, column 16).
+    refused(
+        "conductivity-in-time",
+        &HEAT.replace(
+            "initial = \"x\"",
+            "initial = \"x\"\nconductivity = \"1 + t\"",
+        ),
+        2,
+        &[
+            "conductivity-in-time.toml:9:16: `problem.conductivity`",
+            "may not depend on t",
+        ],
+    );
+    refused(
+        "tensor-in-time",
+        &HEAT.replace(
+            "initial = \"x\"",
+            "initial = \"x\"\nconductivity = [[1, 0], [0, \"exp(-t)\"]]",
+        ),
+        2,
+        &["`problem.conductivity`", "may not depend on t"],
+    );
     refused(
         "kind",
         &HEAT.replace("\"heat\"", "\"maxwel\""),

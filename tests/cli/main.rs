@@ -22,6 +22,8 @@ mod cli_info;
 mod cli_input;
 mod cli_output;
 mod cli_physics;
+mod darcy_reports;
 mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
+mod method_warnings;

@@ -187,6 +187,175 @@ pub fn load(
     Ok(star.iter().zip(values).map(|(s, x)| s * x).collect())
 }
 
+/// Largest ‖K_eff − I‖₂ (at an interior vertex) that
+/// [`worst_effective_conductivity`] accepts as consistent.
+///
+/// Where the diagonal star is consistent (uniform and graded box grids,
+/// equilateral triangles, with either dual) K_eff = I holds exactly, and
+/// the computed K_eff differs from I by the rounding of a few dozen
+/// products of coordinates: below 1e-13 on unit-sized meshes with up to
+/// 10⁶ cells per side. A deviation above 1e-6 is geometry, not rounding,
+/// and it is an error in the coefficient that does not shrink with h: the
+/// solution converges to that of −∇·(K_eff∇u) = f, off by about
+/// ‖K_eff − I‖ relative. At 1e-6 that error matches the O(h²) error of a
+/// consistent second-order method at h = 10⁻³ (the finest shipped case,
+/// 10⁶ cells), so anything above it is a loss of accuracy a user would see.
+pub const EFFECTIVE_CONDUCTIVITY_TOLERANCE: f64 = 1e-6;
+
+/// The effective conductivity of the diagonal Hodge star at one vertex
+/// (see [`effective_conductivity`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VertexConductivity {
+    /// The vertex.
+    pub vertex: usize,
+    /// Its coordinates.
+    pub point: Vec<f64>,
+    /// K_eff (the leading d×d block; the rest is zero).
+    pub tensor: Tensor,
+    /// ‖K_eff − I‖₂: the largest |eigenvalue − 1|.
+    pub deviation: f64,
+}
+
+/// The effective conductivity of the unit-coefficient diagonal star ⋆₁ of
+/// the `kind` dual at every vertex,
+///
+/// ```text
+///     K_eff(v) = Σ_{e ∋ v} ω_e d_e d_eᵀ / (2 |⋆v|),     ω_e = |⋆e| / |e|,
+/// ```
+///
+/// d_e the edge vector. It is the coefficient the nodal operator
+/// δ⁰ᵀ ⋆₁ δ⁰ / ⋆₀ applies to a quadratic u at v: with Σ_e ω_e d_e = 0,
+/// Σ_e ω_e (u_w − u_v) / |⋆v| = tr(K_eff ∇²u). It is also the constant
+/// field's energy Σ ω_e (g·d_e)² per unit dual volume, which is what makes
+/// ⋆₁ a consistent mass for Maxwell. A consistent star has K_eff = I.
+///
+/// Right (Kuhn) triangles with the barycentric dual have
+/// K_eff = [[(1 + √5)/3, 1/3], [1/3, (1 + √5)/3]] ≈ [[1.079, 0.333],
+/// [0.333, 1.079]] at every interior vertex: the axis edges get
+/// ω = 2·(√5/6) (the centroid is √5/6 of a side from the middle of a leg)
+/// and the diagonals ω = 2·(√2/6)/√2 = 1/3, and |⋆v| = h².
+///
+/// Empty when the complex does not fill its space (n < d: a surface has
+/// no d×d identity to compare with). Errors: those of the dual measures.
+///
+/// ```
+/// use hasse_complex::{dual::DualKind, generate::{kuhn, uniform_axis}};
+/// use hasse_solver::metric::dec;
+/// let x = uniform_axis(2, 0.0, 1.0).unwrap();
+/// let k = kuhn(&[x.clone(), x]).unwrap();
+/// let centre = dec::effective_conductivity(&k, DualKind::Barycentric).unwrap()[4];
+/// let diagonal = (1.0 + 5f64.sqrt()) / 3.0;
+/// assert!((centre[0][0] - diagonal).abs() < 1e-14 && (centre[0][1] - 1.0 / 3.0).abs() < 1e-14);
+/// // The circumcentric dual of the same mesh is the P1 stiffness: K_eff = I.
+/// let centre = dec::effective_conductivity(&k, DualKind::Circumcentric).unwrap()[4];
+/// assert!((centre[0][0] - 1.0).abs() < 1e-14 && centre[0][1].abs() < 1e-14);
+/// ```
+pub fn effective_conductivity(
+    complex: &Complex,
+    kind: DualKind,
+) -> Result<Vec<Tensor>, MetricError> {
+    let d = complex.embedding_dim();
+    if complex.dim() != d || d == 0 {
+        return Ok(Vec::new());
+    }
+    let star = complex.hodge_star(kind, 1)?;
+    let volume = complex.dual_measure(kind, 0)?;
+    let vertices = complex.vertices();
+    let mut sums: Vec<Tensor> = vec![[[0.0; 3]; 3]; complex.cell_count(0)];
+    for (e, omega) in star.iter().enumerate() {
+        let ends = complex.cell_vertices(1, e);
+        let [a, b] = ends else { continue };
+        let (xa, xb) = (vertices.point(*a), vertices.point(*b));
+        for v in [*a, *b] {
+            for i in 0..d {
+                for j in 0..d {
+                    sums[v][i][j] += omega * (xb[i] - xa[i]) * (xb[j] - xa[j]);
+                }
+            }
+        }
+    }
+    for (sum, dual) in sums.iter_mut().zip(volume) {
+        for row in sum.iter_mut().take(d) {
+            for x in row.iter_mut().take(d) {
+                *x /= 2.0 * dual;
+            }
+        }
+    }
+    Ok(sums)
+}
+
+/// The interior vertex whose [`effective_conductivity`] is farthest from
+/// I (largest ‖K_eff − I‖₂, the first such vertex on ties), or `None`
+/// when there is no interior vertex or the complex does not fill its
+/// space.
+///
+/// Boundary vertices are left out: their dual cell is a wedge, and there
+/// even a consistent star has K_eff ≠ I (at a 120° corner of equilateral
+/// triangles, where both duals are the P1 stiffness, its eigenvalues are
+/// 1.25 and 0.75), so they say nothing about the method.
+///
+/// ```
+/// use hasse_complex::{dual::DualKind, generate::{kuhn, rectangle, uniform_axis}};
+/// use hasse_solver::metric::dec;
+/// let grid = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let worst = dec::worst_effective_conductivity(&grid, DualKind::Barycentric).unwrap().unwrap();
+/// assert!(worst.deviation < 1e-14);
+/// let x = uniform_axis(4, 0.0, 1.0).unwrap();
+/// let kuhn = kuhn(&[x.clone(), x]).unwrap();
+/// let worst = dec::worst_effective_conductivity(&kuhn, DualKind::Barycentric).unwrap().unwrap();
+/// // Eigenvalues (2 + √5)/3 and √5/3: ‖K_eff − I‖ = (√5 − 1)/3.
+/// assert!((worst.deviation - (5f64.sqrt() - 1.0) / 3.0).abs() < 1e-14);
+/// assert!(worst.deviation > dec::EFFECTIVE_CONDUCTIVITY_TOLERANCE);
+/// ```
+pub fn worst_effective_conductivity(
+    complex: &Complex,
+    kind: DualKind,
+) -> Result<Option<VertexConductivity>, MetricError> {
+    let tensors = effective_conductivity(complex, kind)?;
+    if tensors.is_empty() {
+        return Ok(None);
+    }
+    let d = complex.embedding_dim();
+    let wall = complex.boundary_subcomplex();
+    let mut worst: Option<VertexConductivity> = None;
+    for (v, tensor) in tensors.into_iter().enumerate() {
+        if wall.contains(0, v) {
+            continue;
+        }
+        let deviation = identity_distance(&tensor, d);
+        // NaN (a vanishing dual cell) counts as the worst.
+        let worse = match &worst {
+            None => true,
+            Some(w) => deviation > w.deviation || (deviation.is_nan() && !w.deviation.is_nan()),
+        };
+        if worse {
+            worst = Some(VertexConductivity {
+                vertex: v,
+                point: complex.vertices().point(v).to_vec(),
+                tensor,
+                deviation,
+            });
+        }
+    }
+    Ok(worst)
+}
+
+/// ‖T − I‖₂ over the leading d×d block of a symmetric T.
+fn identity_distance(t: &Tensor, d: usize) -> f64 {
+    let mut m = nalgebra::Matrix3::<f64>::zeros();
+    for i in 0..d {
+        for j in 0..d {
+            m[(i, j)] = t[i][j] - if i == j { 1.0 } else { 0.0 };
+        }
+    }
+    if m.iter().any(|x| !x.is_finite()) {
+        return f64::NAN;
+    }
+    m.symmetric_eigenvalues()
+        .iter()
+        .fold(0.0f64, |w, x| w.max(x.abs()))
+}
+
 /// λ when the leading d×d block of `t` is λI.
 fn isotropic_value(t: &Tensor, d: usize) -> Option<f64> {
     let lambda = t[0][0];
@@ -459,6 +628,105 @@ mod tests {
                 "{t}: {w} vs {expected}"
             );
         }
+    }
+
+    /// Eigenvalues of the leading 2×2 block of a symmetric tensor.
+    fn eigenvalues_2d(t: &Tensor) -> [f64; 2] {
+        let (a, b, c) = (t[0][0], t[0][1], t[1][1]);
+        let r = (0.25 * (a - c).powi(2) + b * b).sqrt();
+        [0.5 * (a + c) - r, 0.5 * (a + c) + r]
+    }
+
+    #[test]
+    fn effective_conductivity_of_kuhn_triangles_is_the_hand_computed_tensor() {
+        // Issue 30, item 4. Right triangles of side h = 1/4 with the
+        // barycentric dual (see `effective_conductivity`): interior vertices
+        // K = [[(1+√5)/3, 1/3], [1/3, (1+√5)/3]]. At the corner (0, 0) two
+        // legs of one triangle each (ω = √5/6) and the shared diagonal
+        // (ω = 1/3), |⋆v| = 2·(h²/2)/3 = h²/3:
+        // K = [[½ + √5/4, ½], [½, ½ + √5/4]]. Entries are sums of at most
+        // six products of O(1) terms, so 1e-14 is a few dozen ulps.
+        let x = hasse_complex::generate::uniform_axis(4, 0.0, 1.0).unwrap();
+        let k = hasse_complex::generate::kuhn(&[x.clone(), x]).unwrap();
+        let tensors = effective_conductivity(&k, DualKind::Barycentric).unwrap();
+        let r5 = 5f64.sqrt();
+        let wall = k.boundary_subcomplex();
+        for (v, t) in tensors.iter().enumerate() {
+            if wall.contains(0, v) {
+                continue;
+            }
+            approx::assert_abs_diff_eq!(t[0][0], (1.0 + r5) / 3.0, epsilon = 1e-14);
+            approx::assert_abs_diff_eq!(t[1][1], (1.0 + r5) / 3.0, epsilon = 1e-14);
+            approx::assert_abs_diff_eq!(t[0][1], 1.0 / 3.0, epsilon = 1e-14);
+            approx::assert_abs_diff_eq!(t[1][0], 1.0 / 3.0, epsilon = 1e-14);
+        }
+        let corner = &tensors[0];
+        approx::assert_abs_diff_eq!(corner[0][0], 0.5 + r5 / 4.0, epsilon = 1e-14);
+        approx::assert_abs_diff_eq!(corner[0][1], 0.5, epsilon = 1e-14);
+        // The worst interior vertex: eigenvalues (2+√5)/3 and √5/3.
+        let worst = worst_effective_conductivity(&k, DualKind::Barycentric)
+            .unwrap()
+            .unwrap();
+        approx::assert_abs_diff_eq!(worst.deviation, (r5 - 1.0) / 3.0, epsilon = 1e-14);
+        assert!(!wall.contains(0, worst.vertex));
+        assert_eq!(worst.point, k.vertices().point(worst.vertex));
+    }
+
+    #[test]
+    fn effective_conductivity_is_the_identity_where_the_star_is_consistent() {
+        // Rounding only: K_eff = I exactly in these geometries, computed
+        // from a few dozen products of unit-sized numbers, so 1e-13 (far
+        // below EFFECTIVE_CONDUCTIVITY_TOLERANCE) bounds it.
+        let graded = hasse_complex::generate::graded_axis(6, 0.0, 1.0, 1.3).unwrap();
+        let even = hasse_complex::generate::uniform_axis(5, -1.0, 2.0).unwrap();
+        let grids = [
+            hasse_complex::generate::rectangle(6, 4, [0.0, 3.0], [0.0, 1.0]).unwrap(),
+            hasse_complex::generate::grid(&[graded.clone(), even.clone()]).unwrap(),
+            hasse_complex::generate::grid(&[graded, even.clone(), even]).unwrap(),
+        ];
+        for (i, k) in grids.iter().enumerate() {
+            let worst = worst_effective_conductivity(k, DualKind::Barycentric)
+                .unwrap()
+                .unwrap();
+            assert!(worst.deviation < 1e-13, "grid {i}: {worst:?}");
+        }
+        // Equilateral triangles (a hexagon of side 2): the barycentric and
+        // circumcentric duals coincide and interior vertices see six
+        // edges 60° apart, Σ d dᵀ ∝ I.
+        let s = 3f64.sqrt() / 2.0;
+        let mut points = Vec::new();
+        for i in -2i32..=2 {
+            for j in -2i32..=2 {
+                if (i + j).abs() <= 2 {
+                    points.push([f64::from(i) + 0.5 * f64::from(j), s * f64::from(j)]);
+                }
+            }
+        }
+        let hexagon = hasse_complex::generate::delaunay(&points).unwrap();
+        assert_eq!(hexagon.cell_count(2), 24);
+        for kind in [DualKind::Barycentric, DualKind::Circumcentric] {
+            let worst = worst_effective_conductivity(&hexagon, kind)
+                .unwrap()
+                .unwrap();
+            assert!(worst.deviation < 1e-13, "{kind:?}: {worst:?}");
+        }
+        // Why boundary vertices are left out: at the 120° corner (2, 0)
+        // (two triangles, edges at 120°, 180° and 240°, the middle one
+        // shared) both duals give eigenvalues 0.75 and 1.25 although the
+        // circumcentric star is the P1 stiffness there.
+        let corner = points.iter().position(|p| *p == [2.0, 0.0]).unwrap();
+        for kind in [DualKind::Barycentric, DualKind::Circumcentric] {
+            let t = effective_conductivity(&hexagon, kind).unwrap()[corner];
+            let [low, high] = eigenvalues_2d(&t);
+            approx::assert_abs_diff_eq!(low, 0.75, epsilon = 1e-13);
+            approx::assert_abs_diff_eq!(high, 1.25, epsilon = 1e-13);
+        }
+        // A surface has no d×d identity to compare with.
+        let sphere = hasse_complex::generate::sphere(1.0, 1).unwrap();
+        assert_eq!(
+            worst_effective_conductivity(&sphere, DualKind::Barycentric).unwrap(),
+            None
+        );
     }
 
     #[test]

@@ -37,6 +37,23 @@ pub enum Coefficient {
     Tensor(Vec<Vec<Expression>>),
 }
 
+impl Coefficient {
+    /// Whether any entry names the time `t`.
+    ///
+    /// ```
+    /// use hasse_solver::frontend::case::{Case, Coefficient};
+    /// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [2, 2]\n[problem]\nmethod = \"fe\"\nconductivity = [[\"1 + t\", 0], [0, 1]]\n";
+    /// let case = Case::from_text("k.toml", text, &[]).unwrap();
+    /// assert!(case.problem.coefficient().unwrap().uses_time());
+    /// ```
+    pub fn uses_time(&self) -> bool {
+        match self {
+            Coefficient::Scalar(e) => e.uses_time(),
+            Coefficient::Tensor(rows) => rows.iter().flatten().any(Expression::uses_time),
+        }
+    }
+}
+
 /// A boundary condition of the case: one `[[boundary]]` table.
 ///
 /// ```

@@ -126,7 +126,20 @@ pub(super) fn solve(
         factorization: Some(problem.factorization),
         ordering: None,
         timings: vec![("assembly + solve".to_string(), total)],
-        warnings: Vec::new(),
+        warnings: spec
+            .fields
+            .iter()
+            .flat_map(|f| {
+                super::consistency::diffusion_warnings(
+                    complex,
+                    f.diffusion.method,
+                    &f.diffusion.conductivity,
+                    f.diffusion.circumcentres,
+                )
+                .into_iter()
+                .map(move |w| format!("field {}: {w}", f.name))
+            })
+            .collect(),
         pure_neumann: false,
         series: Vec::new(),
         notes,

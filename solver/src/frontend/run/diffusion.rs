@@ -69,21 +69,12 @@ pub(super) fn solve_diffusion(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     let problem = with_solver(case, diffusion_problem(case, spec), complex)?;
-    let mut warnings = Vec::new();
-    if let (crate::metric::Method::Fv, Coefficient::Tensor(rows)) =
-        (spec.method, &spec.conductivity)
-    {
-        let off_diagonal_zero = rows.iter().enumerate().all(|(i, row)| {
-            row.iter()
-                .enumerate()
-                .all(|(j, e)| i == j || (e.is_constant() && e.eval(&[], 0.0) == 0.0))
-        });
-        if !off_diagonal_zero {
-            warnings.push(
-                "the two-point flux (fv) sees only n·K·n: with off-diagonal K it is inconsistent; use fv-mimetic or fe".into(),
-            );
-        }
-    }
+    let mut warnings = super::consistency::diffusion_warnings(
+        complex,
+        spec.method,
+        &spec.conductivity,
+        spec.circumcentres,
+    );
     phase("assembling and solving");
     let started = Instant::now();
     let keys = Keys {

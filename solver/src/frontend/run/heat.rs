@@ -250,7 +250,12 @@ pub(super) fn solve_streaming<'a>(
         factorization: Some(heat.factorization),
         ordering: history.ordering,
         timings,
-        warnings: Vec::new(),
+        warnings: super::consistency::diffusion_warnings(
+            complex,
+            spec.method,
+            &spec.conductivity,
+            false,
+        ),
         pure_neumann: false,
         series,
         notes,

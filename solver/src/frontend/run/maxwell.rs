@@ -8,7 +8,7 @@ use crate::frontend::output::Cochain;
 use crate::la::eigen::EigenError;
 use crate::metric::Method;
 use crate::physics::maxwell::{Cavity, Mass, MaxwellError};
-use hasse_complex::Complex;
+use hasse_complex::{Complex, DualKind};
 use std::time::Instant;
 
 fn method_name(spec: &MaxwellSpec) -> String {
@@ -73,6 +73,11 @@ pub(super) fn solve(
     let solve_seconds = solving.elapsed().as_secs_f64();
     let exact: &[f64] = case.exact.as_ref().map_or(&[], |e| &e.eigenvalues);
     let mut warnings = Vec::new();
+    // The Whitney mass is consistent; in 2D ⋆₂ = 1/|f| needs no dual, and
+    // in 3D the curl-curl's barycentric ⋆₂ is not checked here.
+    if (spec.dual, spec.mass) == (DualKind::Barycentric, Mass::Hodge) {
+        warnings.extend(super::consistency::maxwell_warning(complex));
+    }
     if exact.len() > modes.eigenvalues.len() {
         warnings.push(format!(
             "exact.eigenvalues lists {} values; only the first {} (problem.modes) are compared",

@@ -44,6 +44,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod consistency;
 mod coupled;
 mod darcy;
 mod diffusion;
@@ -89,8 +90,9 @@ pub struct RunResult {
     pub timings: Vec<(String, f64)>,
     /// Messages worth a user's attention (large residual, pure Neumann…).
     pub warnings: Vec<String>,
-    /// The problem had no Dirichlet or Robin boundary (its solution is
-    /// the one with zero mean).
+    /// The problem had no Dirichlet or Robin boundary (Darcy: no pressure
+    /// face), so its solution is the one with zero mean and errors are
+    /// measured with the mean removed.
     pub pure_neumann: bool,
     /// Saved time levels of a transient run, (t, fields) in order; the
     /// output writes them as a time series. Empty for steady problems,

@@ -4,7 +4,7 @@
 
 use super::{join, Reader, KIND_KEYS};
 use crate::frontend::case::expr::{closest, Scope};
-use crate::frontend::case::{DarcySpec, HeatSpec, MaxwellSpec, Problem, TimeSpec};
+use crate::frontend::case::{Coefficient, DarcySpec, HeatSpec, MaxwellSpec, Problem, TimeSpec};
 use crate::metric::fv::FluxMass;
 use crate::metric::Method;
 use crate::physics::maxwell::Mass;
@@ -147,6 +147,20 @@ impl Reader {
             );
         }
         let conductivity = self.coefficient(table, "conductivity", scope);
+        if conductivity.as_ref().is_some_and(Coefficient::uses_time) {
+            // As for a Robin α: K enters the matrix, which is assembled
+            // and factorised once; evaluating it at t = 0 would freeze it
+            // silently (even when time.start ≠ 0).
+            let span = self
+                .entry(table, "problem", "conductivity")
+                .and_then(|e| e.span());
+            self.error(
+                span,
+                "problem.conductivity",
+                "the conductivity enters the matrix, which is assembled and factorised once: it may not depend on t",
+                Some("the source and the boundary values may depend on t; the conductivity may vary with x, y and z".into()),
+            );
+        }
         let source = match self.entry(table, "problem", "source") {
             Some(_) => self.expression_at(table, "problem", "source", scope),
             None => scope.parse("0").ok(),
