@@ -358,11 +358,7 @@ fn pressure_errors(
         .collect();
     let sum: f64 = difference.iter().zip(measure).map(|(e, w)| w * e * e).sum();
     let max = difference.iter().fold(0.0f64, |m, e| m.max(e.abs()));
-    (
-        Errors::sampled(sum.sqrt(), max),
-        exact,
-        difference,
-    )
+    (Errors::sampled(sum.sqrt(), max), exact, difference)
 }
 
 /// Discrete L² error of the flux density U_F/|F| against u = −K∇p at the
