@@ -233,3 +233,47 @@ fn output_places_are_checked_before_solving() {
     assert!(out.status.success(), "{}", text(&out));
     assert!(!dir.join("other").exists());
 }
+
+/// Pure-Neumann data on a polyhedral sphere: Y₂⁰ = 3z² − 1 has zero mean
+/// on the sphere but not on the 2-times subdivided icosphere, whose
+/// imbalance (about 3 % of the terms) exceeds the default tolerance 1e-2.
+/// `neumann = "project"` and a wider `neumann_tolerance` let it run;
+/// a tolerance outside (0, 1] is refused by `check`.
+#[test]
+fn neumann_data_off_balance_are_refused_or_projected_as_asked() {
+    let dir = crate::scratch::Scratch::new("neumann-project");
+    std::fs::create_dir_all(&*dir).unwrap();
+    let case = "[mesh]\ngenerator = \"sphere\"\nsubdivisions = 2\n\n[problem]\nmethod = \"fe\"\nsource = \"6 * (3*z^2 - 1)\"\n\n[output]\nwrite = false\n";
+    std::fs::write(dir.join("sphere.toml"), case).unwrap();
+    let refused = hasse_in(&dir, &["run", "sphere.toml"]);
+    assert_eq!(refused.status.code(), Some(2), "{}", text(&refused));
+    assert!(
+        text(&refused).contains("tolerance 1e-2"),
+        "{}",
+        text(&refused)
+    );
+    assert!(
+        text(&refused).contains("neumann = \"project\""),
+        "{}",
+        text(&refused)
+    );
+    for set in [
+        "problem.neumann=\"project\"",
+        "problem.neumann_tolerance=0.05",
+    ] {
+        let out = hasse_in(&dir, &["run", "sphere.toml", "--set", set]);
+        assert!(out.status.success(), "{set}: {}", text(&out));
+        assert!(text(&out).contains("data imbalance"), "{}", text(&out));
+    }
+    let bad = hasse_in(
+        &dir,
+        &[
+            "check",
+            "sphere.toml",
+            "--set",
+            "problem.neumann_tolerance=2",
+        ],
+    );
+    assert_eq!(bad.status.code(), Some(2), "{}", text(&bad));
+    assert!(text(&bad).contains("not in (0, 1]"), "{}", text(&bad));
+}

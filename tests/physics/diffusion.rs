@@ -936,3 +936,54 @@ fn error_norms_integrate_the_p1_interpolant_exactly() {
     approx::assert_relative_eq!(e.gradient_l2, h / 3f64.sqrt(), max_relative = 1e-12);
     assert!(e.l2_sampled < 1e-14 && e.max < 1e-14, "{e:?}");
 }
+
+#[test]
+fn nodal_gradients_on_a_surface_are_the_p1_tangent_gradients() {
+    // On the icosphere, u = z + x y is solved as a pure-Neumann problem;
+    // whatever the values, the gradient of the P1 field on a flat triangle
+    // (a, b, c) with unit normal ν and doubled area 2A is, by hand,
+    //   ∇u_h = Σ_i u_i ν × (x_{i+2} − x_{i+1}) / 2A   (indices mod 3),
+    // the rotated opposite edges. The reconstructed gradient must be it,
+    // to rounding, in every cell.
+    let mesh = generate::sphere(1.0, 3).unwrap();
+    let solution = Diffusion::new(
+        Method::Fe,
+        Conductivity::Scalar(Arc::new(|_| 1.0)),
+        Arc::new(|x: &[f64]| 2.0 * x[2] + 6.0 * x[0] * x[1]),
+    )
+    .solve(&mesh)
+    .unwrap();
+    let gradient = hasse_solver::physics::diffusion::reconstruct_gradient(&mesh, &solution);
+    let sub = |a: &[f64], b: &[f64]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let mut worst = 0.0f64;
+    let mut scale = 0.0f64;
+    for (c, g) in gradient.iter().enumerate() {
+        let v = mesh.cell_vertices(2, c);
+        let x: Vec<&[f64]> = v.iter().map(|&i| mesh.vertices().point(i)).collect();
+        let normal = cross(sub(x[1], x[0]), sub(x[2], x[0]));
+        let twice_area = normal.iter().map(|a| a * a).sum::<f64>().sqrt();
+        let unit = normal.map(|a| a / twice_area);
+        let mut expected = [0.0; 3];
+        for i in 0..3 {
+            let edge = sub(x[(i + 2) % 3], x[(i + 1) % 3]);
+            let rotated = cross(unit, edge);
+            for a in 0..3 {
+                expected[a] += solution.values[v[i]] * rotated[a] / twice_area;
+            }
+        }
+        for a in 0..3 {
+            worst = worst.max((g[a] - expected[a]).abs());
+            scale = scale.max(expected[a].abs());
+        }
+    }
+    // Both are sums of three terms of size |u|/h: rounding is ~1e-15 of
+    // that scale; 1e-12 leaves room for the QR in the library's version.
+    assert!(worst <= 1e-12 * scale, "worst {worst:e} of {scale:e}");
+}

@@ -197,6 +197,10 @@ pub struct DiffusionSpec {
     /// Two-point flux with unknowns at circumcentres instead of centroids
     /// (`problem.cell_points = "circumcentres"`).
     pub circumcentres: bool,
+    /// The largest relative imbalance of pure-Neumann data that is
+    /// projected away (`problem.neumann_tolerance`, default 1e-2;
+    /// `problem.neumann = "project"` makes it infinite).
+    pub neumann_tolerance: f64,
 }
 
 /// g = Ω δ f: a cell field's "normal gradient" as a face cochain

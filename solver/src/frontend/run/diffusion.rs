@@ -25,6 +25,7 @@ pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion 
     if spec.circumcentres {
         problem.cell_points = CellPoints::Circumcentres;
     }
+    problem.neumann_tolerance = spec.neumann_tolerance;
     problem
 }
 

@@ -241,8 +241,13 @@ pub(crate) fn diffusion_error(case: &Case, keys: &Keys, error: DiffusionError) -
             &method,
             Some("choose a method that supports this mesh (fe and fv-mimetic take any convex cells)".into()),
         ),
-        DiffusionError::IncompatibleNeumann { .. }
-        | DiffusionError::Disconnected { .. }
+        DiffusionError::IncompatibleNeumann { .. } => RunError::input_at(
+            case,
+            "problem.neumann",
+            &message,
+            Some("make the data balance, or let hasse project the imbalance away: `neumann = \"project\"`, or a larger `neumann_tolerance` in [problem]".into()),
+        ),
+        DiffusionError::Disconnected { .. }
         | DiffusionError::FloatingPart { .. }
         | DiffusionError::Multigrid(_) => RunError::input(case, &message),
         DiffusionError::Canonical(_) | DiffusionError::Solve(_) | DiffusionError::Iterative(_) => {

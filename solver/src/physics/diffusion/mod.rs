@@ -257,12 +257,14 @@ pub enum DiffusionError {
     /// A problem without Dirichlet or Robin boundary has a solution only
     /// when the sources and boundary fluxes balance, and they do not
     /// (beyond [`Diffusion::neumann_tolerance`]).
-    #[error("pure Neumann problem with incompatible data: sources plus boundary fluxes sum to {imbalance:e} (relative {relative:e}); they must balance (∫f + ∮g = 0)")]
+    #[error("pure Neumann problem with incompatible data: sources plus boundary fluxes sum to {imbalance:e} (relative {relative:e}, tolerance {tolerance:e}); they must balance (∫f + ∮g = 0)")]
     IncompatibleNeumann {
         /// Σ b over the unknowns: ∫f + ∮g as assembled.
         imbalance: f64,
         /// The imbalance relative to Σ |b|.
         relative: f64,
+        /// The tolerance it exceeds ([`Diffusion::neumann_tolerance`]).
+        tolerance: f64,
     },
     /// A problem without Dirichlet or Robin boundary on a domain in
     /// several pieces: one zero-mean constraint cannot fix a constant on

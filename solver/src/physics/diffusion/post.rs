@@ -30,7 +30,16 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
             let xc = &centre[c * d..(c + 1) * d];
             match solution.location {
                 Location::Nodal => {
-                    for &v in complex.cell_vertices(n, c) {
+                    let vertices = complex.cell_vertices(n, c);
+                    // A simplex carries the P1 field: its gradient exactly,
+                    // tangent to the cell on a surface (a least-squares fit
+                    // there leans on a pseudo-inverse cutoff).
+                    if vertices.len() == n + 1 {
+                        if let Some(g) = p1_gradient(complex, vertices, &solution.values) {
+                            return g;
+                        }
+                    }
+                    for &v in vertices {
                         points.push((complex.vertices().point(v).to_vec(), solution.values[v]));
                     }
                 }
@@ -65,6 +74,27 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
             least_squares_gradient(&points, d)
         })
         .collect()
+}
+
+/// Σ_v u_v ∇λ_v on the simplex with `vertices`; `None` if degenerate.
+fn p1_gradient(complex: &Complex, vertices: &[usize], values: &[f64]) -> Option<[f64; 3]> {
+    let d = complex.embedding_dim();
+    let corners: Vec<[f64; 3]> = vertices
+        .iter()
+        .map(|&v| {
+            let mut x = [0.0; 3];
+            x[..d].copy_from_slice(complex.vertices().point(v));
+            x
+        })
+        .collect();
+    let (_, gradients) = fe::simplex_gradients(&corners, d)?;
+    let mut g = [0.0; 3];
+    for (&v, gv) in vertices.iter().zip(&gradients) {
+        for a in 0..3 {
+            g[a] += values[v] * gv[a];
+        }
+    }
+    Some(g)
 }
 
 pub(super) fn least_squares_gradient(points: &[(Vec<f64>, f64)], d: usize) -> [f64; 3] {

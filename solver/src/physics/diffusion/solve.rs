@@ -423,6 +423,7 @@ impl Diffusion {
             return Err(DiffusionError::IncompatibleNeumann {
                 imbalance: total,
                 relative,
+                tolerance: self.neumann_tolerance,
             });
         }
         let weights = self.mean_weights(complex, system.location, rhs.len());

@@ -152,6 +152,9 @@ impl Reader {
                             source,
                             boundary,
                             circumcentres: false,
+                            // Not read: the coupled block solve does not
+                            // project Neumann data.
+                            neumann_tolerance: 1e-2,
                         },
                         exact,
                     }),

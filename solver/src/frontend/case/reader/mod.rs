@@ -54,6 +54,8 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "field",
     "metric",
     "cell_points",
+    "neumann",
+    "neumann_tolerance",
     "initial",
     "permeability",
     "mass",
@@ -72,7 +74,14 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
 pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
     (
         "diffusion",
-        &["method", "conductivity", "source", "cell_points"],
+        &[
+            "method",
+            "conductivity",
+            "source",
+            "cell_points",
+            "neumann",
+            "neumann_tolerance",
+        ],
     ),
     ("gradient", &["field", "metric"]),
     ("heat", &["method", "conductivity", "source", "initial"]),

@@ -62,6 +62,50 @@ impl Reader {
         (None, spans)
     }
 
+    /// `problem.neumann` ("check", the default, or "project") and
+    /// `problem.neumann_tolerance` (in (0, 1]): how much imbalance of
+    /// pure-Neumann data is projected away rather than refused.
+    fn neumann_tolerance(&mut self, table: &dyn TableLike) -> f64 {
+        const DEFAULT: f64 = 1e-2;
+        let project = match self.string_at(table, "problem", "neumann").as_deref() {
+            None | Some("check") => false,
+            Some("project") => true,
+            Some(other) => {
+                let span = self
+                    .entry(table, "problem", "neumann")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "problem.neumann",
+                    format!("unknown Neumann treatment \"{other}\""),
+                    Some("use \"check\" (refuse data whose imbalance exceeds `neumann_tolerance`) or \"project\" (remove any imbalance and report it)".into()),
+                );
+                false
+            }
+        };
+        let tolerance = match self.number_at(table, "problem", "neumann_tolerance") {
+            None => DEFAULT,
+            Some(t) if t > 0.0 && t <= 1.0 => t,
+            Some(t) => {
+                let span = self
+                    .entry(table, "problem", "neumann_tolerance")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "problem.neumann_tolerance",
+                    format!("{t} is not in (0, 1]"),
+                    Some("it is the largest |∫f + ∮g| / Σ|terms| that is projected away, e.g. 0.05; `neumann = \"project\"` removes any imbalance".into()),
+                );
+                DEFAULT
+            }
+        };
+        if project {
+            f64::INFINITY
+        } else {
+            tolerance
+        }
+    }
+
     pub(super) fn problem(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<Problem> {
         let Some((table, problem_entry)) = self.subtable(root, "", "problem") else {
             if root.get("problem").is_none() {
@@ -106,12 +150,14 @@ impl Reader {
                         .and_then(|e| e.span());
                     self.error(span, "problem.cell_points", "only the two-point flux (method = \"fv\") places its unknowns at other cell points", None);
                 }
+                let neumann_tolerance = self.neumann_tolerance(table);
                 Some(Problem::Diffusion(DiffusionSpec {
                     method: method?,
                     conductivity: conductivity?,
                     source: source?,
                     boundary,
                     circumcentres,
+                    neumann_tolerance,
                 }))
             }
             "heat" => self.heat(root, table, problem_entry.span(), scope),
