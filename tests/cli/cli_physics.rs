@@ -24,7 +24,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// Run `hasse run case` with overrides, output off; the summary.
-fn run(case: &str, sets: &[String]) -> String {
+pub(crate) fn run(case: &str, sets: &[String]) -> String {
     let mut args = vec!["run".to_string(), case.to_string()];
     args.extend(["--set".into(), "output.write=false".into()]);
     for s in sets {
@@ -43,7 +43,7 @@ fn run(case: &str, sets: &[String]) -> String {
 }
 
 /// The number after `label` on the summary line starting with `line`.
-fn reported(stdout: &str, line: &str, label: &str) -> f64 {
+pub(crate) fn reported(stdout: &str, line: &str, label: &str) -> f64 {
     let text = stdout
         .lines()
         .find(|l| l.starts_with(line))

@@ -2,55 +2,14 @@
 //! constant (flux conditions all round) and when f = 0 (issue 30,
 //! item 6). Kept apart from `cli_physics`, which is past 800 lines.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use crate::cli_physics::{reported, run};
+use std::path::PathBuf;
 
 fn scratch(name: &str) -> PathBuf {
     let dir =
         std::env::temp_dir().join(format!("hasse-darcy-reports-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-/// Run `hasse run case` with output off; the summary.
-fn run(case: &str, sets: &[String]) -> String {
-    let mut args = vec!["run".to_string(), case.to_string()];
-    args.extend(["--set".into(), "output.write=false".into()]);
-    for s in sets {
-        args.extend(["--set".into(), s.clone()]);
-    }
-    let out = Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(&args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs");
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "hasse {args:?} failed ({:?}):\n{stdout}\n{}",
-        out.status,
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
-
-/// The number after `label` on the summary line starting with `line`.
-fn reported(stdout: &str, line: &str, label: &str) -> f64 {
-    let text = stdout
-        .lines()
-        .find(|l| l.starts_with(line))
-        .unwrap_or_else(|| panic!("no `{line}` line in\n{stdout}"));
-    let start = text
-        .find(label)
-        .unwrap_or_else(|| panic!("no {label} in {text}"))
-        + label.len();
-    text[start..]
-        .trim_start()
-        .split([',', ' ', ')'])
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap_or_else(|e| panic!("{text}: {e}"))
 }
 
 /// Issue 30, item 6: a Darcy problem with flux conditions all round. Its

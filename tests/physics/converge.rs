@@ -311,12 +311,8 @@ fn svg_size(svg: &str) -> (u32, u32) {
 /// The series labels of the legend, in order: texts of the form
 /// `METHOD · NORM`.
 fn legend_labels(svg: &str) -> Vec<String> {
-    svg.split("<text")
-        .skip(1)
-        .map(|t| {
-            let body = &t[t.find('>').unwrap() + 1..t.find("</text>").unwrap()];
-            body.trim().to_string()
-        })
+    svg_texts(svg)
+        .into_iter()
         .filter(|t| t.contains(" · "))
         .collect()
 }

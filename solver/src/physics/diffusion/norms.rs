@@ -47,13 +47,7 @@ pub(super) fn quadrature_errors(
         Location::Nodal => Vec::new(),
         _ => reconstruct_gradient(complex, solution),
     };
-    let centre = match solution.location {
-        Location::CellCentred => solution
-            .cell_points
-            .as_deref()
-            .unwrap_or(complex.centroid(n)),
-        _ => complex.centroid(n),
-    };
+    let centre = post::cell_centres(complex, solution);
     let gradient_error = |x: &[f64], g: &[f64; 3]| -> f64 {
         exact_gradient.map_or(0.0, |grad| {
             let e = grad(x);

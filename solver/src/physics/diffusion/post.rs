@@ -13,14 +13,7 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
     let n = complex.dim();
     let d = complex.embedding_dim();
     let cells = complex.cell_count(n);
-    // Cell values stand for the exact field at their cell points.
-    let centre = match solution.location {
-        Location::CellCentred => solution
-            .cell_points
-            .as_deref()
-            .unwrap_or(complex.centroid(n)),
-        _ => complex.centroid(n),
-    };
+    let centre = cell_centres(complex, solution);
     let face_centre = complex.centroid(n - 1);
     let by_cell = complex.boundary_csc(n);
     let top = complex.boundary(n);
@@ -74,6 +67,20 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
             least_squares_gradient(&points, d)
         })
         .collect()
+}
+
+/// Where each top cell's value and gradient stand: the cell points of a
+/// cell-centred solution (centroids unless [`Solution::cell_points`] says
+/// otherwise), the centroids for the others, as coordinates in a row.
+pub(super) fn cell_centres<'a>(complex: &'a Complex, solution: &'a Solution) -> &'a [f64] {
+    let n = complex.dim();
+    match solution.location {
+        Location::CellCentred => solution
+            .cell_points
+            .as_deref()
+            .unwrap_or(complex.centroid(n)),
+        _ => complex.centroid(n),
+    }
 }
 
 /// Σ_v u_v ∇λ_v on the simplex with `vertices`; `None` if degenerate.
