@@ -340,3 +340,57 @@ fn bad_input_is_a_typed_error() {
         Err(MaxwellError::Metric(_))
     ));
 }
+
+#[test]
+fn a_cavity_with_a_hole_has_one_static_field() {
+    // The annulus is a cavity with one hole: β₁ = 1, so one static field
+    // (H¹(Ω, ∂Ω) ≅ H₁(Ω) by Lefschetz duality), curl-free (K e = 0) and
+    // M-orthogonal to every gradient, before the nonzero ω². The square
+    // has none.
+    let annulus = hasse_complex::generate::annulus(0.5, 1.0, 8, 32).unwrap();
+    let cavity = Cavity::new(&annulus, DualKind::Barycentric, Mass::Hodge).unwrap();
+    assert_eq!(cavity.static_count(), 1);
+    let modes = cavity.modes(2, &cavity.default_options()).unwrap();
+    assert_eq!(modes.static_fields.len(), 1);
+    assert_eq!(modes.eigenvalues.len(), 2);
+    assert!(
+        modes.eigenvalues.iter().all(|&w| w > 1.0),
+        "{:?}",
+        modes.eigenvalues
+    );
+    let e = &modes.static_fields[0];
+    let multiply = |a: faer::sparse::SparseColMatRef<'_, usize, f64>, x: &[f64]| {
+        let mut y = vec![0.0; a.nrows()];
+        for (j, xj) in x.iter().enumerate() {
+            let range = a.col_range(j);
+            for (&i, v) in a.row_idx()[range.clone()].iter().zip(&a.val()[range]) {
+                y[i] += v * xj;
+            }
+        }
+        y
+    };
+    let norm = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let k_norm = (0..cavity.stiffness().ncols())
+        .map(|j| {
+            cavity.stiffness().val()[cavity.stiffness().col_range(j)]
+                .iter()
+                .map(|v| v.abs())
+                .sum::<f64>()
+        })
+        .fold(0.0, f64::max);
+    // Curl-free to rounding of ‖K‖‖e‖.
+    assert!(norm(&multiply(cavity.stiffness(), e)) <= 1e-10 * k_norm * norm(e));
+    // Removing gradients leaves it unchanged: it is M-orthogonal to them.
+    let mut projected = e.clone();
+    cavity.remove_gradients(&mut projected).unwrap();
+    let moved: Vec<f64> = projected.iter().zip(e).map(|(a, b)| a - b).collect();
+    assert!(norm(&moved) <= 1e-10 * norm(e));
+    let square = rectangle(8, 8, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let plain = Cavity::new(&square, DualKind::Barycentric, Mass::Hodge).unwrap();
+    assert_eq!(plain.static_count(), 0);
+    assert!(plain
+        .modes(2, &plain.default_options())
+        .unwrap()
+        .static_fields
+        .is_empty());
+}

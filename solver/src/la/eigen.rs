@@ -94,7 +94,10 @@ pub struct Options {
     /// Vectors per Krylov block; at least the largest multiplicity wanted.
     pub block: usize,
     /// Relative residual ‖Kx − λMx‖₂ / (‖Kx‖₂ + |λ| ‖Mx‖₂) every returned
-    /// pair must reach.
+    /// pair must reach. A pair whose λ is zero to rounding (|λ| ≤ 1e-10 ·
+    /// ‖K‖₁/‖M‖₁, a kernel vector of K) is measured against ‖K‖₁‖x‖₂
+    /// instead: for it ‖Kx‖ and |λ|‖Mx‖ are themselves rounding, and the
+    /// ratio above is about 1 however exact the vector.
     pub tolerance: f64,
     /// Largest basis before giving up with [`EigenError::NotConverged`].
     pub max_basis: usize,
@@ -123,6 +126,9 @@ pub struct Eigenpairs {
     pub vectors: Vec<Vec<f64>>,
     /// Relative residual of each pair (see [`Options::tolerance`]).
     pub residuals: Vec<f64>,
+    /// How many of the values (the first ones) are zero to rounding:
+    /// kernel vectors of K inside the projection's range.
+    pub zeros: usize,
     /// Size of the final Krylov basis.
     pub basis: usize,
     /// Number of solves with K − σM.
@@ -190,6 +196,12 @@ pub fn smallest(
     if !sigma.is_finite() {
         return Err(EigenError::BadShift(sigma));
     }
+    // The scale of the spectrum, for telling zero eigenvalues from small
+    // ones: ‖K‖₁/‖M‖₁ is of the order of the largest eigenvalue.
+    let scale = Scale {
+        k: column_norm(k),
+        m: column_norm(m),
+    };
     let shifted = combine(k, m, -sigma);
     // K − σM is positive definite for σ < 0 (K ⪰ 0, M ≻ 0), indefinite
     // above the lowest eigenvalue.
@@ -232,17 +244,19 @@ pub fn smallest(
                 }
             }
         }
-        let ritz = basis.rayleigh_ritz(count, sigma)?;
+        let ritz = basis.rayleigh_ritz(count, sigma, scale)?;
         let converged = ritz
             .residuals
             .iter()
             .filter(|&&r| r <= options.tolerance)
             .count();
         if converged == count {
+            let zeros = ritz.values.iter().filter(|&&l| scale.is_zero(l)).count();
             return Ok(Eigenpairs {
                 values: ritz.values,
                 vectors: ritz.vectors,
                 residuals: ritz.residuals,
+                zeros,
                 basis: basis.len(),
                 solves,
                 factorization: kind,
@@ -319,6 +333,30 @@ struct Basis {
     h: Vec<Vec<f64>>,
 }
 
+/// Below this fraction of ‖K‖₁/‖M‖₁ an eigenvalue is zero: kernel
+/// vectors give about 1e-16 of it, the smallest physical eigenvalue of a
+/// second-order operator (h/L)² of it, 1e-10 at h = L/10⁵.
+const ZERO_EIGENVALUE: f64 = 1e-10;
+
+/// ‖K‖₁ and ‖M‖₁ (largest column sums of |entries|).
+#[derive(Clone, Copy)]
+struct Scale {
+    k: f64,
+    m: f64,
+}
+
+impl Scale {
+    fn is_zero(&self, lambda: f64) -> bool {
+        self.m > 0.0 && lambda.abs() <= ZERO_EIGENVALUE * self.k / self.m
+    }
+}
+
+fn column_norm(a: SparseColMatRef<'_, usize, f64>) -> f64 {
+    (0..a.ncols())
+        .map(|j| a.val()[a.col_range(j)].iter().map(|v| v.abs()).sum::<f64>())
+        .fold(0.0, f64::max)
+}
+
 struct Ritz {
     values: Vec<f64>,
     vectors: Vec<Vec<f64>>,
@@ -371,7 +409,7 @@ impl Basis {
     }
 
     /// The `count` Ritz pairs with values closest to σ, ascending.
-    fn rayleigh_ritz(&self, count: usize, sigma: f64) -> Result<Ritz, EigenError> {
+    fn rayleigh_ritz(&self, count: usize, sigma: f64, spectrum: Scale) -> Result<Ritz, EigenError> {
         let size = self.len();
         // Symmetrise: rounding makes qᵢᵀKqⱼ and qⱼᵀKqᵢ differ slightly.
         let h = Mat::from_fn(size, size, |i, j| 0.5 * (self.h[i][j] + self.h[j][i]));
@@ -408,7 +446,11 @@ impl Basis {
                 }
             }
             let r: Vec<f64> = kx.iter().zip(&mx).map(|(a, b)| a - lambda * b).collect();
-            let scale = norm(&kx) + lambda.abs() * norm(&mx);
+            let scale = if spectrum.is_zero(lambda) {
+                spectrum.k * norm(&x)
+            } else {
+                norm(&kx) + lambda.abs() * norm(&mx)
+            };
             ritz.residuals.push(if scale > 0.0 {
                 norm(&r) / scale
             } else {
@@ -434,5 +476,46 @@ impl SplitMix {
         z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
         z ^= z >> 31;
         (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+    use faer::sparse::Triplet;
+
+    #[test]
+    fn a_kernel_vector_is_returned_as_a_zero_eigenvalue() {
+        // The 1D Neumann Laplacian on n points (K = path-graph Laplacian /
+        // h, zero row sums) with M = h I: λ_j = (2 − 2 cos(jπ/n)) / h²,
+        // j = 0 … n − 1, the constant vector being the kernel (λ₀ = 0).
+        let (n, h) = (20usize, 0.05);
+        let mut k = Vec::new();
+        for i in 0..n - 1 {
+            k.push(Triplet::new(i, i, 1.0 / h));
+            k.push(Triplet::new(i + 1, i + 1, 1.0 / h));
+            k.push(Triplet::new(i, i + 1, -1.0 / h));
+            k.push(Triplet::new(i + 1, i, -1.0 / h));
+        }
+        let k = SparseColMat::try_new_from_triplets(n, n, &k).unwrap();
+        let m: Vec<_> = (0..n).map(|i| Triplet::new(i, i, h)).collect();
+        let m = SparseColMat::try_new_from_triplets(n, n, &m).unwrap();
+        let options = Options {
+            block: 2,
+            ..Default::default()
+        };
+        let pairs = smallest(k.as_ref(), m.as_ref(), 3, None, n, &options).unwrap();
+        assert_eq!(pairs.zeros, 1);
+        assert!(pairs.values[0].abs() < 1e-9, "{:?}", pairs.values);
+        for j in 1..3 {
+            let exact = (2.0 - 2.0 * (j as f64 * std::f64::consts::PI / n as f64).cos()) / (h * h);
+            assert_relative_eq!(pairs.values[j], exact, max_relative = 1e-9);
+        }
+        // The kernel vector is the constant, M-normalised: 1/√(n h).
+        let c = 1.0 / (n as f64 * h).sqrt();
+        for x in &pairs.vectors[0] {
+            assert_relative_eq!(x.abs(), c, max_relative = 1e-8);
+        }
     }
 }

@@ -171,6 +171,8 @@ pub struct Cavity {
     /// LLᵀ of Gᵀ M G (absent when there is no interior vertex).
     gram: Option<Factor>,
     diameter: f64,
+    /// β_{n−1} of the cavity: the dimension of its static fields.
+    static_count: usize,
 }
 
 /// Resonant modes, ascending in ω².
@@ -195,6 +197,9 @@ pub struct Modes {
     pub fields: Vec<Vec<f64>>,
     /// Relative residuals ‖Ke − ω²Me‖ / (‖Ke‖ + ω²‖Me‖).
     pub residuals: Vec<f64>,
+    /// The static fields found (ω² = 0 to rounding, M-orthonormal), on the
+    /// interior edges; [`Cavity::static_count`] says how many there are.
+    pub static_fields: Vec<Vec<f64>>,
     /// Krylov basis size used.
     pub basis: usize,
     /// Solves with K − σM used.
@@ -311,6 +316,13 @@ impl Cavity {
             })
             .sum::<f64>()
             .sqrt();
+        // Static fields: curl-free, divergence-free fields with zero
+        // tangential trace, the relative cohomology H¹(Ω, ∂Ω), which by
+        // Lefschetz duality has the dimension of H_{n−1}(Ω): one per hole
+        // of a 2D cavity, one per enclosed void of a 3D one. The mesh is
+        // orientable and embedded, so Z₂ gives the rational Betti numbers.
+        let betti = complex.betti_numbers_over(hasse_complex::Field::Z2);
+        let static_count = betti.get(complex.dim() - 1).copied().unwrap_or(0);
         Ok(Self {
             edges,
             vertices,
@@ -319,6 +331,7 @@ impl Cavity {
             gradient,
             gram,
             diameter,
+            static_count,
         })
     }
 
@@ -332,9 +345,17 @@ impl Cavity {
         self.vertices.free().len()
     }
 
-    /// The most physical modes there are: unknowns − gradients.
+    /// The most physical modes there are: unknowns − gradients (the
+    /// static fields included).
     pub fn physical_count(&self) -> usize {
         self.unknowns() - self.gradient_count()
+    }
+
+    /// The number of static fields (ω² = 0 after the gradients are
+    /// removed): β_{n−1} of the cavity, its holes in 2D and enclosed voids
+    /// in 3D.
+    pub fn static_count(&self) -> usize {
+        self.static_count
     }
 
     /// The interior edges, in unknown order.
@@ -400,23 +421,36 @@ impl Cavity {
     }
 
     /// The `count` smallest nonzero ω² and their fields, with the gradient
-    /// null space deflated. Errors: `count` = 0 or above
-    /// [`physical_count`](Self::physical_count), non-convergence, and
-    /// factorisation failures, as [`MaxwellError::Eigen`].
+    /// null space deflated, after the static fields (ω² = 0, as many as
+    /// [`static_count`](Self::static_count)). Errors: `count` = 0 or
+    /// above [`physical_count`](Self::physical_count) less the static
+    /// fields, non-convergence, and factorisation failures, as
+    /// [`MaxwellError::Eigen`].
     pub fn modes(&self, count: usize, options: &Options) -> Result<Modes, MaxwellError> {
         let project = |v: &mut [f64]| self.remove_gradients(v);
         let pairs = eigen::smallest(
             self.stiffness.as_ref(),
             self.mass.as_ref(),
-            count,
+            count + self.static_count,
             Some(&project),
             self.physical_count(),
             options,
         )?;
+        let zeros = pairs.zeros;
+        let mut values = pairs.values;
+        let mut fields = pairs.vectors;
+        let mut residuals = pairs.residuals;
+        let static_fields: Vec<Vec<f64>> = fields.drain(..zeros).collect();
+        values.drain(..zeros);
+        residuals.drain(..zeros);
+        values.truncate(count);
+        fields.truncate(count);
+        residuals.truncate(count);
         Ok(Modes {
-            eigenvalues: pairs.values,
-            fields: pairs.vectors,
-            residuals: pairs.residuals,
+            eigenvalues: values,
+            fields,
+            residuals,
+            static_fields,
             basis: pairs.basis,
             solves: pairs.solves,
             shift: options.shift,

@@ -51,16 +51,17 @@ pub(super) fn solve(
     let started = Instant::now();
     let cavity = Cavity::new(complex, spec.dual, spec.mass).map_err(|e| run_error(case, e))?;
     let assembly_seconds = started.elapsed().as_secs_f64();
-    let available = cavity.physical_count();
+    let available = cavity.physical_count() - cavity.static_count().min(cavity.physical_count());
     if spec.modes > available {
         return Err(RunError::input_at(
             case,
             "problem.modes",
             format!(
-                "{} modes asked for, but this cavity has only {available} physical modes ({} interior edges minus {} gradients of interior vertices)",
+                "{} modes asked for, but this cavity has only {available} resonant modes ({} interior edges minus {} gradients of interior vertices and {} static fields)",
                 spec.modes,
                 cavity.unknowns(),
-                cavity.gradient_count()
+                cavity.gradient_count(),
+                cavity.static_count()
             ),
             Some("ask for fewer or refine the mesh".into()),
         ));
@@ -109,7 +110,24 @@ pub(super) fn solve(
             "residual": residual,
         }));
     }
-    let fields = modes
+    let found = modes.static_fields.len();
+    if found != cavity.static_count() {
+        warnings.push(format!(
+            "{found} static fields found (ω² = 0 to rounding), but the cavity's β_{} = {} says there are {}",
+            complex.dim() - 1,
+            cavity.static_count(),
+            cavity.static_count()
+        ));
+    }
+    let mut fields: Vec<Cochain> = modes
+        .static_fields
+        .iter()
+        .enumerate()
+        .map(|(k, e)| Cochain::new(format!("static_{}", k + 1), 1, cavity.extend(e)).with_description(
+            "a static field (ω² = 0): curl-free and M-orthogonal to every gradient, zero on the walls, M-normalised".to_string()
+        ))
+        .collect();
+    fields.extend(modes
         .fields
         .iter()
         .zip(&modes.eigenvalues)
@@ -117,8 +135,7 @@ pub(super) fn solve(
         .map(|(k, (e, value))| Cochain::new(format!("mode_{}", k + 1), 1, cavity.extend(e)).with_description(format!(
                 "electric field of mode {} (ω² = {value:.10e}) as an edge cochain ∫_e E·t, zero on the walls, M-normalised",
                 k + 1
-            )))
-        .collect();
+            ))));
     let mut report = serde_json::Map::new();
     report.insert("modes".into(), serde_json::Value::Array(rows));
     report.insert(
@@ -130,7 +147,11 @@ pub(super) fn solve(
             "gradients_deflated": cavity.gradient_count(),
         }),
     );
-    let notes = vec![
+    report.insert(
+        "static_fields".into(),
+        serde_json::json!({ "found": found, "betti": cavity.static_count() }),
+    );
+    let mut notes = vec![
         (
             "cavity".to_string(),
             format!(
@@ -144,6 +165,21 @@ pub(super) fn solve(
         ),
         ("modes".to_string(), table),
     ];
+    if cavity.static_count() > 0 || found > 0 {
+        notes.insert(
+            1,
+            (
+                "static".to_string(),
+                format!(
+                    "{found} static field{} (ω² = 0), β_{} = {} of the cavity ({}); the modes below are the nonzero ω²",
+                    if found == 1 { "" } else { "s" },
+                    complex.dim() - 1,
+                    cavity.static_count(),
+                    if complex.dim() == 2 { "its holes" } else { "its enclosed voids" }
+                ),
+            ),
+        );
+    }
     Ok(RunResult {
         problem: "maxwell".into(),
         method: Some(method_name(spec)),
