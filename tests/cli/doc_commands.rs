@@ -1,6 +1,7 @@
 //! Every `hasse …` command line the documentation prints runs as printed:
-//! the lines of the code blocks (but Rust's) of `README.md` and
-//! `cases/README.md` that start with `hasse` and a subcommand,
+//! the lines of the code blocks (but Rust's) of `README.md`,
+//! `cases/README.md` and `benches/README.md` that start with `hasse` and
+//! a subcommand,
 //! the `hasse …` commands in the comments of `cases/*.toml`, and the
 //! examples of `hasse --help` and of each subcommand's help.
 //!
@@ -114,7 +115,7 @@ fn command_in(line: &str) -> Option<String> {
 /// Every documented command line, with where it is printed.
 fn documented() -> Vec<(String, String)> {
     let mut found = Vec::new();
-    for doc in ["README.md", "cases/README.md"] {
+    for doc in ["README.md", "cases/README.md", "benches/README.md"] {
         let text = std::fs::read_to_string(root().join(doc)).unwrap();
         // Any code block but Rust's: a line that starts with `hasse` and a
         // subcommand.
