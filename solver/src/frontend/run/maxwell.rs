@@ -57,7 +57,7 @@ pub(super) fn solve(
             case,
             "problem.modes",
             format!(
-                "{} modes asked for, but this cavity has only {available} resonant modes ({} interior edges minus {} gradients of interior vertices and {} static fields)",
+                "{} modes asked for, but this cavity has only {available} physical modes ({} interior edges minus {} gradients of interior vertices and {} static fields)",
                 spec.modes,
                 cavity.unknowns(),
                 cavity.gradient_count(),
