@@ -27,3 +27,4 @@ mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
 mod method_warnings;
+mod regions;

@@ -24,6 +24,7 @@ use crate::metric::Location;
 use crate::metric::Method;
 use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use crate::physics::diffusion::{Diffusion, DiffusionError};
+use crate::physics::regions::Regional;
 use crate::physics::{non_finite_text, point_text, BoundaryKind, Conductivity, Datum, ScalarFn};
 use hasse_complex::Complex;
 use sprs::CsMat;
@@ -202,6 +203,10 @@ pub struct Heat {
     pub conductivity: Conductivity,
     /// f(x, t).
     pub source: TimeFn,
+    /// f(x, t) per region of top cells, replacing [`Heat::source`] when
+    /// set ([`Diffusion::with_source_by_region`] says how each method
+    /// integrates it).
+    pub source_by_region: Option<Arc<Regional<TimeFn>>>,
     /// Applied in order, as in [`Diffusion::boundary`].
     pub boundary: Vec<(String, HeatBoundary)>,
     /// 1: backward Euler (default), ½: Crank–Nicolson, 0: forward Euler.
@@ -286,6 +291,7 @@ impl Heat {
             method,
             conductivity,
             source: TimeFn::Steady(Arc::new(|_| 0.0)),
+            source_by_region: None,
             boundary: Vec::new(),
             theta: 1.0,
             dt,
@@ -298,6 +304,12 @@ impl Heat {
     /// Set the source f.
     pub fn with_source(mut self, source: TimeFn) -> Self {
         self.source = source;
+        self
+    }
+
+    /// Set a source per region of top cells.
+    pub fn with_source_by_region(mut self, source: Regional<TimeFn>) -> Self {
+        self.source_by_region = Some(Arc::new(source));
         self
     }
 
@@ -318,6 +330,9 @@ impl Heat {
         let mut problem = Diffusion::new(self.method, self.conductivity.clone(), self.source.at(t));
         problem.factorization = self.factorization;
         problem.ordering = self.ordering;
+        if let Some(regional) = &self.source_by_region {
+            problem.source_by_region = Some(Arc::new(regional.map(|f| f.at(t))));
+        }
         for (tag, kind) in &self.boundary {
             let kind = match kind {
                 HeatBoundary::Dirichlet(g) => BoundaryKind::Dirichlet(g.at(t)),
@@ -334,6 +349,10 @@ impl Heat {
 
     fn data_vary(&self) -> bool {
         self.source.varies()
+            || self.source_by_region.as_ref().is_some_and(|r| {
+                r.pieces().iter().any(|(_, f)| f.varies())
+                    || r.default().is_some_and(TimeFn::varies)
+            })
             || self.boundary.iter().any(|(_, kind)| match kind {
                 HeatBoundary::Dirichlet(g) | HeatBoundary::Neumann(g) => g.varies(),
                 HeatBoundary::Robin { value, .. } => value.varies(),

@@ -11,6 +11,7 @@ pub mod elasticity;
 pub mod gradient;
 pub mod heat;
 pub mod maxwell;
+pub mod regions;
 
 use crate::metric::Tensor;
 use hasse_complex::Complex;
@@ -57,6 +58,9 @@ pub enum Conductivity {
     Scalar(ScalarFn),
     /// A symmetric positive definite tensor field.
     Tensor(TensorFn),
+    /// A conductivity per region of top cells ([`regions`]): each cell's
+    /// is its region's, evaluated at the cell's centroid.
+    Regional(Arc<regions::Regional<Conductivity>>),
 }
 
 /// A boundary condition's kind and data, functions of the position on the

@@ -36,6 +36,7 @@ pub mod diagnostic;
 pub mod expr;
 mod problem;
 mod reader;
+mod regions;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use problem::*;
@@ -215,6 +216,9 @@ pub struct Case {
     pub scope: Scope,
     /// `[mesh]`: how to build the complex ([`Case::build_mesh`]).
     pub mesh: MeshSpec,
+    /// `[regions]`: tags of top cells defined by a condition on their
+    /// centroids, added to the mesh when it is built.
+    pub regions: Vec<(String, Expression)>,
     /// `[problem]` and its boundary conditions.
     pub problem: Problem,
     /// `[exact]`, if given.
@@ -286,7 +290,7 @@ impl Case {
     pub fn build_mesh(&self) -> Result<Complex, Diagnostics> {
         let mut collector = self.collector.clone();
         collector.diagnostics.clear();
-        let complex = match self.mesh.build(&self.path) {
+        let mut complex = match self.mesh.build(&self.path) {
             Ok(complex) => complex,
             Err(e) => {
                 let (key, message) = match &e {
@@ -304,6 +308,8 @@ impl Case {
                 return Err(Diagnostics(collector.diagnostics));
             }
         };
+        self.apply_regions(&mut complex, &mut collector);
+        self.check_regional_data(&complex, &mut collector);
         {
             let n = complex.dim();
             let available: Vec<String> = complex

@@ -654,4 +654,49 @@ impl Problem {
             Problem::Gradient(_) | Problem::Maxwell(_) | Problem::Elasticity(_) => Vec::new(),
         }
     }
+
+    /// Every datum given per region, with its key: what the mesh's tags
+    /// must cover ([`Case::build_mesh`] checks them).
+    pub fn regional_data(&self) -> Vec<(String, &Expression)> {
+        fn diffusion<'a>(
+            all: &mut Vec<(String, &'a Expression)>,
+            prefix: &str,
+            k: &'a Coefficient,
+            f: &'a Expression,
+        ) {
+            if let Coefficient::Scalar(e) = k {
+                all.push((format!("{prefix}.conductivity"), e));
+            }
+            all.push((format!("{prefix}.source"), f));
+        }
+        let mut all: Vec<(String, &Expression)> = Vec::new();
+        match self {
+            Problem::Diffusion(d) => diffusion(&mut all, "problem", &d.conductivity, &d.source),
+            Problem::Heat(h) => diffusion(&mut all, "problem", &h.conductivity, &h.source),
+            Problem::Coupled(c) => {
+                for (i, f) in c.fields.iter().enumerate() {
+                    let prefix = format!("field[{i}]");
+                    diffusion(
+                        &mut all,
+                        &prefix,
+                        &f.diffusion.conductivity,
+                        &f.diffusion.source,
+                    );
+                }
+            }
+            Problem::Elasticity(e) => match &e.material {
+                MaterialSpec::Lame { lambda, mu } => {
+                    all.push(("problem.lambda".into(), lambda));
+                    all.push(("problem.mu".into(), mu));
+                }
+                MaterialSpec::Young { young, poisson } => {
+                    all.push(("problem.young".into(), young));
+                    all.push(("problem.poisson".into(), poisson));
+                }
+            },
+            Problem::Gradient(_) | Problem::Darcy(_) | Problem::Maxwell(_) => {}
+        }
+        all.retain(|(_, e)| e.regions().is_some());
+        all
+    }
 }

@@ -7,6 +7,9 @@ use crate::physics::diffusion::{self as physics, CellPoints};
 pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion {
     let conductivity = conductivity(&spec.conductivity);
     let mut problem = Diffusion::new(spec.method, conductivity, scalar_fn(&spec.source));
+    if let Some(source) = regional_fn(&spec.source) {
+        problem = problem.with_source_by_region(source);
+    }
     for b in &spec.boundary {
         let kind = match &b.kind {
             BoundaryKindSpec::Dirichlet(v) => BoundaryKind::Dirichlet(scalar_fn(v)),

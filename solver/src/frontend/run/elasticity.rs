@@ -18,8 +18,25 @@ fn vector_fn(components: &[Expression]) -> VectorFn {
     super::vector_fn(components)
 }
 
-fn problem(case: &Case, spec: &ElasticitySpec) -> Elasticity {
-    let coefficient = |e: &Expression| Coefficient::Function(scalar_fn(e));
+fn problem(case: &Case, spec: &ElasticitySpec, complex: &Complex) -> Elasticity {
+    // A parameter per region becomes a value per cell, its region's at the
+    // centroid; regions that do not fit the mesh were refused when it was
+    // built, so the NaN fallback only marks a library misuse.
+    let coefficient = |e: &Expression| match super::regional_fn(e) {
+        Some(regional) => {
+            let n = complex.dim();
+            let values: Vec<f64> = match regional.per_cell(complex) {
+                Ok(per_cell) => per_cell
+                    .iter()
+                    .enumerate()
+                    .map(|(c, f)| f(complex.centroid_of(n, c)))
+                    .collect(),
+                Err(_) => vec![f64::NAN; complex.cell_count(n)],
+            };
+            Coefficient::PerCell(values.into())
+        }
+        None => Coefficient::Function(scalar_fn(e)),
+    };
     let material = match &spec.material {
         MaterialSpec::Lame { lambda, mu } => Material::Lame {
             lambda: coefficient(lambda),
@@ -126,7 +143,7 @@ pub(super) fn solve(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     let d = complex.embedding_dim();
-    let elasticity = problem(case, spec);
+    let elasticity = problem(case, spec, complex);
     phase("assembling and solving");
     let started = Instant::now();
     let u = elasticity
@@ -204,7 +221,7 @@ pub(super) fn solve(
 /// The material and the body force evaluated where the solve evaluates
 /// them, without solving.
 pub(super) fn check(case: &Case, spec: &ElasticitySpec, complex: &Complex) -> Result<(), RunError> {
-    problem(case, spec)
+    problem(case, spec, complex)
         .check_data(complex)
         .map_err(|e| run_error(case, spec, e))
 }

@@ -237,6 +237,12 @@ pub(crate) fn diffusion_error(case: &Case, keys: &Keys, error: DiffusionError) -
         DiffusionError::NotSymmetric { .. } | DiffusionError::Unsupported { .. } => {
             at(&method, None)
         }
+        // Regions are checked against the mesh when it is built, so this
+        // is reached only by a mesh changed afterwards.
+        DiffusionError::Region(_) => at(
+            &format!("{}.{}", keys.prefix, keys.coefficient),
+            Some("regions are tags of top cells; add `default = …` for the cells in none".into()),
+        ),
         DiffusionError::Metric(_) => at(
             &method,
             Some("choose a method that supports this mesh (fe and fv-mimetic take any convex cells)".into()),

@@ -9,6 +9,7 @@ use crate::frontend::output::Cochain;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::physics::diffusion::Errors;
 use crate::physics::heat::{Heat, HeatBoundary, HeatError, HeatEvent, History, TimeFn};
+use crate::physics::regions::Regional;
 use hasse_complex::Complex;
 use std::sync::Arc;
 use std::time::Instant;
@@ -28,6 +29,16 @@ fn heat_problem(case: &Case, spec: &HeatSpec) -> Heat {
     let mut heat = Heat::new(spec.method, conductivity(&spec.conductivity), spec.time.dt)
         .with_theta(spec.time.theta)
         .with_source(time_fn(&spec.source));
+    if let Some(regions) = spec.source.regions() {
+        heat = heat.with_source_by_region(Regional::new(
+            regions
+                .pieces
+                .iter()
+                .map(|(name, piece)| (name.clone(), time_fn(piece)))
+                .collect(),
+            regions.default.as_ref().map(time_fn),
+        ));
+    }
     heat.start = spec.time.start;
     for b in &spec.boundary {
         let kind = match &b.kind {

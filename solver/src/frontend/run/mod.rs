@@ -110,6 +110,22 @@ pub(crate) fn scalar_fn(e: &crate::frontend::case::expr::Expression) -> ScalarFn
     Arc::new(move |x: &[f64]| e.eval(x, 0.0))
 }
 
+/// A case datum given per region as the library takes it (evaluated at
+/// t = 0); `None` for a datum given by one expression.
+pub(crate) fn regional_fn(
+    e: &crate::frontend::case::expr::Expression,
+) -> Option<crate::physics::regions::Regional<ScalarFn>> {
+    let regions = e.regions()?;
+    Some(crate::physics::regions::Regional::new(
+        regions
+            .pieces
+            .iter()
+            .map(|(name, piece)| (name.clone(), scalar_fn(piece)))
+            .collect(),
+        regions.default.as_ref().map(scalar_fn),
+    ))
+}
+
 /// Solve the case's problem on `complex`; `phase` is told when each long
 /// phase starts (for progress display).
 pub fn solve(
@@ -170,7 +186,12 @@ pub(crate) fn vector_fn(components: &[crate::frontend::case::expr::Expression]) 
 /// A case coefficient as a conductivity of the library (evaluated at t = 0).
 pub(crate) fn conductivity(coefficient: &Coefficient) -> Conductivity {
     match coefficient {
-        Coefficient::Scalar(e) => Conductivity::Scalar(scalar_fn(e)),
+        Coefficient::Scalar(e) => match regional_fn(e) {
+            Some(regional) => {
+                Conductivity::Regional(Arc::new(regional.map(|f| Conductivity::Scalar(f.clone()))))
+            }
+            None => Conductivity::Scalar(scalar_fn(e)),
+        },
         Coefficient::Tensor(rows) => {
             let rows = rows.clone();
             let f: TensorFn = Arc::new(move |x: &[f64]| {

@@ -156,6 +156,25 @@ pub fn load(
     complex: &Complex,
     f: &(dyn Fn(&[f64]) -> f64 + Sync),
 ) -> Result<Vec<f64>, MetricError> {
+    load_in_cells(complex, &|_, x| f(x))
+}
+
+/// [`load()`] of a source that depends on the top cell as well as the
+/// position (data given per region): cell c's quadrature evaluates
+/// f(c, x).
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::metric::fe;
+/// let k = rectangle(3, 2, [0.0, 3.0], [0.0, 1.0]).unwrap();
+/// // f = 2 in cell 0 (of area 1), 0 elsewhere: a total load of 2.
+/// let b = fe::load_in_cells(&k, &|c, _| if c == 0 { 2.0 } else { 0.0 }).unwrap();
+/// assert!((b.iter().sum::<f64>() - 2.0).abs() < 1e-14);
+/// ```
+pub fn load_in_cells(
+    complex: &Complex,
+    f: &(dyn Fn(usize, &[f64]) -> f64 + Sync),
+) -> Result<Vec<f64>, MetricError> {
     let top = Topology::new(complex, "FE load")?;
     let n = top.n;
     let cells = complex.cell_count(n);
@@ -180,7 +199,7 @@ pub fn load(
                 cell_load(
                     &top,
                     c,
-                    f,
+                    &|x| f(c, x),
                     &mut piece[offsets[c] - base..offsets[c + 1] - base],
                 )?;
             }

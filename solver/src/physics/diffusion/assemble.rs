@@ -243,6 +243,7 @@ impl Diffusion {
             Conductivity::Tensor(f) => {
                 CellConductivity::Full(cells.into_par_iter().map(|c| f(at(c))).collect())
             }
+            Conductivity::Regional(regional) => regional_conductivity(regional, complex)?,
         };
         Ok(conductivity)
     }
@@ -327,6 +328,12 @@ impl Diffusion {
         // Nodal FE finds each cell's element once for Ω and the load.
         let mut fe_load = None;
         let (incidence, metric, unknowns) = match self.method {
+            // A source per region is loaded apart ([`Self::source_load`]).
+            Method::Fe if self.source_by_region.is_some() => (
+                complex.shared_coboundary(0),
+                fe::stiffness_metric(complex, tensors)?,
+                complex.cell_count(0),
+            ),
             Method::Fe => {
                 let (metric, load) =
                     fe::stiffness_and_load(complex, tensors, &|x| (self.source)(x))
@@ -515,10 +522,20 @@ impl Diffusion {
         let d = complex.embedding_dim();
         let cells = complex.cell_count(n);
         let mut rhs = crate::la::parallel::zeroed(unknowns);
-        match self.method {
-            Method::Fe => rhs = fe::load(complex, &|x| (self.source)(x)).map_err(source_error)?,
-            Method::Dec(kind) => {
+        let sources = self.cell_sources(complex)?;
+        let in_cell = |c: usize, x: &[f64]| sources[c](x);
+        match (self.method, &self.source_by_region) {
+            (Method::Fe, None) => {
+                rhs = fe::load(complex, &|x| (self.source)(x)).map_err(source_error)?
+            }
+            (Method::Fe, Some(_)) => {
+                rhs = fe::load_in_cells(complex, &in_cell).map_err(source_error)?
+            }
+            (Method::Dec(kind), None) => {
                 rhs = dec::load(complex, kind, &|x| (self.source)(x)).map_err(source_error)?
+            }
+            (Method::Dec(kind), Some(_)) => {
+                rhs = dec::load_in_cells(complex, kind, &in_cell).map_err(source_error)?
             }
             _ => {
                 let volume = complex.measure(n);
@@ -526,14 +543,14 @@ impl Diffusion {
                 let at = |c: usize| &centre[c * d..(c + 1) * d];
                 let values: Vec<f64> = (0..cells)
                     .into_par_iter()
-                    .map(|c| (self.source)(at(c)))
+                    .map(|c| sources[c](at(c)))
                     .collect();
                 // The first bad cell in cell order, whatever the threads did.
                 for (c, &v) in values.iter().enumerate() {
                     let v = if v.is_finite() {
                         v
                     } else {
-                        evaluate(&self.source, at(c), Datum::Source)?
+                        evaluate(sources[c], at(c), Datum::Source)?
                     };
                     rhs[c] += v * volume[c];
                 }
@@ -680,4 +697,55 @@ impl Diffusion {
         }
         Ok((rhs, boundary.fixed))
     }
+}
+
+/// A conductivity per region at every cell centroid: scalars stay scalars
+/// when every region's is one.
+fn regional_conductivity(
+    regional: &Regional<Conductivity>,
+    complex: &Complex,
+) -> Result<CellConductivity, DiffusionError> {
+    let n = complex.dim();
+    let d = complex.embedding_dim();
+    let owner = regional.piece_per_cell(complex)?;
+    let centroids = complex.centroid(n);
+    let at = |c: usize| &centroids[c * d..(c + 1) * d];
+    // A region's own conductivity may be per region again (a library
+    // user's choice; case files cannot write it): resolved once per such
+    // piece, on the whole complex.
+    let pieces = regional.pieces().len() + usize::from(regional.default().is_some());
+    let mut nested = Vec::with_capacity(pieces);
+    for i in 0..pieces {
+        nested.push(match regional.piece(i) {
+            Conductivity::Regional(inner) => Some(regional_conductivity(inner, complex)?),
+            _ => None,
+        });
+    }
+    let all_scalar = (0..pieces).all(|i| match regional.piece(i) {
+        Conductivity::Scalar(_) => true,
+        Conductivity::Tensor(_) => false,
+        Conductivity::Regional(_) => matches!(nested[i], Some(CellConductivity::Scalar(_))),
+    });
+    let scalar = |c: usize| -> f64 {
+        match (regional.piece(owner[c]), &nested[owner[c]]) {
+            (Conductivity::Scalar(f), _) => f(at(c)),
+            (_, Some(CellConductivity::Scalar(v))) => v[c],
+            _ => f64::NAN,
+        }
+    };
+    let tensor = |c: usize| -> Tensor {
+        match (regional.piece(owner[c]), &nested[owner[c]]) {
+            (Conductivity::Scalar(f), _) => metric::isotropic(f(at(c))),
+            (Conductivity::Tensor(f), _) => f(at(c)),
+            (_, Some(CellConductivity::Scalar(v))) => metric::isotropic(v[c]),
+            (_, Some(CellConductivity::Full(t))) => t[c],
+            (_, None) => [[f64::NAN; 3]; 3],
+        }
+    };
+    let cells = 0..owner.len();
+    Ok(if all_scalar {
+        CellConductivity::Scalar(cells.into_par_iter().map(scalar).collect())
+    } else {
+        CellConductivity::Full(cells.into_par_iter().map(tensor).collect())
+    })
 }

@@ -272,13 +272,17 @@ pub fn flux_error(
     let face_centre = complex.centroid(n - 1);
     let cell_centre = complex.centroid(n);
     let normal = complex.normal();
-    let exact_density = |f: usize| -> f64 {
+    // Per region, a face takes the conductivity of the cell whose flux is
+    // measured (where K jumps, the exact K∇u·n is continuous but ∇u is not;
+    // the exact gradient is the user's to give on the cell's side).
+    let owner = match &problem.conductivity {
+        Conductivity::Regional(r) => r.piece_per_cell(complex).ok(),
+        _ => None,
+    };
+    let exact_density = |f: usize, cell: usize| -> f64 {
         let x = &face_centre[f * d..(f + 1) * d];
         let g = exact_gradient(x);
-        let k = match &problem.conductivity {
-            Conductivity::Scalar(l) => metric::isotropic(l(x)),
-            Conductivity::Tensor(t) => t(x),
-        };
+        let k = conductivity_at(&problem.conductivity, owner.as_deref(), cell, x);
         let mut kg = [0.0; 3];
         for a in 0..d {
             for b in 0..d {
@@ -310,7 +314,7 @@ pub fn flux_error(
                     [k] => distance(&cell_centre[k * d..(k + 1) * d], xf),
                     _ => continue,
                 };
-                let e = solution.flux[f] / area[f] - exact_density(f);
+                let e = solution.flux[f] / area[f] - exact_density(f, cells[0]);
                 sum += area[f] * d_f * e * e;
             }
         }
@@ -323,7 +327,7 @@ pub fn flux_error(
                 for (f, &s) in col.iter() {
                     let xf = &face_centre[f * d..(f + 1) * d];
                     let d_f = distance(&cell_centre[k * d..(k + 1) * d], xf);
-                    let e = solution.flux[row] / area[f] - f64::from(s) * exact_density(f);
+                    let e = solution.flux[row] / area[f] - f64::from(s) * exact_density(f, k);
                     sum += area[f] * d_f * e * e;
                     row += 1;
                 }
@@ -331,6 +335,21 @@ pub fn flux_error(
         }
     }
     Some(sum.sqrt())
+}
+
+/// K at `x` in top cell `cell`; `owner` is the region index of every cell
+/// for a conductivity per region (a region's own regional conductivity,
+/// which case files cannot write, gives NaN here).
+fn conductivity_at(k: &Conductivity, owner: Option<&[usize]>, cell: usize, x: &[f64]) -> Tensor {
+    match (k, owner) {
+        (Conductivity::Scalar(l), _) => metric::isotropic(l(x)),
+        (Conductivity::Tensor(t), _) => t(x),
+        (Conductivity::Regional(r), Some(owner)) => match r.piece(owner[cell]) {
+            Conductivity::Regional(_) => [[f64::NAN; 3]; 3],
+            piece => conductivity_at(piece, None, cell, x),
+        },
+        (Conductivity::Regional(_), None) => [[f64::NAN; 3]; 3],
+    }
 }
 
 /// Per-cell conservation residual of cell-centred fluxes: for every top

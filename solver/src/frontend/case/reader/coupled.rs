@@ -134,7 +134,7 @@ impl Reader {
             }
             let conductivity = self.coefficient_in(table, &prefix, "conductivity", scope);
             let source = match self.entry(table, &prefix, "source") {
-                Some(_) => self.expression_at(table, &prefix, "source", scope),
+                Some(_) => self.expression_or_regions_at(table, &prefix, "source", scope),
                 None => scope.parse("0").ok(),
             };
             let exact = match self.entry(table, &prefix, "exact") {

@@ -107,7 +107,7 @@ impl Reader {
         scope: &Scope,
     ) -> Option<crate::frontend::case::expr::Expression> {
         match self.entry(table, "problem", key) {
-            Some(_) => self.expression_at(table, "problem", key, scope),
+            Some(_) => self.expression_or_regions_at(table, "problem", key, scope),
             None => {
                 self.error(header, &join("problem", key), "missing", None);
                 None

@@ -3,7 +3,7 @@
 //! check` can list them all).
 
 use super::diagnostic::{Collector, Diagnostics};
-use super::expr::{closest, ExprError, Expression, Scope};
+use super::expr::{closest, ExprError, Expression, Regions, Scope};
 use super::{
     BoundaryKindSpec, BoundarySpec, Case, Coefficient, DiffusionSpec, ExactSpec, GradientMetric,
     GradientSpec, OutputSpec, Problem, SolverKind, SolverSpec,
@@ -37,6 +37,7 @@ pub(super) const TOP_KEYS: &[&str] = &[
     "constants",
     "definitions",
     "mesh",
+    "regions",
     "problem",
     "boundary",
     "exact",
@@ -163,6 +164,7 @@ impl Reader {
         let constants = reader.constants(root, &mut scope);
         reader.definitions(root, &mut scope);
         let (mesh, mesh_spans) = reader.mesh(root, text);
+        let regions = reader.regions(root, &scope);
         let problem = reader.problem(root, &scope);
         let exact = reader.exact(root, &scope);
         let solver = reader.solver(root);
@@ -192,6 +194,7 @@ impl Reader {
                 constants,
                 scope,
                 mesh,
+                regions,
                 problem,
                 exact,
                 solver,
@@ -324,6 +327,15 @@ impl Reader {
             }
             Some(Value::Float(f)) => format_number(*f.value()),
             Some(Value::Integer(i)) => i.value().to_string(),
+            _ if item.is_table_like() => {
+                self.error(
+                    span,
+                    name,
+                    "values per region (a table `{ region = value, default = value }`) are not accepted here".to_string(),
+                    Some(format!("{REGIONAL_KEYS}; give `{name}` one expression (`if(…)` can tell places apart)")),
+                );
+                return None;
+            }
             _ => {
                 let found = describe(item);
                 self.error(
@@ -359,6 +371,55 @@ impl Reader {
                 None
             }
         }
+    }
+
+    /// An expression `<prefix>.<key>` that may be given per region: a
+    /// table of region names (tags of top cells) and an optional `default`,
+    /// each an expression.
+    pub(super) fn expression_or_regions_at(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        key: &str,
+        scope: &Scope,
+    ) -> Option<Expression> {
+        let entry = self.entry(table, prefix, key)?;
+        self.expression_or_regions(&entry, scope)
+    }
+
+    /// [`Reader::expression_or_regions_at`] of an entry already found.
+    pub(super) fn expression_or_regions(
+        &mut self,
+        entry: &Entry,
+        scope: &Scope,
+    ) -> Option<Expression> {
+        let Some(regions) = entry.item.as_table_like() else {
+            return self.expression_of(entry.item, &entry.name, entry.span(), scope);
+        };
+        let mut pieces = Vec::new();
+        let mut default = None;
+        let mut ok = true;
+        for (region, item) in regions.iter() {
+            let name = format!("{}.{region}", entry.name);
+            let span = item.span().or_else(|| entry.span());
+            self.collector.record(&name, span.clone());
+            match self.expression_of(item, &name, span, scope) {
+                Some(e) if region == "default" => default = Some(e),
+                Some(e) => pieces.push((region.to_string(), e)),
+                None => ok = false,
+            }
+        }
+        if ok && pieces.is_empty() {
+            self.error(
+                entry.span(),
+                &entry.name,
+                "a table of values per region names no region".to_string(),
+                Some("write `{ region = value, …, default = value }` with tags of top cells as regions, or give one value".into()),
+            );
+            return None;
+        }
+        let text = entry.item.to_string().trim().to_string();
+        ok.then(|| Expression::per_region(&text, Regions { pieces, default }))
     }
 
     pub(super) fn expression_at(
@@ -456,6 +517,30 @@ impl Reader {
     }
 }
 
+impl Reader {
+    /// `[regions]`: tags of top cells defined by a condition on the
+    /// centroid, `name = "x < 0.5"`, applied when the mesh is built.
+    pub(super) fn regions(
+        &mut self,
+        root: &dyn TableLike,
+        scope: &Scope,
+    ) -> Vec<(String, Expression)> {
+        let Some((table, _)) = self.subtable(root, "", "regions") else {
+            return Vec::new();
+        };
+        let mut regions = Vec::new();
+        for (key, _) in table.iter() {
+            let Some(entry) = self.entry(table, "regions", key) else {
+                continue;
+            };
+            if let Some(e) = self.expression_of(entry.item, &entry.name, entry.span(), scope) {
+                regions.push((key.to_string(), e));
+            }
+        }
+        regions
+    }
+}
+
 pub(super) fn join(prefix: &str, key: &str) -> String {
     if prefix.is_empty() {
         key.to_string()
@@ -489,6 +574,9 @@ pub(super) fn format_number(v: f64) -> String {
         v.to_string()
     }
 }
+
+/// Where values per region are accepted, as messages say it.
+pub(super) const REGIONAL_KEYS: &str = "values per region are accepted by the conductivity and source of diffusion and heat problems (and of coupled fields) and by the Lamé parameters of elasticity";
 
 pub(super) fn expression_help(e: &ExprError, scope: &Scope) -> String {
     match e {

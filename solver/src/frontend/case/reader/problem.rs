@@ -128,7 +128,7 @@ impl Reader {
                 let method = self.method(table, problem_entry.span());
                 let conductivity = self.coefficient(table, "conductivity", scope);
                 let source = match self.entry(table, "problem", "source") {
-                    Some(_) => self.expression_at(table, "problem", "source", scope),
+                    Some(_) => self.expression_or_regions_at(table, "problem", "source", scope),
                     None => scope.parse("0").ok(),
                 };
                 let boundary = self.boundary(root, scope, Conditions::Steady);
@@ -276,7 +276,7 @@ impl Reader {
         };
         let Some(Value::Array(rows)) = entry.item.as_value() else {
             return self
-                .expression_of(entry.item, &entry.name, entry.span(), scope)
+                .expression_or_regions(&entry, scope)
                 .map(Coefficient::Scalar);
         };
         let size = rows.len();

@@ -4,7 +4,10 @@
 //! Parsing and evaluation are exmex's (`+ - * / ^`, `sin cos tan asin acos
 //! atan atan2 sinh cosh tanh exp ln log10 log2 sqrt cbrt abs signum floor
 //! ceil round trunc fract min max`, the constants `PI`/`π`, `TAU`/`τ`, `E`).
-//! On top of that a [`Scope`] supplies `pi` (the usual spelling in
+//! hasse adds comparisons (`< <= > >= == !=`, worth 1 or 0), `&&` and `||`
+//! (a number holds when it is nonzero), and the conditional
+//! `if(condition, value when it holds, value otherwise)`
+//! ([`ops`] says how). On top of that a [`Scope`] supplies `pi` (the usual spelling in
 //! engineering texts), the case's named constants and its definitions:
 //! named expressions that later expressions may use, evaluated point by
 //! point in the order the case file gives them.
@@ -19,10 +22,18 @@
 //! scope.add_definition("r", "sqrt(x^2 + y^2)").unwrap();
 //! let e = scope.parse("k * r * sin(pi * t)").unwrap();
 //! assert!((e.eval(&[3.0, 4.0], 0.5) - 10.0).abs() < 1e-12);
+//! // A conductivity of 20 right of x = 1.2 and 1 elsewhere; a square.
+//! let jump = scope.parse("if(x > 1.2, 20, 1)").unwrap();
+//! assert_eq!((jump.eval(&[1.0], 0.0), jump.eval(&[1.5], 0.0)), (1.0, 20.0));
+//! let square = scope.parse("x > 0 && x < 1 && y > 0 && y < 1").unwrap();
+//! assert_eq!((square.eval(&[0.5, 0.5], 0.0), square.eval(&[0.5, 1.5], 0.0)), (1.0, 0.0));
 //! ```
 
+pub mod ops;
+
 use exmex::prelude::*;
-use exmex::{FloatOpsFactory, MatchLiteral};
+use exmex::MatchLiteral;
+use ops::CaseOps;
 use std::sync::Arc;
 
 /// Number literals with an optional exponent (`2.5e-3`, `1E6`): exmex's own
@@ -59,7 +70,7 @@ impl MatchLiteral for ScientificNumbers {
     }
 }
 
-type Flat = FlatEx<f64, FloatOpsFactory<f64>, ScientificNumbers>;
+type Flat = FlatEx<f64, CaseOps, ScientificNumbers>;
 
 /// Names every expression may use without declaring them.
 pub const COORDINATES: [&str; 4] = ["x", "y", "z", "t"];
@@ -189,7 +200,7 @@ fn syntax_position(text: &str) -> Option<usize> {
         return Some(first);
     }
     text.chars()
-        .position(|c| !(c.is_alphanumeric() || c.is_whitespace() || "+-*/^(),._".contains(c)))
+        .position(|c| !(c.is_alphanumeric() || c.is_whitespace() || "+-*/^(),._<>=!&|".contains(c)))
 }
 
 /// Where (in characters) `name` first stands as a whole word in `text`.
@@ -243,6 +254,19 @@ pub struct Expression {
     /// True when the value depends on neither position nor time.
     constant: bool,
     uses_time: bool,
+    /// Set for a value per region ([`Expression::per_region`]).
+    regions: Option<Arc<Regions>>,
+}
+
+/// A value per region of top cells, as a case writes it:
+/// `conductivity = { steel = 1, copper = "20 + x", default = 5 }`. The
+/// names are tags of top cells, checked against the mesh when it is built.
+#[derive(Clone, Debug)]
+pub struct Regions {
+    /// Each region's expression, in the order written.
+    pub pieces: Vec<(String, Expression)>,
+    /// The expression of cells in no listed region (`default`).
+    pub default: Option<Expression>,
 }
 
 impl Expression {
@@ -261,11 +285,52 @@ impl Expression {
         self.uses_time
     }
 
-    /// The value at `point` (missing coordinates are 0) and time `t`.
+    /// An expression per region; `text` is how the case wrote it.
+    ///
+    /// ```
+    /// use hasse_solver::frontend::case::expr::{Expression, Regions, Scope};
+    /// let scope = Scope::new();
+    /// let regions = Regions {
+    ///     pieces: vec![("copper".into(), scope.parse("20 + x").unwrap())],
+    ///     default: Some(scope.parse("5").unwrap()),
+    /// };
+    /// let k = Expression::per_region("{ copper = \"20 + x\", default = 5 }", regions);
+    /// assert!(!k.is_constant() && k.regions().is_some());
+    /// // A point alone does not say which region it is in.
+    /// assert!(k.eval(&[0.5], 0.0).is_nan());
+    /// ```
+    pub fn per_region(text: &str, regions: Regions) -> Expression {
+        let uses_time = regions
+            .pieces
+            .iter()
+            .map(|(_, e)| e)
+            .chain(&regions.default)
+            .any(Expression::uses_time);
+        let flat = Flat::parse("0").expect("`0` parses");
+        Expression {
+            text: text.to_string(),
+            flat: Box::new(flat),
+            slots: Vec::new(),
+            constant: false,
+            uses_time,
+            regions: Some(Arc::new(regions)),
+        }
+    }
+
+    /// The expressions per region, if the case gave the value so.
+    pub fn regions(&self) -> Option<&Regions> {
+        self.regions.as_deref()
+    }
+
+    /// The value at `point` (missing coordinates are 0) and time `t`; NaN
+    /// for a value per region, which a point alone does not select.
     ///
     /// Division by zero and the like give non-finite values, not errors:
     /// callers check the values they evaluate and say where it happened.
     pub fn eval(&self, point: &[f64], t: f64) -> f64 {
+        if self.regions.is_some() {
+            return f64::NAN;
+        }
         // Almost every expression has a handful of variables: keep them on
         // the stack; this runs once per cell or quadrature point.
         let mut stack = [0.0; 16];
@@ -315,11 +380,11 @@ pub struct Scope {
 
 /// Names exmex already gives a meaning to; a user name equal to one of
 /// them would be parsed as the operator or constant instead.
-const BUILTINS: [&str; 38] = [
+const BUILTINS: [&str; 40] = [
     "abs", "acos", "acosh", "asin", "asinh", "atan", "atan2", "atanh", "cbrt", "ceil", "cos",
     "cosh", "exp", "floor", "fract", "ln", "log", "log10", "log2", "max", "min", "round", "signum",
     "sin", "sinh", "sqrt", "tan", "tanh", "trunc", "PI", "π", "E", "e", "TAU", "τ", "pi", "if",
-    "else",
+    "else", "if_then", "if_else",
 ];
 
 impl Scope {
@@ -389,7 +454,8 @@ impl Scope {
 
     /// Parse `text` against this scope.
     pub fn parse(&self, text: &str) -> Result<Expression, ExprError> {
-        let flat = Flat::parse(text).map_err(|_| ExprError::Syntax {
+        let rewritten = ops::rewrite_conditionals(text)?;
+        let flat = Flat::parse(&rewritten).map_err(|_| ExprError::Syntax {
             text: text.to_string(),
             message: syntax_problem(text, &self.names()),
         })?;
@@ -427,6 +493,7 @@ impl Scope {
             slots,
             constant,
             uses_time,
+            regions: None,
         })
     }
 }
@@ -548,6 +615,52 @@ mod tests {
         let c = scope.parse("pi * 2").unwrap();
         assert!(c.is_constant());
         assert_eq!(c.eval(&[], 0.0), 2.0 * std::f64::consts::PI);
+    }
+
+    #[test]
+    fn comparisons_logic_and_conditionals() {
+        let scope = Scope::new();
+        let at = |text: &str, x: f64, y: f64| scope.parse(text).unwrap().eval(&[x, y], 0.0);
+        // Comparisons bind more loosely than arithmetic: 2 + 1 > 2.5.
+        assert_eq!(at("x + 1 > 2.5", 2.0, 0.0), 1.0);
+        assert_eq!(at("x + 1 > 2.5", 1.0, 0.0), 0.0);
+        assert_eq!(at("x <= 1", 1.0, 0.0), 1.0);
+        assert_eq!(at("x >= 1", 0.5, 0.0), 0.0);
+        assert_eq!(at("x == y", 2.0, 2.0), 1.0);
+        assert_eq!(at("x != y", 2.0, 2.0), 0.0);
+        // && before ||, as in C: 0 || (1 && 0) is 0, (0 || 1) && 0 would be 0
+        // too, so tell them apart with 1 || (0 && 0) = 1 against
+        // (1 || 0) && 0 = 0.
+        assert_eq!(at("x > 0 || y > 0 && y < 0", 1.0, 1.0), 1.0);
+        assert_eq!(at("x < 0 && y > 0", -1.0, 1.0), 1.0);
+        // The conditional takes either branch, whatever the other's value:
+        // ln(x) is NaN for x < 0 but is not chosen there.
+        assert_eq!(at("if(x > 0, ln(x), -1)", -2.0, 0.0), -1.0);
+        assert_eq!(at("if(x > 0, ln(x), -1)", 1.0, 0.0), 0.0);
+        // Nested, inside arithmetic, and with a NaN of its own chosen.
+        assert_eq!(at("2 * if(x < 1, if(y < 1, 1, 2), 3) + 1", 0.0, 5.0), 5.0);
+        assert_eq!(at("2 * if(x < 1, if(y < 1, 1, 2), 3) + 1", 4.0, 0.0), 7.0);
+        assert!(at("if(x > 0, sqrt(-1), 1)", 1.0, 0.0).is_nan());
+        // Wrongly written conditionals are syntax errors that say how.
+        for (text, words) in [
+            ("if(x > 0, 1)", "three arguments"),
+            (
+                "if x > 0",
+                "if(condition, value when it holds, value otherwise)",
+            ),
+            ("if(x > 0, 1, 2", "never closed"),
+        ] {
+            match scope.parse(text) {
+                Err(ExprError::Syntax { message, .. }) => {
+                    assert!(message.contains(words), "{text}: {message}")
+                }
+                other => panic!("{text}: expected a syntax error, got {other:?}"),
+            }
+        }
+        // A name that merely starts with `if` is a variable like any other.
+        let mut scope = Scope::new();
+        scope.add_constant("iff", 3.0).unwrap();
+        assert_eq!(scope.parse("iff + 1").unwrap().eval(&[], 0.0), 4.0);
     }
 
     #[test]

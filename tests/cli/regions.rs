@@ -1,0 +1,160 @@
+//! Data per region (issue 29, item 1): conductivities and sources given
+//! per tag of top cells, regions defined by conditions, and the refusals
+//! of values that do not fit the mesh's tags, made by `hasse check`
+//! before anything is solved.
+//!
+//! The exact solutions are derived by hand in `cases/two-materials.toml`
+//! (piecewise linear, flux continuous across x = 1) and below (a source
+//! on the left half only).
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn hasse(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hasse"))
+        .args(args)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .output()
+        .expect("the hasse binary runs")
+}
+
+fn with_sets<'a>(mut args: Vec<&'a str>, sets: &[&'a str]) -> Vec<&'a str> {
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    args
+}
+
+/// The largest error at the unknowns' points, from the summary's `error`
+/// line of `hasse run` (output off).
+fn max_error(sets: &[&str]) -> f64 {
+    let args = with_sets(
+        vec![
+            "run",
+            "cases/two-materials.toml",
+            "--set",
+            "output.write=false",
+        ],
+        sets,
+    );
+    let out = hasse(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "hasse {args:?} failed:\n{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("error "))
+        .unwrap_or_else(|| panic!("no error line in:\n{stdout}"));
+    let after = line.split("max ").nth(1).expect("a max error");
+    after
+        .split(|c: char| c == ',' || c == ' ')
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("cannot read the max error of `{line}`"))
+}
+
+/// `hasse check` of the two-material case with overrides: must fail; its
+/// stderr.
+fn refused(sets: &[&str]) -> String {
+    let args = with_sets(vec!["check", "cases/two-materials.toml"], sets);
+    let out = hasse(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(!out.status.success(), "hasse {args:?} should fail");
+    stderr
+}
+
+#[test]
+fn two_materials_are_exact_for_methods_that_reproduce_piecewise_linear_fields() {
+    // fe: nodal values; fv and fv-mimetic: cell (and face) values. The
+    // solution is linear in each material with the interface on a mesh
+    // line, so each is exact up to rounding (a few ulps of u ≤ 1, with
+    // condition numbers ~ 20 · n²).
+    for method in ["fe", "fv", "fv-mimetic"] {
+        let set = format!("problem.method=\"{method}\"");
+        let error = max_error(&[&set]);
+        assert!(error < 1e-12, "{method}: max error {error:e}");
+    }
+    // The same plate on triangles (fe) is exact too.
+    let error = max_error(&["mesh.cells=\"simplex\""]);
+    assert!(error < 1e-12, "fe on triangles: max error {error:e}");
+    // One conductivity everywhere is wrong by O(1): the check can fail.
+    let uniform = max_error(&["problem.conductivity=1"]);
+    assert!(uniform > 0.1, "uniform conductivity: max error {uniform:e}");
+}
+
+#[test]
+fn a_source_per_region_is_integrated_over_its_own_cells() {
+    // K = 1, f = 2 on x < 1 and 0 beyond, u(0) = u(2) = 0, insulated top
+    // and bottom: u = 3x/2 − x² on [0, 1] and (2 − x)/2 on [1, 2] (u and
+    // u′ continuous at 1). Q1 on a grid reduces to 1D P1, which is exact
+    // at the nodes.
+    let error = max_error(&[
+        "problem.conductivity=1",
+        "problem.source={ insulation = 2, default = 0 }",
+        "boundary.1.value=0",
+        "exact.solution=\"if(x < 1, 1.5*x - x^2, (2 - x)/2)\"",
+    ]);
+    assert!(error < 1e-12, "max error {error:e}");
+}
+
+#[test]
+fn values_that_do_not_fit_the_regions_are_refused_before_solving() {
+    // A cell in no listed region and no default: the first such cell,
+    // and the tags of top cells the mesh has.
+    let e = refused(&["problem.conductivity={ copper = 20 }"]);
+    assert!(e.contains("`problem.conductivity`"), "{e}");
+    assert!(e.contains("top cell 0"), "{e}");
+    assert!(
+        e.contains("the mesh's tags of top cells: copper, insulation"),
+        "{e}"
+    );
+    // A region the mesh does not have.
+    let e = refused(&["problem.conductivity={ steel = 1, default = 2 }"]);
+    assert!(e.contains("no tag `steel` in the mesh"), "{e}");
+    // A boundary tag is not a region.
+    let e = refused(&["problem.source={ xmin = 1, default = 0 }"]);
+    assert!(e.contains("tag `xmin` names 1-cells"), "{e}");
+    // Overlapping regions give a cell two values.
+    let e = refused(&[
+        "regions.left_half=\"x < 1.5\"",
+        "problem.conductivity={ copper = 20, left_half = 1 }",
+    ]);
+    assert!(e.contains("is in both `copper` and `left_half`"), "{e}");
+    // A region defined by a condition may not reuse a tag's name, and
+    // must select some cell.
+    let e = refused(&["regions.xmin=\"x < 1\""]);
+    assert!(
+        e.contains("`regions.xmin`") && e.contains("already has a tag `xmin`"),
+        "{e}"
+    );
+    let e = refused(&["regions.nowhere=\"x > 5\""]);
+    assert!(e.contains("holds at no top cell's centroid"), "{e}");
+    // Keys that take one expression say where tables are accepted.
+    let e = refused(&["boundary.0.value={ copper = 1 }"]);
+    assert!(
+        e.contains("values per region") && e.contains("not accepted here"),
+        "{e}"
+    );
+}
+
+#[test]
+fn heat_with_a_conductivity_per_region_settles_on_the_two_material_profile() {
+    // Backward Euler from u = 0 with dt = 1000: each step divides the
+    // slowest mode by 1 + λ₁ dt with λ₁ ≥ (π/4)²·1 for this plate, so
+    // after 5 steps the transient is below (1 + 600)⁻⁵ ≈ 1e-14 of the steady profile of
+    // `two-materials.toml`.
+    for method in ["fv", "fe"] {
+        let set = format!("problem.method=\"{method}\"");
+        let error = max_error(&[
+            "problem.kind=\"heat\"",
+            "problem.initial=0",
+            "time.dt=1000",
+            "time.steps=5",
+            &set,
+        ]);
+        assert!(error < 1e-12, "heat {method}: max error {error:e}");
+    }
+}
