@@ -546,6 +546,11 @@ fn run_case(
             (None, Some(stream)) => stream.finish(complex, &mut result),
             (None, None) => run::write_output(&case, complex, &result, &stem),
         };
+        // A transient run's quantities of interest, level by level.
+        let written = written.and_then(|files| {
+            let csv = run::write_quantities_csv(&stem, &result.report_json(complex))?;
+            Ok((files, csv))
+        });
         match written {
             Ok(files) => Some(files),
             Err(e) => {
@@ -581,10 +586,11 @@ fn run_case(
             println!("finest     re-solved with the case's own solver for the output:");
         }
         print!("{result}");
-        if let Some(files) = written {
+        if let Some((files, csv)) = written {
             let mut names = vec![files.hdf5.display().to_string()];
             names.push(files.xdmf.display().to_string());
             names.extend(files.extra_xdmf.iter().map(|p| p.display().to_string()));
+            names.extend(csv.iter().map(|p| p.display().to_string()));
             println!("output     {}", names.join(", "));
         }
     } else {

@@ -27,4 +27,5 @@ mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
 mod method_warnings;
+mod quantities;
 mod regions;

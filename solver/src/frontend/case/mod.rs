@@ -35,11 +35,13 @@
 pub mod diagnostic;
 pub mod expr;
 mod problem;
+mod quantity;
 mod reader;
 mod regions;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use problem::*;
+pub use quantity::{QuantityKind, QuantitySpec};
 
 use crate::frontend::mesh_spec::{MeshError, MeshSpec};
 use crate::la::direct::Factorization;
@@ -162,7 +164,7 @@ impl Default for SolverSpec {
 /// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [2, 2]\n[problem]\nmethod = \"fv\"\n";
 /// // By default the stem is the case file's, in the working directory.
 /// let output = Case::from_text("cases/plate.toml", text, &[]).unwrap().output;
-/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true });
+/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true, quantities: vec![] });
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct OutputSpec {
@@ -172,6 +174,21 @@ pub struct OutputSpec {
     pub name: String,
     /// Whether to write files at all.
     pub write: bool,
+    /// `[[output.quantity]]` tables, in order.
+    pub quantities: Vec<QuantitySpec>,
+}
+
+/// One `[regions]` entry: `name = "condition"` tags the top cells whose
+/// centroid satisfies the condition; `name = { faces = "condition" }` the
+/// (n−1)-cells (an interface to measure a flux across).
+#[derive(Clone, Debug)]
+pub struct RegionSpec {
+    /// The tag's name.
+    pub name: String,
+    /// The condition on the centroid (nonzero where it holds).
+    pub condition: Expression,
+    /// Whether it tags (n−1)-cells instead of top cells.
+    pub faces: bool,
 }
 
 /// A case file, read and checked.
@@ -216,9 +233,9 @@ pub struct Case {
     pub scope: Scope,
     /// `[mesh]`: how to build the complex ([`Case::build_mesh`]).
     pub mesh: MeshSpec,
-    /// `[regions]`: tags of top cells defined by a condition on their
-    /// centroids, added to the mesh when it is built.
-    pub regions: Vec<(String, Expression)>,
+    /// `[regions]`: tags defined by a condition on the centroids of top
+    /// cells (or of (n−1)-cells), added to the mesh when it is built.
+    pub regions: Vec<RegionSpec>,
     /// `[problem]` and its boundary conditions.
     pub problem: Problem,
     /// `[exact]`, if given.
@@ -310,6 +327,7 @@ impl Case {
         };
         self.apply_regions(&mut complex, &mut collector);
         self.check_regional_data(&complex, &mut collector);
+        self.check_quantities(&complex, &mut collector);
         {
             let n = complex.dim();
             let available: Vec<String> = complex

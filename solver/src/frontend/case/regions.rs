@@ -12,11 +12,11 @@ impl Case {
     /// Tag the top cells whose centroid satisfies each `[regions]`
     /// condition (a nonzero value).
     pub(super) fn apply_regions(&self, complex: &mut Complex, collector: &mut Collector) {
-        let n = complex.dim();
-        let centroids = complex.centroid(n).to_vec();
         let d = complex.embedding_dim();
-        for (name, condition) in &self.regions {
+        for region in &self.regions {
+            let name = &region.name;
             let key = format!("regions.{name}");
+            let dim = complex.dim() - usize::from(region.faces);
             if complex.tag(name).is_some() {
                 collector.error(
                     None,
@@ -26,9 +26,10 @@ impl Case {
                 );
                 continue;
             }
-            let cells: Vec<usize> = (0..complex.cell_count(n))
+            let centroids = complex.centroid(dim);
+            let cells: Vec<usize> = (0..complex.cell_count(dim))
                 .filter(|&c| {
-                    let v = condition.eval(&centroids[c * d..(c + 1) * d], 0.0);
+                    let v = region.condition.eval(&centroids[c * d..(c + 1) * d], 0.0);
                     v != 0.0 && !v.is_nan()
                 })
                 .collect();
@@ -36,12 +37,16 @@ impl Case {
                 collector.error(
                     None,
                     &key,
-                    format!("`{}` holds at no top cell's centroid", condition.text()),
-                    Some("a region is the set of top cells whose centroid satisfies the condition; check the comparison and the mesh's extent".into()),
+                    format!(
+                        "`{}` holds at no {}'s centroid",
+                        region.condition.text(),
+                        if region.faces { "(n−1)-cell" } else { "top cell" }
+                    ),
+                    Some("a region is the set of cells whose centroid satisfies the condition; check the comparison and the mesh's extent (compare coordinates of faces with a tolerance, e.g. abs(x - 1) < 1e-9)".into()),
                 );
                 continue;
             }
-            if let Err(e) = complex.set_tag(name, n, cells) {
+            if let Err(e) = complex.set_tag(name, dim, cells) {
                 collector.error(None, &key, e.to_string(), None);
             }
         }
@@ -67,6 +72,98 @@ impl Case {
                     RegionError::UnknownTag { .. } | RegionError::NotTopCells { .. } => "regions are tags of top cells: Gmsh physical groups of the mesh's dimension, or conditions under [regions]",
                 };
                 collector.error(None, &key, e.to_string(), Some(help.to_string()));
+            }
+        }
+    }
+}
+
+impl Case {
+    /// Refuse quantities whose tag or region the mesh does not have, a
+    /// flux across interior (n−1)-cells with a nodal method, and
+    /// quantities of problems that do not compute them.
+    pub(super) fn check_quantities(&self, complex: &Complex, collector: &mut Collector) {
+        use super::{Problem, QuantityKind};
+        let n = complex.dim();
+        for q in &self.output.quantities {
+            match (&self.problem, q.kind) {
+                (Problem::Diffusion(_), _) => {}
+                (Problem::Heat(_), QuantityKind::Flux) => {
+                    collector.error(
+                        None,
+                        &format!("{}.type", q.key),
+                        "fluxes of heat runs are not computed yet (integrals, means, minima and maxima are, at every saved level)",
+                        Some("measure the flux in the steady problem (kind = \"diffusion\"), or remove this quantity".into()),
+                    );
+                    continue;
+                }
+                (Problem::Heat(_), _) => {}
+                _ => {
+                    collector.error(
+                        None,
+                        &q.key,
+                        "quantities are computed for diffusion and heat problems",
+                        Some("remove the [[output.quantity]] tables of this case".into()),
+                    );
+                    continue;
+                }
+            }
+            let (name, dim, what) = match (&q.tag, &q.region) {
+                (Some(tag), _) => (tag, n - 1, "tag"),
+                (None, Some(region)) => (region, n, "region"),
+                (None, None) => continue,
+            };
+            let key = format!("{}.{what}", q.key);
+            let candidates: Vec<String> = complex
+                .tags()
+                .iter()
+                .filter(|(_, t)| t.dim == dim)
+                .map(|(n, _)| n.to_string())
+                .collect();
+            let Some(tag) = complex.tag(name) else {
+                collector.error(
+                    None,
+                    &key,
+                    format!("no tag `{name}` in the mesh"),
+                    Some(format!(
+                        "its tags of {dim}-cells: {}",
+                        candidates.join(", ")
+                    )),
+                );
+                continue;
+            };
+            if tag.dim != dim {
+                collector.error(
+                    None,
+                    &key,
+                    format!(
+                        "tag `{name}` names {}-cells; a {} needs {dim}-cells",
+                        tag.dim,
+                        q.kind.name()
+                    ),
+                    Some(format!(
+                        "its tags of {dim}-cells: {}",
+                        candidates.join(", ")
+                    )),
+                );
+                continue;
+            }
+            let nodal = self
+                .method()
+                .is_some_and(|m| m.location() == crate::metric::Location::Nodal);
+            if q.kind == QuantityKind::Flux && nodal {
+                let top = complex.boundary(n);
+                if let Some(&f) = tag
+                    .cells
+                    .iter()
+                    .find(|&&f| top.outer_view(f).map_or(0, |r| r.nnz()) != 1)
+                {
+                    collector.error(
+                        None,
+                        &key,
+                        format!("tag `{name}` has interior (n−1)-cells (cell {f}, at {:?}); a flux across them is computed for the cell-centred methods (fv, fd, fv-mimetic), whose unknowns make face fluxes", complex.centroid_of(n - 1, f)),
+                        Some("use a boundary tag, or a cell-centred method".into()),
+                    );
+                }
             }
         }
     }

@@ -125,7 +125,7 @@ pub(super) fn solve_diffusion(
     } else {
         check_residual(case, report.relative_residual, &mut warnings)?;
     }
-    let notes = match &solution.iterations {
+    let mut notes = match &solution.iterations {
         Some(cg) => vec![(
             "iterative".to_string(),
             format!(
@@ -231,6 +231,9 @@ pub(super) fn solve_diffusion(
             (Some(errors), flux_error)
         }
     };
+    let quantities = super::quantities::diffusion_quantities(case, &problem, complex, &solution)
+        .map_err(|e| diffusion_error(case, &keys, e))?;
+    notes.extend(quantities.notes);
     timings.push(("post-processing".into(), post.elapsed().as_secs_f64()));
     timings.push(("assembly + solve".into(), total));
     Ok(RunResult {
@@ -251,7 +254,7 @@ pub(super) fn solve_diffusion(
         pure_neumann: solution.pure_neumann,
         series: Vec::new(),
         notes,
-        report: serde_json::Map::new(),
+        report: quantities.report,
     })
 }
 

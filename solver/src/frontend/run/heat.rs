@@ -127,6 +127,8 @@ pub(super) fn solve_streaming<'a>(
     // be written while the run goes on.
     let mut series = Vec::new();
     let mut level_errors = Vec::new();
+    let mut level_quantities = Vec::new();
+    let location = heat.at(time.start).location();
     let mut post_seconds = 0.0;
     let mut stream_seconds = 0.0;
     // Progress on long runs: at most ~100 updates, each a phase message.
@@ -142,6 +144,8 @@ pub(super) fn solve_streaming<'a>(
                     time: t, field: u, ..
                 } => {
                     let post = Instant::now();
+                    level_quantities
+                        .push(super::quantities::level_values(case, complex, u, location));
                     let mut fields = vec![
                         Cochain::new("u", dim, u.to_vec()).with_description("the temperature")
                     ];
@@ -221,7 +225,9 @@ pub(super) fn solve_streaming<'a>(
         0.5 => "Crank–Nicolson".to_string(),
         t => format!("θ = {t}"),
     };
-    let notes = vec![(
+    let quantities = super::quantities::heat_quantities(case, &history.times, &level_quantities);
+    report.extend(quantities.report);
+    let mut notes = vec![(
         "time".to_string(),
         format!(
             "{} steps of dt = {} from t = {} to {} ({scheme}), {} levels saved\none factorisation {:.3} s, {:.3} ms per step ({:.3} ms in solves)",
@@ -235,6 +241,7 @@ pub(super) fn solve_streaming<'a>(
             1e3 * history.solve_seconds_per_step,
         ),
     )];
+    notes.extend(quantities.notes);
     let mut timings = vec![
         ("factorisation".to_string(), history.factorization_seconds),
         (

@@ -23,6 +23,7 @@
 //! = 0 up to quadrature error), and the solution with zero mean is returned.
 
 mod assemble;
+mod balance;
 mod norms;
 mod post;
 mod solve;

@@ -24,6 +24,7 @@ mod elasticity;
 mod kinds;
 mod overrides;
 mod problem;
+mod quantities;
 mod sections;
 #[cfg(test)]
 mod tests;
@@ -105,7 +106,7 @@ pub(super) const SOLVER_KEYS: &[&str] = &[
     "prolongation",
     "ordering",
 ];
-pub(super) const OUTPUT_KEYS: &[&str] = &["directory", "name", "write"];
+pub(super) const OUTPUT_KEYS: &[&str] = &["directory", "name", "write", "quantity"];
 pub(super) const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "tolerance"];
 pub(super) const STRATEGIES: &[&str] = &[
     "uniform",
@@ -518,13 +519,14 @@ impl Reader {
 }
 
 impl Reader {
-    /// `[regions]`: tags of top cells defined by a condition on the
-    /// centroid, `name = "x < 0.5"`, applied when the mesh is built.
+    /// `[regions]`: tags defined by a condition on the centroid,
+    /// `name = "x < 0.5"` (top cells) or `name = { faces = "x == 1" }`
+    /// ((n−1)-cells), applied when the mesh is built.
     pub(super) fn regions(
         &mut self,
         root: &dyn TableLike,
         scope: &Scope,
-    ) -> Vec<(String, Expression)> {
+    ) -> Vec<super::RegionSpec> {
         let Some((table, _)) = self.subtable(root, "", "regions") else {
             return Vec::new();
         };
@@ -533,8 +535,25 @@ impl Reader {
             let Some(entry) = self.entry(table, "regions", key) else {
                 continue;
             };
-            if let Some(e) = self.expression_of(entry.item, &entry.name, entry.span(), scope) {
-                regions.push((key.to_string(), e));
+            let (item, name, span, faces) = match entry.item.as_table_like() {
+                Some(inner) => {
+                    self.check_keys(inner, &entry.name, &["faces"]);
+                    match self.entry(inner, &entry.name, "faces") {
+                        Some(e) => (e.item, e.name.clone(), e.span(), true),
+                        None => {
+                            self.error(entry.span(), &entry.name, "a table here is `{ faces = \"condition\" }`", Some("give a condition string for a region of top cells, or faces = \"…\" for (n−1)-cells".into()));
+                            continue;
+                        }
+                    }
+                }
+                None => (entry.item, entry.name.clone(), entry.span(), false),
+            };
+            if let Some(condition) = self.expression_of(item, &name, span, scope) {
+                regions.push(super::RegionSpec {
+                    name: key.to_string(),
+                    condition,
+                    faces,
+                });
             }
         }
         regions

@@ -408,6 +408,7 @@ impl Reader {
             directory: PathBuf::from("."),
             name: stem,
             write: true,
+            quantities: Vec::new(),
         };
         let Some((table, _)) = self.subtable(root, "", "output") else {
             return spec;
@@ -435,6 +436,7 @@ impl Reader {
                 None => self.type_error(&e, "true or false"),
             }
         }
+        spec.quantities = self.quantities(table);
         spec
     }
 }
