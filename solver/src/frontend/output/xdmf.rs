@@ -1,7 +1,7 @@
 //! The XDMF 3 texts: one document per cochain degree grid, each pointing
 //! into the same h5 file.
 
-use super::topology::{grid_topology, GridTopology};
+use super::topology::{grid_topology, GridTopology, Polygons};
 use super::{Cochain, Levels, MeshAt, OutputError};
 use std::fmt::Write;
 
@@ -22,18 +22,27 @@ pub(crate) fn degrees(levels: &Levels) -> Vec<usize> {
 }
 
 /// The grids of every mesh: `grids[m][i]` is the grid of the cells of
-/// degree `degrees[i]` of `levels.meshes[m]`.
+/// degree `degrees[i]` of `levels.meshes[m]`. In a series whose mesh
+/// changes, polygons of five or more vertices are written as triangles:
+/// each level has a file that `meshio.read` must open (see
+/// [`level_document`]), and meshio reads no `Polygon` cell. A one-mesh
+/// output keeps its polygons, as it always has.
 pub(crate) fn grids(
     levels: &Levels,
     degrees: &[usize],
 ) -> Result<Vec<Vec<GridTopology>>, OutputError> {
+    let polygons = if levels.mesh_changes {
+        Polygons::Triangulate
+    } else {
+        Polygons::Keep
+    };
     levels
         .meshes
         .iter()
         .map(|mesh| {
             degrees
                 .iter()
-                .map(|&p| grid_topology(mesh.complex, p))
+                .map(|&p| grid_topology(mesh.complex, p, polygons))
                 .collect()
         })
         .collect()
