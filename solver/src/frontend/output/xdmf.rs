@@ -129,6 +129,10 @@ impl<'a> Files<'a> {
     }
 }
 
+const HEADER: &str =
+    "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n";
+const FOOTER: &str = "  </Domain>\n</Xdmf>\n";
+
 /// The XDMF document of the grid of degree `degrees[i]` (its grids are
 /// `grids[m][i]`, see [`grids`]), reading `files`. One grid per document,
 /// because `meshio.read` accepts only a domain holding a single uniform
@@ -142,9 +146,7 @@ pub(crate) fn document(
     i: usize,
     files: &Files,
 ) -> String {
-    let mut out = String::new();
-    out.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
-    out.push_str("<Xdmf Version=\"3.0\">\n  <Domain>\n");
+    let mut out = String::from(HEADER);
     let grid = Grid {
         levels,
         grids,
@@ -167,7 +169,33 @@ pub(crate) fn document(
             out.push_str("    </Grid>\n");
         }
     }
-    out.push_str("  </Domain>\n</Xdmf>\n");
+    out.push_str(FOOTER);
+    out
+}
+
+/// The XDMF document of level `k` alone on the grid of degree
+/// `degrees[i]`: one plain uniform grid (level k's mesh and fields),
+/// without `<Time>`, which `meshio.read` rejects ("Unknown section"). The
+/// file a reader without support for a changing mesh opens, one level at a
+/// time.
+pub(crate) fn level_document(
+    levels: &Levels,
+    grids: &[Vec<GridTopology>],
+    i: usize,
+    k: usize,
+    files: &Files,
+) -> String {
+    let mut out = String::from(HEADER);
+    let grid = Grid {
+        levels,
+        grids,
+        i,
+        mesh_h5: escape(files.mesh),
+        level_h5: files.level,
+    };
+    let mesh = levels.steps.get(k).map_or(0, |s| s.mesh);
+    grid.uniform(&mut out, mesh, Some(k), false, 4);
+    out.push_str(FOOTER);
     out
 }
 
@@ -198,7 +226,16 @@ impl Grid<'_> {
         let n = levels.dim();
         let pad = " ".repeat(indent);
         let name = grid_name(grid.degree, n);
-        let _ = writeln!(out, "{pad}<Grid Name=\"{name}\" GridType=\"Uniform\">");
+        // The grids of a collection whose mesh changes leave `GridType` at
+        // its default, Uniform: meshio's `TimeSeriesReader` looks for a grid
+        // that names its type and, finding none, refuses the file ("Couldn't
+        // find the mesh grid") instead of pairing every level's fields with
+        // level 0's mesh. ParaView's XDMF readers follow the default.
+        if timed && levels.mesh_changes {
+            let _ = writeln!(out, "{pad}<Grid Name=\"{name}\">");
+        } else {
+            let _ = writeln!(out, "{pad}<Grid Name=\"{name}\" GridType=\"Uniform\">");
+        }
         let level = step.and_then(|k| levels.steps.get(k).map(|s| (k, s)));
         if let (true, Some((_, s))) = (timed, level) {
             let _ = writeln!(out, "{pad}  <Time Value=\"{}\"/>", float(s.time));
