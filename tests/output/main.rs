@@ -12,3 +12,4 @@ mod scratch;
 mod level_files;
 mod output_files;
 mod output_python;
+mod refine_series;
