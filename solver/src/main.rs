@@ -63,7 +63,9 @@ enum Command {
     /// chain map, and re-solves by multigrid-CG from the moved solution,
     /// the earlier meshes being the coarse levels (the table shows the
     /// estimator, the errors, the iterations and where CG started).
-    /// Options override the case's `[refine]` table. Output: the final mesh.
+    /// Options override the case's `[refine]` table. Output: every level,
+    /// OUT.xdmf as a series (level k at time k) and OUT.level-K.xdmf each
+    /// level alone (see cases/OUTPUT.md).
     ///
     /// Example: hasse refine cases/l-shape-adaptive.toml --steps 4
     #[command(verbatim_doc_comment)]
@@ -478,7 +480,7 @@ fn run_case(
     // output, so that an interrupted or failed run keeps them.
     let mut stream = writing.then(|| run::LevelStream::new(&case, &stem));
     // With a [refine] table the case is solved, refined and re-solved; the
-    // output holds the final mesh and its solution.
+    // output holds every level, each on its own mesh.
     let (refined, study, result) = match &case.refine {
         None => {
             let result = run::solve_streaming(&case, &complex, stream.as_mut(), &mut |name| {
@@ -592,6 +594,24 @@ fn run_case(
             names.extend(files.extra_xdmf.iter().map(|p| p.display().to_string()));
             names.extend(csv.iter().map(|p| p.display().to_string()));
             println!("output     {}", names.join(", "));
+            // A refinement also wrote each level alone (for readers that
+            // take one mesh per file); name the first and the last.
+            let level_file = |files: Option<&Vec<PathBuf>>| {
+                files
+                    .and_then(|f| f.first())
+                    .map(|p| p.display().to_string())
+            };
+            match (
+                level_file(files.levels.first()),
+                level_file(files.levels.last()),
+            ) {
+                (Some(first), Some(last)) if files.levels.len() > 1 => println!(
+                    "levels     {first} … {last} (each level alone, {} files)",
+                    files.levels.iter().map(Vec::len).sum::<usize>()
+                ),
+                (Some(only), _) => println!("levels     {only} (the level alone)"),
+                _ => {}
+            }
         }
     } else {
         for w in &result.warnings {

@@ -9,5 +9,7 @@ mod pyenv;
 #[path = "../common/scratch.rs"]
 mod scratch;
 
+mod level_files;
 mod output_files;
 mod output_python;
+mod refine_series;

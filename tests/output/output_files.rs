@@ -980,11 +980,17 @@ fn data_item<'x>(grid: &'x str, tag: &str) -> (&'x str, &'x str) {
     (dims, text)
 }
 
-/// The uniform grids of a document, in order.
+/// The uniform grids of a document, in order: those that say so, and in
+/// a series whose mesh changes those that leave `GridType` at its default
+/// (Uniform).
 fn uniform_grids<'x>(xml: &'x str, name: &str) -> Vec<&'x str> {
-    let open = format!("<Grid Name=\"{name}\" GridType=\"Uniform\">");
+    let open = format!("<Grid Name=\"{name}\"");
     xml.split(open.as_str())
         .skip(1)
+        .filter_map(|g| {
+            g.strip_prefix(" GridType=\"Uniform\">")
+                .or_else(|| g.strip_prefix('>'))
+        })
         .map(|g| &g[..g.find("</Grid>").unwrap()])
         .collect()
 }
@@ -1002,10 +1008,18 @@ fn a_refinement_series_stores_each_mesh_with_its_step() {
     assert_eq!(files.hdf5, dir.join("refine.h5"));
     assert_eq!(files.xdmf, dir.join("refine.xdmf"));
     assert_eq!(files.extra_xdmf, [dir.join("refine.edges.xdmf")]);
-    assert_eq!(
-        files_in(&dir),
-        ["refine.edges.xdmf", "refine.h5", "refine.xdmf"]
-    );
+    // Besides the series, each level alone, its top cells and its edges.
+    let mut names: Vec<String> = ["refine.edges.xdmf", "refine.h5", "refine.xdmf"]
+        .map(String::from)
+        .to_vec();
+    for k in 0..3 {
+        let top = format!("refine.level-{k}.xdmf");
+        let edges = format!("refine.level-{k}.edges.xdmf");
+        assert_eq!(files.levels[k], [dir.join(&top), dir.join(&edges)]);
+        names.extend([top, edges]);
+    }
+    names.sort();
+    assert_eq!(files_in(&dir), names);
 
     let f = open(&files.hdf5);
     let root_u64 = |name: &str| f.attr(name).unwrap().read_scalar::<u64>().unwrap();
@@ -1300,5 +1314,16 @@ fn a_bad_mesh_series_is_rejected_before_anything_is_written() {
             .unwrap(),
         1
     );
-    assert_eq!(files_in(&dir), ["bad.edges.xdmf", "bad.h5", "bad.xdmf"]);
+    assert_eq!(
+        files_in(&dir),
+        [
+            "bad.edges.xdmf",
+            "bad.h5",
+            "bad.level-0.edges.xdmf",
+            "bad.level-0.xdmf",
+            "bad.level-1.edges.xdmf",
+            "bad.level-1.xdmf",
+            "bad.xdmf"
+        ]
+    );
 }

@@ -5,8 +5,9 @@
 //! series) and compares with the values this test computes from analytic
 //! formulas. A series whose mesh changes (`write_mesh_series`) is read
 //! with h5py step by step, its XDMF files are parsed with `xml.etree` to
-//! check that grid k points at step k's mesh, and meshio's
-//! `TimeSeriesReader` is shown to give the first step's mesh only.
+//! check that grid k points at step k's mesh, `meshio.read` opens each
+//! level's own files (`<stem>.level-<k>[.edges].xdmf`) with that level's
+//! mesh and fields, and meshio's `TimeSeriesReader` refuses the series.
 //!
 //! Python runs in a private venv at `<target>/pyenv` (see
 //! `tests/common/pyenv.rs`). Without network the test fails under `CI` and is
@@ -347,6 +348,16 @@ fn mesh_series_case(dir: &Path) -> Value {
     };
     let files = write_mesh_series(&dir.join("growing"), &series).unwrap();
     assert_eq!(files.extra_xdmf, [dir.join("growing.edges.xdmf")]);
+    // Each level alone: its top cells and its edges.
+    let expected_levels: Vec<Vec<_>> = (0..meshes.len())
+        .map(|k| {
+            vec![
+                dir.join(format!("growing.level-{k}.xdmf")),
+                dir.join(format!("growing.level-{k}.edges.xdmf")),
+            ]
+        })
+        .collect();
+    assert_eq!(files.levels, expected_levels);
     let steps: Vec<Value> = meshes
         .iter()
         .map(|(t, k, kind, nodes)| {
@@ -370,6 +381,7 @@ fn mesh_series_case(dir: &Path) -> Value {
         "h5": files.hdf5,
         "xdmf": files.xdmf,
         "edges_xdmf": files.extra_xdmf[0],
+        "levels": files.levels,
         "dim": 2,
         "times": meshes.iter().map(|m| m.0).collect::<Vec<_>>(),
         "steps": steps,

@@ -21,35 +21,53 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
     let n = levels.dim();
     let final_h5 = dir.join(&h5_name);
     let final_xdmf = dir.join(format!("{file_name}.xdmf"));
+    // A series whose mesh changes also gets one document per level and
+    // degree, `<stem>.level-<k>[.<grid>].xdmf`: readers that take one mesh
+    // per file (meshio) open those, while `<stem>.xdmf` is the series.
+    let mut level_files: Vec<Vec<PathBuf>> = Vec::new();
+    let mut documents = Vec::new();
+    if levels.mesh_changes {
+        for k in 0..levels.steps.len() {
+            let mut of_level = Vec::new();
+            for (i, &p) in degrees.iter().enumerate() {
+                let grid = (i > 0).then(|| xdmf::grid_name(p, n));
+                let path = dir.join(level_file_name(&file_name, k, grid));
+                of_level.push(path.clone());
+                documents.push((path, xdmf::level_document(levels, &grids, i, k, &files)));
+            }
+            level_files.push(of_level);
+        }
+    }
     // One XDMF document per degree: the top grid (first in `degrees`) under
     // `<stem>.xdmf`, each lower degree under `<stem>.<grid>.xdmf`.
     let mut extra_xdmf = Vec::new();
-    let mut documents = Vec::new();
-    for (i, &p) in degrees.iter().enumerate() {
-        let text = xdmf::document(levels, &grids, i, &files);
-        if i == 0 {
-            documents.push((final_xdmf.clone(), text));
-        } else {
-            let path = dir.join(format!("{file_name}.{}.xdmf", xdmf::grid_name(p, n)));
-            extra_xdmf.push(path.clone());
-            documents.push((path, text));
-        }
+    for (i, &p) in degrees.iter().enumerate().skip(1) {
+        let path = dir.join(format!("{file_name}.{}.xdmf", xdmf::grid_name(p, n)));
+        extra_xdmf.push(path.clone());
+        documents.push((path, xdmf::document(levels, &grids, i, &files)));
     }
     // Rename order: the h5 first, because no xdmf may point at a file that
     // is not there; the main xdmf last, because it is the one users open,
     // so once it appears the whole output is in place.
-    documents.rotate_left(1);
+    documents.push((
+        final_xdmf.clone(),
+        xdmf::document(levels, &grids, 0, &files),
+    ));
 
     let tag = temporary_tag();
     let mut finals = vec![final_h5.clone()];
     finals.extend(documents.iter().map(|(path, _)| path.clone()));
     let mut temps = Temporaries(finals.iter().map(|path| temporary(path, &tag)).collect());
+    // Level documents of an earlier output under this stem, and the
+    // temporaries of killed writers of any of them.
+    let earlier_levels = level_files_in(&dir, &file_name);
     let mut known = finals.clone();
     known.extend(
         LOWER_GRID_NAMES
             .iter()
             .map(|grid| dir.join(format!("{file_name}.{grid}.xdmf"))),
     );
+    known.extend(earlier_levels.iter().cloned());
     remove_orphaned_temporaries(&dir, &known);
 
     hdf5_file::write(&temps.0[0], levels, &grids, &rfc3339_now())?;
@@ -66,11 +84,14 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
         rename(&temps.0[0], target)?;
         temps.0.remove(0);
     }
-    // Degree files of an earlier output under this stem that this run does
-    // not have would point at datasets the new h5 may lack: remove them.
-    for grid_name in LOWER_GRID_NAMES {
-        let path = dir.join(format!("{file_name}.{grid_name}.xdmf"));
-        if extra_xdmf.contains(&path) {
+    // Degree and level files of an earlier output under this stem that this
+    // run does not have would point at datasets the new h5 may lack (a
+    // level it has fewer of, a degree without cochains): remove them.
+    let stale_degrees = LOWER_GRID_NAMES
+        .iter()
+        .map(|grid_name| dir.join(format!("{file_name}.{grid_name}.xdmf")));
+    for path in stale_degrees.chain(earlier_levels) {
+        if finals.contains(&path) {
             continue;
         }
         remove_if_present(&path)?;
@@ -79,7 +100,57 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
         hdf5: final_h5,
         xdmf: final_xdmf,
         extra_xdmf,
+        levels: level_files,
     })
+}
+
+/// `<stem>.level-<k>.xdmf`, or `<stem>.level-<k>.<grid>.xdmf` for a lower
+/// degree's grid.
+fn level_file_name(file_name: &str, k: usize, grid: Option<&str>) -> String {
+    match grid {
+        None => format!("{file_name}.level-{k}.xdmf"),
+        Some(grid) => format!("{file_name}.level-{k}.{grid}.xdmf"),
+    }
+}
+
+/// The level documents of `file_name` in `dir`: those there under their
+/// final names, and the final names of temporaries of them. Names that
+/// only look alike (another stem, `level-x`) are not theirs.
+fn level_files_in(dir: &Path, file_name: &str) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut found = Vec::new();
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        // A temporary is `.<final>.tmp-<tag>[.<ext>]` (see `atomic::temporary`).
+        let name = match name.strip_prefix('.').and_then(|n| n.split_once(".tmp-")) {
+            Some((final_name, _)) => final_name.to_string(),
+            None => name,
+        };
+        if is_level_file_name(&name, file_name) && !found.contains(&dir.join(&name)) {
+            found.push(dir.join(&name));
+        }
+    }
+    found
+}
+
+/// Whether `name` is `<file_name>.level-<k>[.<grid>].xdmf`.
+fn is_level_file_name(name: &str, file_name: &str) -> bool {
+    let Some(rest) = name
+        .strip_prefix(file_name)
+        .and_then(|r| r.strip_prefix(".level-"))
+        .and_then(|r| r.strip_suffix(".xdmf"))
+    else {
+        return false;
+    };
+    let (k, grid) = match rest.split_once('.') {
+        Some((k, grid)) => (k, Some(grid)),
+        None => (rest, None),
+    };
+    !k.is_empty()
+        && k.bytes().all(|b| b.is_ascii_digit())
+        && grid.is_none_or(|g| LOWER_GRID_NAMES.contains(&g))
 }
 
 /// An output as the writers see it, whichever entry point built it: the
@@ -305,4 +376,38 @@ pub(super) fn rfc3339(seconds: u64) -> String {
         (rem / 60) % 60,
         rem % 60
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn level_file_names_are_recognised_only_for_their_stem() {
+        assert_eq!(level_file_name("run", 3, None), "run.level-3.xdmf");
+        assert_eq!(
+            level_file_name("run", 0, Some("edges")),
+            "run.level-0.edges.xdmf"
+        );
+        for name in [
+            "run.level-0.xdmf",
+            "run.level-12.xdmf",
+            "run.level-2.edges.xdmf",
+            "run.level-2.faces.xdmf",
+        ] {
+            assert!(is_level_file_name(name, "run"), "{name}");
+        }
+        for name in [
+            "run.xdmf",
+            "run.edges.xdmf",
+            "run.level-.xdmf",
+            "run.level-x.xdmf",
+            "run.level-1.cells.xdmf",
+            "run.level-1.h5",
+            "other.level-1.xdmf",
+            "runs.level-1.xdmf",
+        ] {
+            assert!(!is_level_file_name(name, "run"), "{name}");
+        }
+    }
 }

@@ -35,7 +35,13 @@
 //! (`<p>/topology`, `<p>/cell_ids`, `<p>/steps/<k>/<name>`). The cochains
 //! stay in `/steps/<k>/<name>`, so no cochain of a series may be named
 //! `mesh`. In the XDMF files, the k-th grid of the temporal collection
-//! reads its geometry and topology from `/steps/<k>/mesh`.
+//! reads its geometry and topology from `/steps/<k>/mesh` (and leaves
+//! `GridType` at its default, so that meshio's `TimeSeriesReader`, which
+//! takes one mesh for all grids, refuses the file). Each level also gets
+//! files of its own, `<stem>.level-<k>.xdmf` (and
+//! `<stem>.level-<k>.<grid>.xdmf`), one plain uniform grid each, which
+//! `meshio.read` opens; for meshio too, polygons of five or more vertices
+//! are written as triangles (with `cell_ids`, as split polyhedra).
 //!
 //! # Partial output of a running series ([`PartialOutput`])
 //!
@@ -73,8 +79,8 @@
 //! collection, so one grid per file lets meshio read every file, while
 //! ParaView opens each. One time level gives a plain uniform grid,
 //! several give a temporal collection. `TimeSeriesReader` takes the mesh of the
-//! first grid only, so it cannot read a series whose mesh changes; h5py
-//! can (`cases/OUTPUT.md`).
+//! first grid only, so it cannot read a series whose mesh changes; the
+//! level files and h5py can (`cases/OUTPUT.md`).
 
 pub(crate) mod atomic;
 mod hdf5_file;
@@ -269,6 +275,11 @@ pub struct OutputFiles {
     /// `<stem>.edges.xdmf` and `<stem>.faces.xdmf`, in increasing degree:
     /// one per lower degree that carries cochains (empty when none does).
     pub extra_xdmf: Vec<PathBuf>,
+    /// Only for a series whose mesh changes ([`write_mesh_series`]; empty
+    /// otherwise): `levels[k]` are the files of level k alone, each one
+    /// plain uniform grid: `<stem>.level-<k>.xdmf` (top cells), then
+    /// `<stem>.level-<k>.<grid>.xdmf` for the degrees of `extra_xdmf`.
+    pub levels: Vec<Vec<PathBuf>>,
 }
 
 /// Why an output could not be written. Nothing is left under the final
@@ -460,7 +471,9 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
 
 /// Writes `<stem>.h5`, `<stem>.xdmf` and one `<stem>.<grid>.xdmf` per
 /// lower cochain degree for a time series whose complex changes from one
-/// level to the next (refinement studies, growing tissues), and returns
+/// level to the next (refinement studies, growing tissues), plus the same
+/// documents for each level k alone, `<stem>.level-<k>[.<grid>].xdmf`
+/// (for readers of one mesh per file, such as `meshio.read`), and returns
 /// their paths.
 ///
 /// Each level k stores its own complex under `/steps/<k>/mesh` (the layout
@@ -468,7 +481,9 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
 /// `/steps/<k>/mesh/xdmf`) next to its cochains `/steps/<k>/<name>`; the
 /// root attribute `mesh_changes` is 1 (0 in [`write_run`] files). In every
 /// XDMF file the k-th grid of the temporal collection has its own geometry
-/// and topology pointing into `/steps/<k>/mesh`.
+/// and topology pointing into `/steps/<k>/mesh`; the level files hold
+/// grid k alone, without `<Time>`. Polygons of five or more vertices are
+/// written as triangles (meshio reads no polygon).
 ///
 /// Checks, temporary files and renames are those of [`write_run`]. Besides
 /// its checks, the series must have at least one level
@@ -495,6 +510,9 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
 /// let xdmf = std::fs::read_to_string(&files.xdmf).unwrap();
 /// assert!(xdmf.contains("grow.h5:/steps/1/mesh/vertices"));
 /// assert!(xdmf.contains("grow.h5:/steps/1/x"));
+/// assert_eq!(files.levels[1], [dir.join("grow.level-1.xdmf")]);
+/// let level = std::fs::read_to_string(&files.levels[1][0]).unwrap();
+/// assert!(level.contains("grow.h5:/steps/1/x") && !level.contains("/steps/0/"));
 /// std::fs::remove_dir_all(&dir).unwrap();
 /// ```
 pub fn write_mesh_series(stem: &Path, series: &SeriesOutput) -> Result<OutputFiles, OutputError> {

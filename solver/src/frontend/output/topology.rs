@@ -119,8 +119,23 @@ impl GridTopology {
     }
 }
 
-/// Build the grid of the p-cells of `complex` (1 ≤ p ≤ dim).
-pub(crate) fn grid_topology(complex: &Complex, p: usize) -> Result<GridTopology, OutputError> {
+/// How a grid writes 2-cells of five or more vertices.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Polygons {
+    /// As XDMF `Polygon` cells: ParaView and VisIt read them, meshio does not.
+    Keep,
+    /// As triangles on the polygon's own vertices (no point added, so point
+    /// data stays valid), which every reader reads, meshio included.
+    Triangulate,
+}
+
+/// Build the grid of the p-cells of `complex` (1 ≤ p ≤ dim), with its
+/// polygons of five or more vertices written as `polygons` says.
+pub(crate) fn grid_topology(
+    complex: &Complex,
+    p: usize,
+    polygons: Polygons,
+) -> Result<GridTopology, OutputError> {
     let mut elements = Vec::with_capacity(complex.cell_count(p));
     match p {
         1 => {
@@ -132,7 +147,15 @@ pub(crate) fn grid_topology(complex: &Complex, p: usize) -> Result<GridTopology,
         2 => {
             for f in 0..complex.cell_count(2) {
                 let cycle = face_cycle(complex, f)?;
-                elements.push((f, polygon_element(cycle)));
+                if polygons == Polygons::Triangulate && cycle.len() > 4 {
+                    let triangles = fan_triangles(complex, &cycle);
+                    if triangles.is_empty() {
+                        return Err(topology_error(2, f, "polygon has zero area"));
+                    }
+                    elements.extend(triangles.into_iter().map(|t| (f, Element::Triangle(t))));
+                } else {
+                    elements.push((f, polygon_element(cycle)));
+                }
             }
         }
         3 => {
@@ -157,6 +180,52 @@ fn polygon_element(cycle: Vec<usize>) -> Element {
         4 => Element::Quadrilateral([cycle[0], cycle[1], cycle[2], cycle[3]]),
         _ => Element::Polygon(cycle),
     }
+}
+
+/// A convex polygon (its vertices in cyclic order) as a fan of triangles
+/// in the same orientation. SPLIT leaves vertices in the middle of the
+/// sides of a cut cell's neighbours (hanging vertices), and a fan from a
+/// corner next to such a side has triangles of three collinear points; so
+/// the apex is the first vertex whose fan has no such triangle, and when
+/// every apex has one (hanging vertices on every side), the one with fewest,
+/// its zero-area triangles left out (they cover nothing).
+fn fan_triangles(complex: &Complex, cycle: &[usize]) -> Vec<[usize; 3]> {
+    let k = cycle.len();
+    let fan = |apex: usize| -> Vec<([usize; 3], bool)> {
+        (1..k - 1)
+            .map(|j| {
+                let t = [
+                    cycle[apex],
+                    cycle[(apex + j) % k],
+                    cycle[(apex + j + 1) % k],
+                ];
+                (t, is_flat(complex, t))
+            })
+            .collect()
+    };
+    let flat_count = |f: &[([usize; 3], bool)]| f.iter().filter(|(_, flat)| *flat).count();
+    let mut best = fan(0);
+    for apex in 1..k {
+        if flat_count(&best) == 0 {
+            break;
+        }
+        let candidate = fan(apex);
+        if flat_count(&candidate) < flat_count(&best) {
+            best = candidate;
+        }
+    }
+    best.into_iter()
+        .filter(|(_, flat)| !flat)
+        .map(|(t, _)| t)
+        .collect()
+}
+
+/// Whether the triangle's corners are collinear: the sine of its angle at
+/// the first corner below 1e-10 (relative, so independent of the mesh size).
+fn is_flat(complex: &Complex, t: [usize; 3]) -> bool {
+    let [a, b, c] = t.map(|v| Vector3::from(point3(complex, v)));
+    let (u, w) = (b - a, c - a);
+    u.cross(&w).norm() <= 1e-10 * u.norm() * w.norm()
 }
 
 /// Tail and head of edge `e` as ∂_1 orients it.
@@ -351,7 +420,7 @@ mod tests {
     #[test]
     fn unit_quad_is_cyclic_with_positive_area() {
         let k = generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
-        let grid = grid_topology(&k, 2).unwrap();
+        let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
         assert_eq!(grid.uniform, Some(("Quadrilateral", 4)));
         let quad: Vec<usize> = grid.connectivity.iter().map(|&v| v as usize).collect();
         // Tensor order 0,1,2,3 = (0,0),(1,0),(0,1),(1,1); cyclic means the
@@ -380,7 +449,7 @@ mod tests {
     #[test]
     fn unit_hex_has_positive_vtk_volume() {
         let k = generate::box3(1, 1, 1, [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]).unwrap();
-        let grid = grid_topology(&k, 3).unwrap();
+        let grid = grid_topology(&k, 3, Polygons::Keep).unwrap();
         assert_eq!(grid.uniform, Some(("Hexahedron", 8)));
         let hex: Vec<usize> = grid.connectivity.iter().map(|&v| v as usize).collect();
         let p: [[f64; 3]; 8] = std::array::from_fn(|i| point3(&k, hex[i]));
@@ -411,7 +480,7 @@ mod tests {
         .unwrap();
         let k =
             Complex::build(v, TopCells::polygons([vec![0, 1, 2, 3, 4], vec![1, 5, 2]])).unwrap();
-        let grid = grid_topology(&k, 2).unwrap();
+        let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
         assert_eq!(grid.uniform, None);
         assert_eq!(grid.connectivity.len(), (2 + 5) + (1 + 3));
         let pentagon: Vec<usize> = grid.connectivity[2..7]
@@ -443,7 +512,7 @@ mod tests {
             vec![2, 0, 3, 5],
         ];
         let k = Complex::build(v, TopCells::polyhedra([prism])).unwrap();
-        let grid = grid_topology(&k, 3).unwrap();
+        let grid = grid_topology(&k, 3, Polygons::Keep).unwrap();
         assert_eq!(grid.uniform, Some(("Tetrahedron", 4)));
         let ids = grid.cell_ids.clone().unwrap();
         assert!(ids.iter().all(|&c| c == 0));
@@ -458,5 +527,55 @@ mod tests {
             })
             .sum();
         assert!((volume - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn hanging_vertices_are_triangulated_without_flat_triangles() {
+        // The unit square with a hanging vertex in the middle of its bottom
+        // and of its right side (a neighbour on each was cut): a hexagon
+        // whose fan from the corner (0, 0) would hold two flat triangles.
+        let v = Vertices::from_points(&[
+            [0.0, 0.0],
+            [0.5, 0.0],
+            [1.0, 0.0],
+            [1.0, 0.5],
+            [1.0, 1.0],
+            [0.0, 1.0],
+            [2.0, 0.0],
+        ])
+        .unwrap();
+        let k = Complex::build(
+            v,
+            TopCells::polygons([vec![0, 1, 2, 3, 4, 5], vec![2, 6, 3]]),
+        )
+        .unwrap();
+        let kept = grid_topology(&k, 2, Polygons::Keep).unwrap();
+        assert_eq!(&kept.connectivity[..2], &[code::POLYGON, 6]);
+        assert_eq!(kept.cell_ids, None);
+
+        let grid = grid_topology(&k, 2, Polygons::Triangulate).unwrap();
+        assert_eq!(grid.uniform, Some(("Triangle", 3)));
+        let ids = grid.cell_ids.clone().unwrap();
+        // Four triangles for the hexagon (k − 2), one for the triangle.
+        assert_eq!(ids, [0, 0, 0, 0, 1]);
+        let mut used = Vec::new();
+        let area: f64 = grid.connectivity[..12]
+            .chunks(3)
+            .map(|t| {
+                let t: Vec<usize> = t.iter().map(|&v| v as usize).collect();
+                let a = shoelace(&k, &t);
+                assert!(a > 1e-3, "flat or clockwise triangle {t:?}: {a}");
+                used.extend(t);
+                a
+            })
+            .sum();
+        assert!((area - 1.0).abs() < 1e-12);
+        used.sort_unstable();
+        used.dedup();
+        assert_eq!(
+            used,
+            [0, 1, 2, 3, 4, 5],
+            "every vertex of the hexagon is used"
+        );
     }
 }

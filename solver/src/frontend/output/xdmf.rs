@@ -1,7 +1,7 @@
 //! The XDMF 3 texts: one document per cochain degree grid, each pointing
 //! into the same h5 file.
 
-use super::topology::{grid_topology, GridTopology};
+use super::topology::{grid_topology, GridTopology, Polygons};
 use super::{Cochain, Levels, MeshAt, OutputError};
 use std::fmt::Write;
 
@@ -22,18 +22,27 @@ pub(crate) fn degrees(levels: &Levels) -> Vec<usize> {
 }
 
 /// The grids of every mesh: `grids[m][i]` is the grid of the cells of
-/// degree `degrees[i]` of `levels.meshes[m]`.
+/// degree `degrees[i]` of `levels.meshes[m]`. In a series whose mesh
+/// changes, polygons of five or more vertices are written as triangles:
+/// each level has a file that `meshio.read` must open (see
+/// [`level_document`]), and meshio reads no `Polygon` cell. A one-mesh
+/// output keeps its polygons, as it always has.
 pub(crate) fn grids(
     levels: &Levels,
     degrees: &[usize],
 ) -> Result<Vec<Vec<GridTopology>>, OutputError> {
+    let polygons = if levels.mesh_changes {
+        Polygons::Triangulate
+    } else {
+        Polygons::Keep
+    };
     levels
         .meshes
         .iter()
         .map(|mesh| {
             degrees
                 .iter()
-                .map(|&p| grid_topology(mesh.complex, p))
+                .map(|&p| grid_topology(mesh.complex, p, polygons))
                 .collect()
         })
         .collect()
@@ -120,6 +129,10 @@ impl<'a> Files<'a> {
     }
 }
 
+const HEADER: &str =
+    "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<Xdmf Version=\"3.0\">\n  <Domain>\n";
+const FOOTER: &str = "  </Domain>\n</Xdmf>\n";
+
 /// The XDMF document of the grid of degree `degrees[i]` (its grids are
 /// `grids[m][i]`, see [`grids`]), reading `files`. One grid per document,
 /// because `meshio.read` accepts only a domain holding a single uniform
@@ -133,9 +146,7 @@ pub(crate) fn document(
     i: usize,
     files: &Files,
 ) -> String {
-    let mut out = String::new();
-    out.push_str("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n");
-    out.push_str("<Xdmf Version=\"3.0\">\n  <Domain>\n");
+    let mut out = String::from(HEADER);
     let grid = Grid {
         levels,
         grids,
@@ -158,7 +169,33 @@ pub(crate) fn document(
             out.push_str("    </Grid>\n");
         }
     }
-    out.push_str("  </Domain>\n</Xdmf>\n");
+    out.push_str(FOOTER);
+    out
+}
+
+/// The XDMF document of level `k` alone on the grid of degree
+/// `degrees[i]`: one plain uniform grid (level k's mesh and fields),
+/// without `<Time>`, which `meshio.read` rejects ("Unknown section"). The
+/// file a reader without support for a changing mesh opens, one level at a
+/// time.
+pub(crate) fn level_document(
+    levels: &Levels,
+    grids: &[Vec<GridTopology>],
+    i: usize,
+    k: usize,
+    files: &Files,
+) -> String {
+    let mut out = String::from(HEADER);
+    let grid = Grid {
+        levels,
+        grids,
+        i,
+        mesh_h5: escape(files.mesh),
+        level_h5: files.level,
+    };
+    let mesh = levels.steps.get(k).map_or(0, |s| s.mesh);
+    grid.uniform(&mut out, mesh, Some(k), false, 4);
+    out.push_str(FOOTER);
     out
 }
 
@@ -189,7 +226,16 @@ impl Grid<'_> {
         let n = levels.dim();
         let pad = " ".repeat(indent);
         let name = grid_name(grid.degree, n);
-        let _ = writeln!(out, "{pad}<Grid Name=\"{name}\" GridType=\"Uniform\">");
+        // The grids of a collection whose mesh changes leave `GridType` at
+        // its default, Uniform: meshio's `TimeSeriesReader` looks for a grid
+        // that names its type and, finding none, refuses the file ("Couldn't
+        // find the mesh grid") instead of pairing every level's fields with
+        // level 0's mesh. ParaView's XDMF readers follow the default.
+        if timed && levels.mesh_changes {
+            let _ = writeln!(out, "{pad}<Grid Name=\"{name}\">");
+        } else {
+            let _ = writeln!(out, "{pad}<Grid Name=\"{name}\" GridType=\"Uniform\">");
+        }
         let level = step.and_then(|k| levels.steps.get(k).map(|s| (k, s)));
         if let (true, Some((_, s))) = (timed, level) {
             let _ = writeln!(out, "{pad}  <Time Value=\"{}\"/>", float(s.time));
