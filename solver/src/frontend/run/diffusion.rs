@@ -156,18 +156,40 @@ pub(super) fn solve_diffusion(
     let field = solution.field(complex).to_vec();
     let mut fields =
         vec![Cochain::new("u", field_dim, field.clone()).with_description("the solution")];
-    match solution.location {
-        Location::Nodal => fields.push(
-            Cochain::new("flux", 1, solution.flux.clone())
-                .with_description("edge cochain Ω A u (the discrete flux along edges)"),
-        ),
-        Location::CellCentred => fields.push(
-            Cochain::new("flux", n - 1, solution.flux.clone())
-                .with_description("flux through each (n−1)-cell along its orientation"),
-        ),
-        // Half-face fluxes have no cells of their own to live on.
-        Location::Hybrid => {}
+    // One convention for every method: the physical flux −K∇u·n through
+    // each (n−1)-cell along its orientation (OUTPUT.md).
+    let oriented = problem
+        .oriented_flux(complex, &solution)
+        .map_err(|e| diffusion_error(case, &keys, e))?;
+    if let Some(flux) = oriented {
+        let how = match solution.location {
+            Location::Nodal => "interior cells: |F| times the mean of the two cells' −K∇u_h·n; boundary cells: the method's residual flux, which balances the sources",
+            _ => "the method's own face flux, which balances the sources",
+        };
+        fields.push(Cochain::new("flux", n - 1, flux).with_description(format!(
+            "−K∇u·n through each (n−1)-cell along its orientation ({how})"
+        )));
     }
+    let outflow = problem
+        .boundary_outflow(complex, &solution)
+        .map_err(|e| diffusion_error(case, &keys, e))?;
+    fields.push(Cochain::new("outflow", n - 1, outflow).with_description(
+        "−K∇u·n leaving the domain through each boundary (n−1)-cell (0 inside): the method's own flux; Σ over a tag is the flux out through it",
+    ));
+    if solution.location == Location::Nodal && n > 1 {
+        fields.push(
+            Cochain::new("edge_flux", 1, solution.flux.iter().map(|q| -q).collect())
+                .with_description("−Ω A u: the flux across each edge's dual cell, along the edge (the method's conservative flux)"),
+        );
+    }
+    let coefficients = problem
+        .cell_coefficients(complex)
+        .map_err(|e| diffusion_error(case, &keys, e))?;
+    fields.extend(coefficient_fields(
+        &coefficients,
+        complex.embedding_dim(),
+        n,
+    ));
     let gradient = physics::reconstruct_gradient(complex, &solution);
     // The reconstruction needs cells that fill their space; on a surface in
     // R³ it is undefined (NaN) and left out.
@@ -256,6 +278,37 @@ pub(super) fn solve_diffusion(
         notes,
         report: quantities.report,
     })
+}
+
+/// The conductivity as cell fields: `conductivity` for K = λI, else one
+/// field per component of the upper triangle (`conductivity_xx`, `_xy`, …).
+fn coefficient_fields(k: &physics::CellCoefficients, d: usize, n: usize) -> Vec<Cochain> {
+    match k {
+        physics::CellCoefficients::Scalar(values) => {
+            vec![Cochain::new("conductivity", n, values.clone())
+                .with_description("K = λI: λ per top cell (at its centroid)")]
+        }
+        physics::CellCoefficients::Tensor(tensors) => {
+            let axes = ["x", "y", "z"];
+            let mut fields = Vec::new();
+            for a in 0..d {
+                for b in a..d {
+                    fields.push(
+                        Cochain::new(
+                            format!("conductivity_{}{}", axes[a], axes[b]),
+                            n,
+                            tensors.iter().map(|t| t[a][b]).collect(),
+                        )
+                        .with_description(format!(
+                            "K_{}{} per top cell (at its centroid)",
+                            axes[a], axes[b]
+                        )),
+                    );
+                }
+            }
+            fields
+        }
+    }
 }
 
 /// The data of a diffusion case evaluated where its solve evaluates them,

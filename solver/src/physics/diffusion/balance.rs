@@ -114,6 +114,70 @@ impl Diffusion {
         }
     }
 
+    /// −K∇u·n through every (n−1)-cell along its orientation, for every
+    /// method: [`Diffusion::face_flux`] where the unknowns make face fluxes;
+    /// for nodal methods the residual outflow of [`Diffusion::boundary_outflow`]
+    /// on boundary faces and, on interior faces, |F| times the mean of the
+    /// two cells' −K∇u_h·n (a reconstruction: the conservative fluxes of
+    /// nodal methods cross the dual cells). `None` for a nodal method on a
+    /// surface, whose faces have no normal in the embedding space.
+    pub fn oriented_flux(
+        &self,
+        complex: &Complex,
+        solution: &Solution,
+    ) -> Result<Option<Vec<f64>>, DiffusionError> {
+        if let Some(flux) = self.face_flux(complex, solution) {
+            return Ok(Some(flux));
+        }
+        let (n, d) = (complex.dim(), complex.embedding_dim());
+        if n != d {
+            return Ok(None);
+        }
+        let outflow = self.boundary_outflow(complex, solution)?;
+        let gradient = post::reconstruct_gradient(complex, solution);
+        let conductivity = self.cell_conductivity(complex)?;
+        let normal = complex.normal();
+        let measure = complex.measure(n - 1);
+        let flux = complex
+            .boundary(n)
+            .outer_iterator()
+            .enumerate()
+            .map(|(f, row)| {
+                let cells: Vec<(usize, i8)> = row.iter().map(|(c, &s)| (c, s)).collect();
+                match cells[..] {
+                    [(_, s)] => f64::from(s) * outflow[f],
+                    _ => {
+                        let density = |c: usize| -> f64 {
+                            let k = match &conductivity {
+                                CellConductivity::Scalar(l) => metric::isotropic(l[c]),
+                                CellConductivity::Full(t) => t[c],
+                            };
+                            let g = gradient[c];
+                            -(0..d)
+                                .map(|a| {
+                                    (0..d).map(|b| k[a][b] * g[b]).sum::<f64>() * normal[f * d + a]
+                                })
+                                .sum::<f64>()
+                        };
+                        let sum: f64 = cells.iter().map(|&(c, _)| density(c)).sum();
+                        measure[f] * sum / cells.len().max(1) as f64
+                    }
+                }
+            })
+            .collect();
+        Ok(Some(flux))
+    }
+
+    /// K in every top cell, as the assembly evaluates it (at the
+    /// centroid): one scalar a cell when every K is isotropic, else the
+    /// tensors.
+    pub fn cell_coefficients(&self, complex: &Complex) -> Result<CellCoefficients, DiffusionError> {
+        Ok(match self.cell_conductivity(complex)? {
+            CellConductivity::Scalar(v) => CellCoefficients::Scalar(v),
+            CellConductivity::Full(t) => CellCoefficients::Tensor(t),
+        })
+    }
+
     /// ∫f as the method loads it: Σ of the source's load over the unknowns.
     pub fn source_total(&self, complex: &Complex) -> Result<f64, DiffusionError> {
         let n = complex.dim();
@@ -235,4 +299,13 @@ impl Diffusion {
         }
         Ok(())
     }
+}
+
+/// The conductivity of every top cell ([`Diffusion::cell_coefficients`]).
+#[derive(Clone, Debug, PartialEq)]
+pub enum CellCoefficients {
+    /// K = λ_c I.
+    Scalar(Vec<f64>),
+    /// K_c, symmetric (the leading d×d block is used in R^d).
+    Tensor(Vec<Tensor>),
 }

@@ -45,6 +45,7 @@ use crate::physics::{
     Conductivity, Datum, ScalarFn, TagError, VectorFn,
 };
 pub use assemble::Assembled;
+pub use balance::CellCoefficients;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use hasse_complex::Complex;
 pub use post::{conservation_residual, errors, flux_error, reconstruct_gradient};
