@@ -548,9 +548,11 @@ fn run_case(
             (None, Some(stream)) => stream.finish(complex, &mut result),
             (None, None) => run::write_output(&case, complex, &result, &stem),
         };
-        // A transient run's quantities of interest, level by level.
+        // Quantities of a transient run level by level, and probes.
         let written = written.and_then(|files| {
-            let csv = run::write_quantities_csv(&stem, &result.report_json(complex))?;
+            let report = result.report_json(complex);
+            let mut csv: Vec<_> = run::write_quantities_csv(&stem, &report)?.into_iter().collect();
+            csv.extend(run::write_probes_csv(&stem, &report)?);
             Ok((files, csv))
         });
         match written {

@@ -11,6 +11,7 @@ pub mod elasticity;
 pub mod gradient;
 pub mod heat;
 pub mod maxwell;
+pub mod probe;
 pub mod regions;
 
 use crate::metric::Tensor;

@@ -41,7 +41,7 @@ mod regions;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use problem::*;
-pub use quantity::{QuantityKind, QuantitySpec};
+pub use quantity::{ProbeSpec, QuantityKind, QuantitySpec};
 
 use crate::frontend::mesh_spec::{MeshError, MeshSpec};
 use crate::la::direct::Factorization;
@@ -164,7 +164,7 @@ impl Default for SolverSpec {
 /// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [2, 2]\n[problem]\nmethod = \"fv\"\n";
 /// // By default the stem is the case file's, in the working directory.
 /// let output = Case::from_text("cases/plate.toml", text, &[]).unwrap().output;
-/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true, quantities: vec![] });
+/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true, quantities: vec![], probes: vec![] });
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct OutputSpec {
@@ -176,6 +176,8 @@ pub struct OutputSpec {
     pub write: bool,
     /// `[[output.quantity]]` tables, in order.
     pub quantities: Vec<QuantitySpec>,
+    /// `[[output.probe]]` tables, in order.
+    pub probes: Vec<ProbeSpec>,
 }
 
 /// One `[regions]` entry: `name = "condition"` tags the top cells whose
@@ -328,6 +330,7 @@ impl Case {
         self.apply_regions(&mut complex, &mut collector);
         self.check_regional_data(&complex, &mut collector);
         self.check_quantities(&complex, &mut collector);
+        self.check_probes(&complex, &mut collector);
         {
             let n = complex.dim();
             let available: Vec<String> = complex

@@ -74,3 +74,39 @@ pub struct QuantitySpec {
     /// Its key in messages, `output.quantity[i]`.
     pub key: String,
 }
+
+/// One `[[output.probe]]` table: a point (`at`) or the points of a line
+/// (`from`, `to`, `points`), where the solution is interpolated the way
+/// the method represents it.
+///
+/// ```
+/// use hasse_solver::frontend::case::Case;
+/// let text = r#"
+/// [mesh]
+/// generator = "rectangle"
+/// n = [4, 4]
+/// [problem]
+/// method = "fe"
+/// [[output.probe]]
+/// at = [0.5, 0.25]
+/// [[output.probe]]
+/// name = "diagonal"
+/// from = [0, 0]
+/// to = [1, 1]
+/// points = 3
+/// "#;
+/// let probes = Case::from_text("p.toml", text, &[]).unwrap().output.probes;
+/// assert_eq!(probes[0].name, "probe-0");
+/// assert_eq!(probes[0].points, vec![vec![0.5, 0.25]]);
+/// assert_eq!(probes[1].points, vec![vec![0.0, 0.0], vec![0.5, 0.5], vec![1.0, 1.0]]);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeSpec {
+    /// The label in the summary and the CSV (`name`, or `probe-<i>`).
+    pub name: String,
+    /// The points: one for `at`, `points` evenly spaced from `from` to
+    /// `to` (both included) for a line.
+    pub points: Vec<Vec<f64>>,
+    /// Its key in messages, `output.probe[i]`.
+    pub key: String,
+}

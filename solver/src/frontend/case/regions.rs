@@ -168,3 +168,54 @@ impl Case {
         }
     }
 }
+
+impl Case {
+    /// Refuse probes outside the mesh (with the point) and probes on a
+    /// mesh whose cells do not fill their space.
+    pub(super) fn check_probes(&self, complex: &Complex, collector: &mut Collector) {
+        if self.output.probes.is_empty() {
+            return;
+        }
+        if !matches!(self.problem, super::Problem::Diffusion(_) | super::Problem::Heat(_)) {
+            collector.error(
+                None,
+                &self.output.probes[0].key,
+                "probes are evaluated for diffusion and heat problems",
+                Some("remove the [[output.probe]] tables of this case".into()),
+            );
+            return;
+        }
+        let locator = match crate::physics::probe::PointLocator::new(complex) {
+            Ok(locator) => locator,
+            Err(e) => {
+                collector.error(None, &self.output.probes[0].key, e.to_string(), None);
+                return;
+            }
+        };
+        let d = complex.embedding_dim();
+        for probe in &self.output.probes {
+            if let Some(p) = probe.points.iter().find(|p| p.len() != d) {
+                collector.error(
+                    None,
+                    &probe.key,
+                    format!("the point {p:?} has {} coordinates; the mesh lives in R^{d}", p.len()),
+                    None,
+                );
+                continue;
+            }
+            if let Some((i, p)) = probe.points.iter().enumerate().find(|(_, p)| locator.locate(p).is_none()) {
+                let which = if probe.points.len() == 1 {
+                    String::new()
+                } else {
+                    format!(" (point {i} of the line)")
+                };
+                collector.error(
+                    None,
+                    &probe.key,
+                    format!("the probe point {p:?}{which} is outside the mesh"),
+                    Some("`hasse info` prints the mesh's extent; a point on the boundary is inside".into()),
+                );
+            }
+        }
+    }
+}

@@ -256,6 +256,19 @@ pub(super) fn solve_diffusion(
     let quantities = super::quantities::diffusion_quantities(case, &problem, complex, &solution)
         .map_err(|e| diffusion_error(case, &keys, e))?;
     notes.extend(quantities.notes);
+    let mut run_report = quantities.report;
+    let probed = super::probes::probe_values(
+        case,
+        complex,
+        solution.location,
+        &solution.values,
+        solution.cell_points.as_deref(),
+    );
+    let (probe_notes, probes) = super::probes::probe_report(case, &[], &[probed]);
+    notes.extend(probe_notes);
+    if let Some(probes) = probes {
+        run_report.insert("probes".into(), probes);
+    }
     timings.push(("post-processing".into(), post.elapsed().as_secs_f64()));
     timings.push(("assembly + solve".into(), total));
     Ok(RunResult {
@@ -276,7 +289,7 @@ pub(super) fn solve_diffusion(
         pure_neumann: solution.pure_neumann,
         series: Vec::new(),
         notes,
-        report: quantities.report,
+        report: run_report,
     })
 }
 

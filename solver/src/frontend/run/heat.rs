@@ -128,6 +128,7 @@ pub(super) fn solve_streaming<'a>(
     let mut series = Vec::new();
     let mut level_errors = Vec::new();
     let mut level_quantities = Vec::new();
+    let mut level_probes = Vec::new();
     let location = heat.at(time.start).location();
     let mut post_seconds = 0.0;
     let mut stream_seconds = 0.0;
@@ -146,6 +147,7 @@ pub(super) fn solve_streaming<'a>(
                     let post = Instant::now();
                     level_quantities
                         .push(super::quantities::level_values(case, complex, u, location));
+                    level_probes.push(super::probes::probe_values(case, complex, location, u, None));
                     let mut fields = vec![
                         Cochain::new("u", dim, u.to_vec()).with_description("the temperature")
                     ];
@@ -242,6 +244,12 @@ pub(super) fn solve_streaming<'a>(
         ),
     )];
     notes.extend(quantities.notes);
+    let (probe_notes, probes) =
+        super::probes::probe_report(case, &history.times, &level_probes);
+    notes.extend(probe_notes);
+    if let Some(probes) = probes {
+        report.insert("probes".into(), probes);
+    }
     let mut timings = vec![
         ("factorisation".to_string(), history.factorization_seconds),
         (

@@ -48,7 +48,7 @@ pub use assemble::Assembled;
 pub use balance::CellCoefficients;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use hasse_complex::Complex;
-pub use post::{conservation_residual, errors, flux_error, reconstruct_gradient};
+pub use post::{conservation_residual, errors, flux_error, gradient_of, reconstruct_gradient};
 use rayon::prelude::*;
 pub use solve::solve_with_fixed;
 use sprs::TriMat;

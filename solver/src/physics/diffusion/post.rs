@@ -10,10 +10,30 @@ use super::*;
 /// Exact for linear fields (for cell-centred values wherever a cell has at
 /// least d neighbours in general position).
 pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64; 3]> {
+    gradient_of(
+        complex,
+        solution.location,
+        &solution.values,
+        solution.cell_points.as_deref(),
+    )
+}
+
+/// [`reconstruct_gradient`] of any field laid out as `location` says (all
+/// unknowns), e.g. a level of a transient run; `cell_points` are the cell
+/// points of a cell-centred field when they are not the centroids.
+pub fn gradient_of(
+    complex: &Complex,
+    location: Location,
+    values: &[f64],
+    cell_points: Option<&[f64]>,
+) -> Vec<[f64; 3]> {
     let n = complex.dim();
     let d = complex.embedding_dim();
     let cells = complex.cell_count(n);
-    let centre = cell_centres(complex, solution);
+    let centre = match location {
+        Location::CellCentred => cell_points.unwrap_or(complex.centroid(n)),
+        _ => complex.centroid(n),
+    };
     let face_centre = complex.centroid(n - 1);
     let by_cell = complex.boundary_csc(n);
     let top = complex.boundary(n);
@@ -21,19 +41,19 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
         .map(|c| {
             let mut points: Vec<(Vec<f64>, f64)> = Vec::new();
             let xc = &centre[c * d..(c + 1) * d];
-            match solution.location {
+            match location {
                 Location::Nodal => {
                     let vertices = complex.cell_vertices(n, c);
                     // A simplex carries the P1 field: its gradient exactly,
                     // tangent to the cell on a surface (a least-squares fit
                     // there leans on a pseudo-inverse cutoff).
                     if vertices.len() == n + 1 {
-                        if let Some(g) = p1_gradient(complex, vertices, &solution.values) {
+                        if let Some(g) = p1_gradient(complex, vertices, values) {
                             return g;
                         }
                     }
                     for &v in vertices {
-                        points.push((complex.vertices().point(v).to_vec(), solution.values[v]));
+                        points.push((complex.vertices().point(v).to_vec(), values[v]));
                     }
                 }
                 Location::Hybrid => {
@@ -41,13 +61,13 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
                         for (f, _) in col.iter() {
                             points.push((
                                 face_centre[f * d..(f + 1) * d].to_vec(),
-                                solution.values[cells + f],
+                                values[cells + f],
                             ));
                         }
                     }
                 }
                 Location::CellCentred => {
-                    points.push((xc.to_vec(), solution.values[c]));
+                    points.push((xc.to_vec(), values[c]));
                     if let Some(col) = by_cell.outer_view(c) {
                         for (f, _) in col.iter() {
                             if let Some(row) = top.outer_view(f) {
@@ -55,7 +75,7 @@ pub fn reconstruct_gradient(complex: &Complex, solution: &Solution) -> Vec<[f64;
                                     if other != c {
                                         points.push((
                                             centre[other * d..(other + 1) * d].to_vec(),
-                                            solution.values[other],
+                                            values[other],
                                         ));
                                     }
                                 }

@@ -1,9 +1,12 @@
-//! `[[output.quantity]]` tables.
+//! `[[output.quantity]]` and `[[output.probe]]` tables.
 
 use super::*;
-use crate::frontend::case::{QuantityKind, QuantitySpec};
+use crate::frontend::case::{ProbeSpec, QuantityKind, QuantitySpec};
 
 pub(super) const QUANTITY_KEYS: &[&str] = &["type", "tag", "region", "field", "name"];
+pub(super) const PROBE_KEYS: &[&str] = &["at", "from", "to", "points", "name"];
+/// The most points a line probe may have (each is located in the mesh).
+const MOST_POINTS: i64 = 100_000;
 
 impl Reader {
     /// The quantities under `[output]`, each checked for its keys (the
@@ -114,5 +117,93 @@ impl Reader {
             });
         }
         out
+    }
+}
+
+impl Reader {
+    /// The probes under `[output]` (their points are located in the mesh
+    /// when it is built).
+    pub(super) fn probes(&mut self, output: &dyn TableLike) -> Vec<ProbeSpec> {
+        let Some(entry) = self.entry(output, "output", "probe") else {
+            return Vec::new();
+        };
+        let Some(array) = entry.item.as_array_of_tables() else {
+            self.type_error(&entry, "[[output.probe]] tables");
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for (i, table) in array.iter().enumerate() {
+            let prefix = format!("output.probe[{i}]");
+            self.check_keys(table, &prefix, PROBE_KEYS);
+            let header = table.span();
+            let name = self
+                .string_at(table, &prefix, "name")
+                .unwrap_or_else(|| format!("probe-{i}"));
+            let at = self.point_at(table, &prefix, "at");
+            let from = self.point_at(table, &prefix, "from");
+            let to = self.point_at(table, &prefix, "to");
+            let count = match self.entry(table, &prefix, "points") {
+                None => Some(101),
+                Some(e) => match e.item.as_integer() {
+                    Some(k) if (2..=MOST_POINTS).contains(&k) => Some(k as usize),
+                    _ => {
+                        self.error(e.span(), &e.name, format!("the number of points of a line, an integer from 2 to {MOST_POINTS}"), None);
+                        None
+                    }
+                },
+            };
+            let written = |key: &str| table.get(key).is_some();
+            let points = match (at, from, to) {
+                (Some(Some(p)), None, None) if !written("from") && !written("to") && !written("points") => vec![p],
+                (None, Some(Some(a)), Some(Some(b))) if !written("at") => {
+                    if a.len() != b.len() {
+                        self.error(header, &prefix, "`from` and `to` have different numbers of coordinates", None);
+                        continue;
+                    }
+                    let Some(k) = count else { continue };
+                    (0..k)
+                        .map(|j| {
+                            let s = j as f64 / (k - 1) as f64;
+                            a.iter().zip(&b).map(|(p, q)| p + s * (q - p)).collect()
+                        })
+                        .collect()
+                }
+                // A point that could not be read was reported already.
+                (Some(None), _, _) | (_, Some(None), _) | (_, _, Some(None)) => continue,
+                _ => {
+                    self.error(
+                        header,
+                        &prefix,
+                        "a probe is a point, `at = [x, y]`, or a line, `from = [x, y]`, `to = [x, y]` (and `points`, default 101)",
+                        None,
+                    );
+                    continue;
+                }
+            };
+            out.push(ProbeSpec { name, points, key: prefix });
+        }
+        out
+    }
+
+    /// `<prefix>.<key>` as a point of 1 to 3 finite coordinates: `None`
+    /// when not written, `Some(None)` when written wrongly (reported).
+    fn point_at(&mut self, table: &dyn TableLike, prefix: &str, key: &str) -> Option<Option<Vec<f64>>> {
+        let entry = self.entry(table, prefix, key)?;
+        let coordinates: Option<Vec<f64>> = entry.item.as_array().and_then(|a| {
+            a.iter()
+                .map(|v| match v {
+                    Value::Float(f) => Some(*f.value()),
+                    Value::Integer(i) => Some(*i.value() as f64),
+                    _ => None,
+                })
+                .collect()
+        });
+        match coordinates {
+            Some(p) if (1..=3).contains(&p.len()) && p.iter().all(|x| x.is_finite()) => Some(Some(p)),
+            _ => {
+                self.error(entry.span(), &entry.name, "a point: an array of 1 to 3 finite numbers, e.g. [0.5, 0.25]", None);
+                Some(None)
+            }
+        }
     }
 }

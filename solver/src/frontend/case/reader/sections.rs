@@ -409,6 +409,7 @@ impl Reader {
             name: stem,
             write: true,
             quantities: Vec::new(),
+            probes: Vec::new(),
         };
         let Some((table, _)) = self.subtable(root, "", "output") else {
             return spec;
@@ -437,6 +438,7 @@ impl Reader {
             }
         }
         spec.quantities = self.quantities(table);
+        spec.probes = self.probes(table);
         spec
     }
 }
