@@ -251,7 +251,7 @@ fn largest_ritz(alphas: &[f64], betas: &[f64]) -> f64 {
 /// (10th–90th percentile) against θ = 0.08: most unknowns had no strong
 /// neighbour, became singletons, coarsening stalled, and the whole
 /// level 1 (1/8 of the unknowns, 30 entries per row) went to the sparse
-/// LLᵀ meant for ≤ `coarse_size` unknowns: 80 s and 4.6 GiB of setup at
+/// LLᵀ meant for ≤ `coarse_size` unknowns: 82 s and 4.4 GiB of setup at
 /// 100³. Halving θ per level follows the halving of the couplings as the
 /// stencils widen; θ = 0.04 on level 1 keeps the strongest 40 % or so of
 /// its couplings and coarsens it eightfold.
