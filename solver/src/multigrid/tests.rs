@@ -260,17 +260,18 @@ fn aggregation_coarsens_every_level_of_a_3d_seven_point_stencil() {
     let mg = Multigrid::algebraic(m, &options).unwrap();
     let levels = mg.levels();
     let sizes: Vec<usize> = levels.iter().map(|l| l.unknowns).collect();
-    assert!(levels.len() >= 4, "{sizes:?}");
+    assert!(levels.len() >= 3, "{sizes:?}");
     assert!(levels.last().unwrap().unknowns <= 50, "{sizes:?}");
     // Aggregates of a 3D stencil hold a node and its strong neighbours
     // (7 on the fine level), so each level is at least 4× smaller.
     for pair in sizes.windows(2) {
         assert!(pair[1] * 4 <= pair[0], "{sizes:?}");
     }
-    // Operator complexity: level 1 has n/8 unknowns with ~30 entries per
-    // row against 7 on level 0 (30/(8·7) ≈ 0.54), level 2 n/64 with ~100
-    // (≈ 0.22), and the rest together less than half of that; 1.8 bounds
-    // the sum (measured 1.72 at 40³ and 60³).
+    // Operator complexity: level 1 has n/8 unknowns (a node and its six
+    // neighbours, plus joiners) with ~30 entries per row against 7 on
+    // level 0 (30/(8·7) ≈ 0.54), level 2 ~n/100 with ~100 (≈ 0.15), the
+    // rest much less; 1.8 bounds the sum (measured 1.70–1.72 from 40³ to
+    // 100³).
     let complexity = mg.operator_complexity();
     assert!(complexity <= 1.8, "{complexity} for levels {sizes:?}");
 }
@@ -300,11 +301,23 @@ fn the_coarse_operators_of_a_neumann_laplacian_keep_its_kernel() {
         for (f, c) in fine.iter().zip(&candidate) {
             assert!((f - c).abs() <= 1e-12 * scale, "level {level}: {f} vs {c}");
         }
-        let coarse = p.transpose().product(&a.product(&p));
+        let r = p.transpose();
+        let coarse = r.product(&a.product(&p));
         let kernel = apply(&coarse, &coarse_candidate);
-        let diagonal = coarse.diagonal();
+        // The rounding scale of row i: the same sums with every term's
+        // absolute value, |R| |A| |P| b_c (b_c > 0). The diagonal is no
+        // scale: an operator of few aggregates is itself zero to rounding.
+        let magnitude = |m: &RowMatrix, x: &[f64]| -> Vec<f64> {
+            (0..m.nrows())
+                .map(|i| {
+                    let (c, v) = m.row(i);
+                    c.iter().zip(v).map(|(&j, a)| a.abs() * x[j as usize]).sum()
+                })
+                .collect()
+        };
+        let terms = magnitude(&r, &magnitude(&a, &magnitude(&p, &coarse_candidate)));
         for (i, r) in kernel.iter().enumerate() {
-            let size = diagonal[i] * coarse_candidate[i];
+            let size = terms[i];
             assert!(
                 r.abs() <= 1e-12 * size,
                 "level {level}, row {i}: {r} vs {size}"
