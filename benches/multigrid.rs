@@ -11,6 +11,9 @@
 //!   algebraically down to 4000 unknowns), smoothed cell prolongation.
 //! - `mg-pc`: the same with the piecewise-constant cell prolongation and
 //!   the coarse correction doubled (sparser coarse levels, cheaper setup).
+//! - `sa`: the same with smoothed aggregation from the matrix alone
+//!   (`Hierarchy::Algebraic`, what `solver.type = "amg"` runs): the row
+//!   to set against pyamg, which sees the same matrix.
 //! - `direct`: complex, assembly, faer LLᵀ through hasse (analysis,
 //!   factorisation, solve) with the automatic fill-reducing ordering.
 //! - `solve`: complex, then `Diffusion::solve` as a case file runs it
@@ -131,12 +134,17 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
         parse_case(case).unwrap_or_else(|| panic!("case {case}: use 2d-N, 3d-N or delaunay-COUNT"));
     let started = Instant::now();
     let fields = match phase {
-        "mg" | "mg-pc" => {
+        "mg" | "mg-pc" | "sa" => {
             let (system, complex_s, assembly_s) = build(d, n);
-            let cell_prolongation = if phase == "mg" {
-                CellProlongation::Smoothed
-            } else {
+            let cell_prolongation = if phase == "mg-pc" {
                 CellProlongation::Constant { correction: 2.0 }
+            } else {
+                CellProlongation::Smoothed
+            };
+            let hierarchy = if phase == "sa" {
+                Hierarchy::Algebraic
+            } else {
+                Hierarchy::Grid { cells: vec![n; d] }
             };
             let settings = Iterative {
                 options: CgOptions {
@@ -145,7 +153,7 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 },
                 initial: None,
                 preconditioner: Preconditioning::Multigrid {
-                    hierarchy: Hierarchy::Grid { cells: vec![n; d] },
+                    hierarchy,
                     options: MultigridOptions {
                         cell_prolongation,
                         ..MultigridOptions::default()
@@ -404,9 +412,10 @@ fn write_vector_market(path: &str, v: &[f64]) -> std::io::Result<()> {
 }
 
 /// Every phase of a structured grid case, in the order they run.
-const GRID_PHASES: [&str; 10] = [
+const GRID_PHASES: [&str; 11] = [
     "mg",
     "mg-pc",
+    "sa",
     "direct",
     "solve",
     "plain",
@@ -438,9 +447,9 @@ fn main() {
             (
                 "3d-100",
                 if env("HASSE_BENCH_DIRECT_100") {
-                    vec!["mg", "mg-pc", "direct", "solve", "plain"]
+                    vec!["mg", "mg-pc", "sa", "direct", "solve", "plain"]
                 } else {
-                    vec!["mg", "mg-pc"]
+                    vec!["mg", "mg-pc", "sa"]
                 },
             ),
             ("delaunay-1m", DELAUNAY_PHASES.to_vec()),

@@ -1,7 +1,7 @@
 """Turn the `RESULT case phase key=value ...` lines of benches/multigrid.rs
 and scripts/pyamg_baseline.py (stdin) into one table: hasse next to its
 baseline, with the ratio hasse / baseline (below 1: hasse is faster or
-smaller). Structured cases (phases mg, mg-pc, direct, solve, plain, q1-solve,
+smaller). Structured cases (phases mg, mg-pc, sa, direct, solve, plain, q1-solve,
 q1-assembly, q1-plain, amd, nd) and
 Delaunay cases (phases amg, dec, direct, plain, amd, nd, check) get their own
 rows; a failed phase shows as — in its rows."""
@@ -147,6 +147,11 @@ for case in runs:
     mg_total = None if mg_setup is None else mg_setup + mg_solve
     amg_total = None if num(amg, "setup") is None else num(amg, "setup") + num(amg, "solve")
     rows.append((label, f"MG setup + CG to 1e-8 ({mg.get('iterations', '?')} it)", fmt(mg_total), f"pyamg SA-CG ({amg.get('iterations', '?')} it)", fmt(amg_total), ratio(mg_total, amg_total)))
+    sa = r.get("sa", {})
+    if sa:
+        sa_total = None if num(sa, "setup") is None else num(sa, "setup") + num(sa, "solve")
+        rows.append((label, f"  AMG (smoothed aggregation, matrix alone) setup + CG ({sa.get('iterations', '?')} it)", fmt(sa_total), "pyamg SA-CG", fmt(amg_total), ratio(sa_total, amg_total)))
+        rows.append((label, "    AMG setup alone", fmt(num(sa, "setup")), "pyamg setup", fmt(num(amg, "setup")), ratio(num(sa, "setup"), num(amg, "setup"))))
     pc = r.get("mg-pc", {})
     pc_total = None if num(pc, "setup") is None else num(pc, "setup") + num(pc, "solve")
     rows.append((label, f"  same, constant P, correction 2 ({pc.get('iterations', '?')} it)", fmt(pc_total), f"pyamg SA-CG", fmt(amg_total), ratio(pc_total, amg_total)))

@@ -139,8 +139,10 @@ pub struct MultigridOptions {
     pub coarse_size: usize,
     /// At most this many levels, the coarsest included.
     pub max_levels: usize,
-    /// Strength of connection of the algebraic levels: j is a strong
-    /// neighbour of i when a_ij² ≥ θ² |a_ii a_jj|.
+    /// Strength of connection θ of the algebraic levels: on level l (0 the
+    /// finest) j is a strong neighbour of i when
+    /// a_ij² ≥ (θ 2^(−l))² |a_ii a_jj|, the threshold halved per level
+    /// because the coarse operators spread each row over more neighbours.
     pub strength: f64,
     /// How cell-centred prolongations of a geometric hierarchy are used.
     pub cell_prolongation: CellProlongation,
