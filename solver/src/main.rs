@@ -551,7 +551,9 @@ fn run_case(
         // Quantities of a transient run level by level, and probes.
         let written = written.and_then(|files| {
             let report = result.report_json(complex);
-            let mut csv: Vec<_> = run::write_quantities_csv(&stem, &report)?.into_iter().collect();
+            let mut csv: Vec<_> = run::write_quantities_csv(&stem, &report)?
+                .into_iter()
+                .collect();
             csv.extend(run::write_probes_csv(&stem, &report)?);
             Ok((files, csv))
         });

@@ -27,5 +27,6 @@ mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
 mod method_warnings;
+mod probes;
 mod quantities;
 mod regions;

@@ -195,19 +195,20 @@ pub fn load(
 /// this is f(x_v) ⋆1(v), the load of [`load`].
 ///
 /// ```
-/// use hasse_complex::generate::rectangle;
+/// use hasse_complex::generate::kuhn;
 /// use hasse_complex::DualKind;
 /// use hasse_solver::metric::dec;
-/// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// // The unit square as two right triangles on the diagonal v0–v3.
+/// let k = kuhn(&[vec![0.0, 1.0], vec![0.0, 1.0]]).unwrap();
 /// let uniform = dec::load(&k, DualKind::Circumcentric, &|_| 3.0).unwrap();
 /// let by_cell = dec::load_in_cells(&k, DualKind::Circumcentric, &|_, _| 3.0).unwrap();
 /// // The same up to the rounding of f·Σ|c| / Σ|c|.
 /// assert!(uniform.iter().zip(&by_cell).all(|(a, b)| (a - b).abs() <= 1e-15 * a.abs()));
-/// // f = 4 in cell 0 only: the middle vertices, shared equally by the
-/// // two cells, get half of 4 ⋆1(v).
+/// // f = 4 in triangle 0 only: vertex 0, in both triangles of equal
+/// // area, gets half of 4 ⋆1(v).
 /// let half = dec::load_in_cells(&k, DualKind::Circumcentric, &|c, _| if c == 0 { 4.0 } else { 0.0 }).unwrap();
 /// let star = dec::load(&k, DualKind::Circumcentric, &|_| 1.0).unwrap();
-/// assert!((half[1] - 2.0 * star[1]).abs() < 1e-15);
+/// assert!((half[0] - 2.0 * star[0]).abs() < 1e-15);
 /// ```
 pub fn load_in_cells(
     complex: &Complex,

@@ -55,7 +55,9 @@ pub struct PointLocator<'a> {
 pub enum ProbeError {
     /// The cells are not full-dimensional (a surface in R³): a point of
     /// R³ is not in them.
-    #[error("probes need cells that fill their space; this mesh is {dim}-dimensional in R^{embedding}")]
+    #[error(
+        "probes need cells that fill their space; this mesh is {dim}-dimensional in R^{embedding}"
+    )]
     NotFullDimensional {
         /// Dimension of the top cells.
         dim: usize,
@@ -69,7 +71,10 @@ impl<'a> PointLocator<'a> {
     pub fn new(complex: &'a Complex) -> Result<Self, ProbeError> {
         let (n, d) = (complex.dim(), complex.embedding_dim());
         if n != d || n == 0 {
-            return Err(ProbeError::NotFullDimensional { dim: n, embedding: d });
+            return Err(ProbeError::NotFullDimensional {
+                dim: n,
+                embedding: d,
+            });
         }
         let cells = complex.cell_count(n);
         let mut boxes = Vec::with_capacity(cells);
@@ -199,11 +204,19 @@ pub fn value_at(
 fn nodal_value(complex: &Complex, values: &[f64], cell: usize, x: &[f64]) -> f64 {
     let (n, d) = (complex.dim(), complex.embedding_dim());
     let vertices = complex.cell_vertices(n, cell);
-    let points: Vec<&[f64]> = vertices.iter().map(|&v| complex.vertices().point(v)).collect();
+    let points: Vec<&[f64]> = vertices
+        .iter()
+        .map(|&v| complex.vertices().point(v))
+        .collect();
     let centre = complex.centroid_of(n, cell);
     let size = points
         .iter()
-        .map(|p| (0..d).map(|a| (p[a] - centre[a]).powi(2)).sum::<f64>().sqrt())
+        .map(|p| {
+            (0..d)
+                .map(|a| (p[a] - centre[a]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
     for (p, &v) in points.iter().zip(vertices) {

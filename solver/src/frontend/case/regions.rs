@@ -176,7 +176,10 @@ impl Case {
         if self.output.probes.is_empty() {
             return;
         }
-        if !matches!(self.problem, super::Problem::Diffusion(_) | super::Problem::Heat(_)) {
+        if !matches!(
+            self.problem,
+            super::Problem::Diffusion(_) | super::Problem::Heat(_)
+        ) {
             collector.error(
                 None,
                 &self.output.probes[0].key,
@@ -198,12 +201,20 @@ impl Case {
                 collector.error(
                     None,
                     &probe.key,
-                    format!("the point {p:?} has {} coordinates; the mesh lives in R^{d}", p.len()),
+                    format!(
+                        "the point {p:?} has {} coordinates; the mesh lives in R^{d}",
+                        p.len()
+                    ),
                     None,
                 );
                 continue;
             }
-            if let Some((i, p)) = probe.points.iter().enumerate().find(|(_, p)| locator.locate(p).is_none()) {
+            if let Some((i, p)) = probe
+                .points
+                .iter()
+                .enumerate()
+                .find(|(_, p)| locator.locate(p).is_none())
+            {
                 let which = if probe.points.len() == 1 {
                     String::new()
                 } else {
@@ -213,7 +224,10 @@ impl Case {
                     None,
                     &probe.key,
                     format!("the probe point {p:?}{which} is outside the mesh"),
-                    Some("`hasse info` prints the mesh's extent; a point on the boundary is inside".into()),
+                    Some(
+                        "`hasse info` prints the mesh's extent; a point on the boundary is inside"
+                            .into(),
+                    ),
                 );
             }
         }

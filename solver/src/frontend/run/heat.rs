@@ -147,7 +147,9 @@ pub(super) fn solve_streaming<'a>(
                     let post = Instant::now();
                     level_quantities
                         .push(super::quantities::level_values(case, complex, u, location));
-                    level_probes.push(super::probes::probe_values(case, complex, location, u, None));
+                    level_probes.push(super::probes::probe_values(
+                        case, complex, location, u, None,
+                    ));
                     let mut fields = vec![
                         Cochain::new("u", dim, u.to_vec()).with_description("the temperature")
                     ];
@@ -244,8 +246,7 @@ pub(super) fn solve_streaming<'a>(
         ),
     )];
     notes.extend(quantities.notes);
-    let (probe_notes, probes) =
-        super::probes::probe_report(case, &history.times, &level_probes);
+    let (probe_notes, probes) = super::probes::probe_report(case, &history.times, &level_probes);
     notes.extend(probe_notes);
     if let Some(probes) = probes {
         report.insert("probes".into(), probes);

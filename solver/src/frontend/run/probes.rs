@@ -22,9 +22,15 @@ pub(super) fn probe_values(
         return Vec::new();
     }
     let Ok(locator) = PointLocator::new(complex) else {
-        return case.output.probes.iter().map(|p| vec![f64::NAN; p.points.len()]).collect();
+        return case
+            .output
+            .probes
+            .iter()
+            .map(|p| vec![f64::NAN; p.points.len()])
+            .collect();
     };
-    let gradient = (location != Location::Nodal).then(|| gradient_of(complex, location, values, cell_points));
+    let gradient =
+        (location != Location::Nodal).then(|| gradient_of(complex, location, values, cell_points));
     case.output
         .probes
         .iter()
@@ -61,7 +67,10 @@ pub(super) fn probe_report(
         return (Vec::new(), None);
     }
     let last = &levels[levels.len() - 1];
-    let when = times.last().map(|t| format!(" at t = {t}")).unwrap_or_default();
+    let when = times
+        .last()
+        .map(|t| format!(" at t = {t}"))
+        .unwrap_or_default();
     let mut notes = Vec::new();
     let mut entries = Vec::new();
     for (i, probe) in probes.iter().enumerate() {
@@ -73,7 +82,11 @@ pub(super) fn probe_report(
                 points.len(),
                 points[0],
                 points[points.len() - 1],
-                if times.is_empty() { String::new() } else { " at every saved level".into() }
+                if times.is_empty() {
+                    String::new()
+                } else {
+                    " at every saved level".into()
+                }
             ),
         };
         notes.push(("probe".to_string(), text));
@@ -110,16 +123,17 @@ pub fn probes_csv(report: &Value) -> Option<String> {
     text.push_str("probe,point,");
     text.push_str(&axes[..d].join(","));
     text.push_str(",u\n");
-    let row = |text: &mut String, t: Option<f64>, name: &str, k: usize, point: &Value, u: &Value| {
-        if let Some(t) = t {
-            text.push_str(&format!("{t},"));
-        }
-        text.push_str(&format!("\"{}\",{k}", name.replace('"', "'")));
-        for a in 0..d {
-            text.push_str(&format!(",{}", point[a].as_f64().unwrap_or(f64::NAN)));
-        }
-        text.push_str(&format!(",{:e}\n", u.as_f64().unwrap_or(f64::NAN)));
-    };
+    let row =
+        |text: &mut String, t: Option<f64>, name: &str, k: usize, point: &Value, u: &Value| {
+            if let Some(t) = t {
+                text.push_str(&format!("{t},"));
+            }
+            text.push_str(&format!("\"{}\",{k}", name.replace('"', "'")));
+            for a in 0..d {
+                text.push_str(&format!(",{}", point[a].as_f64().unwrap_or(f64::NAN)));
+            }
+            text.push_str(&format!(",{:e}\n", u.as_f64().unwrap_or(f64::NAN)));
+        };
     for probe in probes {
         let name = probe["name"].as_str().unwrap_or("probe");
         let points = probe["points"].as_array()?;
@@ -132,7 +146,14 @@ pub fn probes_csv(report: &Value) -> Option<String> {
             Some(times) => {
                 for (level, t) in times.iter().enumerate() {
                     for (k, point) in points.iter().enumerate() {
-                        row(&mut text, t.as_f64(), name, k, point, &probe["values"][level][k]);
+                        row(
+                            &mut text,
+                            t.as_f64(),
+                            name,
+                            k,
+                            point,
+                            &probe["values"][level][k],
+                        );
                     }
                 }
             }

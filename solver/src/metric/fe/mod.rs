@@ -167,9 +167,9 @@ pub fn load(
 /// use hasse_complex::generate::rectangle;
 /// use hasse_solver::metric::fe;
 /// let k = rectangle(3, 2, [0.0, 3.0], [0.0, 1.0]).unwrap();
-/// // f = 2 in cell 0 (of area 1), 0 elsewhere: a total load of 2.
+/// // f = 2 in cell 0 (of area 1 × 1/2), 0 elsewhere: a total load of 1.
 /// let b = fe::load_in_cells(&k, &|c, _| if c == 0 { 2.0 } else { 0.0 }).unwrap();
-/// assert!((b.iter().sum::<f64>() - 2.0).abs() < 1e-14);
+/// assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-14);
 /// ```
 pub fn load_in_cells(
     complex: &Complex,

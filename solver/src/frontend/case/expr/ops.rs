@@ -3,7 +3,7 @@
 //!
 //! exmex has only unary and binary operators, so `if(c, a, b)` is read by
 //! rewriting it, before exmex parses the text, into two binary operators:
-//! `if_else(if_then(c, a), b)`. `if_then` yields `a` when `c` holds and a
+//! `((c) if_then (a)) if_else (b)`. `if_then` yields `a` when `c` holds and a
 //! marker otherwise; `if_else` passes any value but the marker through and
 //! replaces the marker by `b`. The marker is a NaN with a payload of its
 //! own: exmex hands the value of `if_then` straight to `if_else` (no
@@ -144,8 +144,10 @@ pub(crate) fn rewrite_conditionals(text: &str) -> Result<String, ExprError> {
             .map(|a| rewrite_conditionals(a))
             .collect::<Result<_, _>>()
             .map_err(|_| syntax("an argument of `if(…)` is not an expression"))?;
+        // Infix, fully bracketed: exmex's function syntax `op(a, b)` does
+        // not nest binary operators reliably.
         out.push_str(&format!(
-            "if_else(if_then(({}), ({})), ({}))",
+            "((({}) if_then ({})) if_else ({}))",
             inner[0], inner[1], inner[2]
         ));
         i = k + 1;

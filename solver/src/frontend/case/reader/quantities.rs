@@ -154,10 +154,19 @@ impl Reader {
             };
             let written = |key: &str| table.get(key).is_some();
             let points = match (at, from, to) {
-                (Some(Some(p)), None, None) if !written("from") && !written("to") && !written("points") => vec![p],
+                (Some(Some(p)), None, None)
+                    if !written("from") && !written("to") && !written("points") =>
+                {
+                    vec![p]
+                }
                 (None, Some(Some(a)), Some(Some(b))) if !written("at") => {
                     if a.len() != b.len() {
-                        self.error(header, &prefix, "`from` and `to` have different numbers of coordinates", None);
+                        self.error(
+                            header,
+                            &prefix,
+                            "`from` and `to` have different numbers of coordinates",
+                            None,
+                        );
                         continue;
                     }
                     let Some(k) = count else { continue };
@@ -180,14 +189,23 @@ impl Reader {
                     continue;
                 }
             };
-            out.push(ProbeSpec { name, points, key: prefix });
+            out.push(ProbeSpec {
+                name,
+                points,
+                key: prefix,
+            });
         }
         out
     }
 
     /// `<prefix>.<key>` as a point of 1 to 3 finite coordinates: `None`
     /// when not written, `Some(None)` when written wrongly (reported).
-    fn point_at(&mut self, table: &dyn TableLike, prefix: &str, key: &str) -> Option<Option<Vec<f64>>> {
+    fn point_at(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        key: &str,
+    ) -> Option<Option<Vec<f64>>> {
         let entry = self.entry(table, prefix, key)?;
         let coordinates: Option<Vec<f64>> = entry.item.as_array().and_then(|a| {
             a.iter()
@@ -199,9 +217,16 @@ impl Reader {
                 .collect()
         });
         match coordinates {
-            Some(p) if (1..=3).contains(&p.len()) && p.iter().all(|x| x.is_finite()) => Some(Some(p)),
+            Some(p) if (1..=3).contains(&p.len()) && p.iter().all(|x| x.is_finite()) => {
+                Some(Some(p))
+            }
             _ => {
-                self.error(entry.span(), &entry.name, "a point: an array of 1 to 3 finite numbers, e.g. [0.5, 0.25]", None);
+                self.error(
+                    entry.span(),
+                    &entry.name,
+                    "a point: an array of 1 to 3 finite numbers, e.g. [0.5, 0.25]",
+                    None,
+                );
                 Some(None)
             }
         }
