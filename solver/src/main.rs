@@ -548,14 +548,12 @@ fn run_case(
             (None, Some(stream)) => stream.finish(complex, &mut result),
             (None, None) => run::write_output(&case, complex, &result, &stem),
         };
-        // Quantities of a transient run level by level, and probes.
+        // The CSV tables (transient quantities, probes) beside the output.
         let written = written.and_then(|files| {
-            let report = result.report_json(complex);
-            let mut csv: Vec<_> = run::write_quantities_csv(&stem, &report)?
-                .into_iter()
-                .collect();
-            csv.extend(run::write_probes_csv(&stem, &report)?);
-            Ok((files, csv))
+            Ok((
+                files,
+                run::write_tables(&stem, &result.report_json(complex))?,
+            ))
         });
         match written {
             Ok(files) => Some(files),
@@ -598,23 +596,8 @@ fn run_case(
             names.extend(files.extra_xdmf.iter().map(|p| p.display().to_string()));
             names.extend(csv.iter().map(|p| p.display().to_string()));
             println!("output     {}", names.join(", "));
-            // A refinement also wrote each level alone (for readers that
-            // take one mesh per file); name the first and the last.
-            let level_file = |files: Option<&Vec<PathBuf>>| {
-                files
-                    .and_then(|f| f.first())
-                    .map(|p| p.display().to_string())
-            };
-            match (
-                level_file(files.levels.first()),
-                level_file(files.levels.last()),
-            ) {
-                (Some(first), Some(last)) if files.levels.len() > 1 => println!(
-                    "levels     {first} … {last} (each level alone, {} files)",
-                    files.levels.iter().map(Vec::len).sum::<usize>()
-                ),
-                (Some(only), _) => println!("levels     {only} (the level alone)"),
-                _ => {}
+            if let Some(levels) = files.levels_line() {
+                println!("levels     {levels}");
             }
         }
     } else {

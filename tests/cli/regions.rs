@@ -47,7 +47,7 @@ fn max_error_of(case: &str, sets: &[&str]) -> f64 {
         .unwrap_or_else(|| panic!("no error line in:\n{stdout}"));
     let after = line.split("max ").nth(1).expect("a max error");
     after
-        .split(|c: char| c == ',' || c == ' ')
+        .split([',', ' '])
         .next()
         .and_then(|v| v.parse().ok())
         .unwrap_or_else(|| panic!("cannot read the max error of `{line}`"))

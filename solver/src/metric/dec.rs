@@ -191,24 +191,19 @@ pub fn load(
 /// position (data given per region). A vertex's dual cell straddles the
 /// top cells around it, so its load is Σ_c f(c, x_v) ⋆1(v) |c| / Σ_c' |c'|
 /// over the top cells c on v: each cell's datum weighted by its share of
-/// the vertex's neighbourhood. For an f that does not depend on the cell
-/// this is f(x_v) ⋆1(v), the load of [`load`].
+/// the vertex's neighbourhood; f(x_v) ⋆1(v) ([`load`]) for a uniform f.
 ///
 /// ```
-/// use hasse_complex::generate::kuhn;
-/// use hasse_complex::DualKind;
+/// use hasse_complex::{generate::kuhn, DualKind};
 /// use hasse_solver::metric::dec;
 /// // The unit square as two right triangles on the diagonal v0–v3.
 /// let k = kuhn(&[vec![0.0, 1.0], vec![0.0, 1.0]]).unwrap();
 /// let uniform = dec::load(&k, DualKind::Circumcentric, &|_| 3.0).unwrap();
 /// let by_cell = dec::load_in_cells(&k, DualKind::Circumcentric, &|_, _| 3.0).unwrap();
-/// // The same up to the rounding of f·Σ|c| / Σ|c|.
 /// assert!(uniform.iter().zip(&by_cell).all(|(a, b)| (a - b).abs() <= 1e-15 * a.abs()));
-/// // f = 4 in triangle 0 only: vertex 0, in both triangles of equal
-/// // area, gets half of 4 ⋆1(v).
-/// let half = dec::load_in_cells(&k, DualKind::Circumcentric, &|c, _| if c == 0 { 4.0 } else { 0.0 }).unwrap();
-/// let star = dec::load(&k, DualKind::Circumcentric, &|_| 1.0).unwrap();
-/// assert!((half[0] - 2.0 * star[0]).abs() < 1e-15);
+/// // f = 3 in triangle 0 only: vertex 0, in both (equal) triangles, gets half.
+/// let half = dec::load_in_cells(&k, DualKind::Circumcentric, &|c, _| 3.0 * f64::from(c == 0)).unwrap();
+/// assert!((half[0] - uniform[0] / 2.0).abs() < 1e-15);
 /// ```
 pub fn load_in_cells(
     complex: &Complex,
@@ -221,7 +216,7 @@ pub fn load_in_cells(
     let volume = complex.measure(n);
     let mut weighted = vec![0.0; complex.cell_count(0)];
     let mut around = vec![0.0; complex.cell_count(0)];
-    for c in 0..complex.cell_count(n) {
+    for (c, &measure) in volume.iter().enumerate() {
         for &v in complex.cell_vertices(n, c) {
             let value = f(c, vertices.point(v));
             if !value.is_finite() {
@@ -231,8 +226,8 @@ pub fn load_in_cells(
                     value,
                 });
             }
-            weighted[v] += value * volume[c];
-            around[v] += volume[c];
+            weighted[v] += value * measure;
+            around[v] += measure;
         }
     }
     Ok(star

@@ -274,10 +274,12 @@ fn solve_dense(mut a: Vec<Vec<f64>>) -> Option<Vec<f64>> {
             return None;
         }
         a.swap(k, pivot);
-        for i in k + 1..m {
-            let factor = a[i][k] / a[k][k];
-            for j in k..=m {
-                a[i][j] -= factor * a[k][j];
+        let (upper, lower) = a.split_at_mut(k + 1);
+        let pivot_row = &upper[k];
+        for row in lower.iter_mut() {
+            let factor = row[k] / pivot_row[k];
+            for (r, p) in row[k..].iter_mut().zip(&pivot_row[k..]) {
+                *r -= factor * p;
             }
         }
     }

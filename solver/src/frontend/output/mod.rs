@@ -282,6 +282,29 @@ pub struct OutputFiles {
     pub levels: Vec<Vec<PathBuf>>,
 }
 
+impl OutputFiles {
+    /// A refinement also writes each level alone (for readers that take
+    /// one mesh per file): the summary names the first and the last.
+    pub fn levels_line(&self) -> Option<String> {
+        let first_file = |files: Option<&Vec<PathBuf>>| {
+            files
+                .and_then(|f| f.first())
+                .map(|p| p.display().to_string())
+        };
+        match (
+            first_file(self.levels.first()),
+            first_file(self.levels.last()),
+        ) {
+            (Some(first), Some(last)) if self.levels.len() > 1 => Some(format!(
+                "{first} … {last} (each level alone, {} files)",
+                self.levels.iter().map(Vec::len).sum::<usize>()
+            )),
+            (Some(only), _) => Some(format!("{only} (the level alone)")),
+            _ => None,
+        }
+    }
+}
+
 /// Why an output could not be written. Nothing is left under the final
 /// file names when any of these is returned, except for an [`Io`] error on
 /// removing a stale degree file of an older output, or the partial output

@@ -62,7 +62,7 @@ pub(crate) use diffusion::diffusion_problem;
 use diffusion::solve_diffusion;
 pub(crate) use error::{diffusion_error, Keys, FINITE_HELP};
 pub use error::{Failure, RunError};
-pub use probes::{probes_csv, write_probes_csv};
+pub use probes::{probes_csv, write_probes_csv, write_tables};
 pub use quantities::{quantities_csv, write_quantities_csv};
 pub use stream::{solve_streaming, write_levels, write_output, LevelStream};
 

@@ -178,3 +178,17 @@ pub fn write_probes_csv(
     atomic::write_atomically(&path, |temporary| atomic::write_text(temporary, &text))?;
     Ok(Some(path))
 }
+
+/// The CSV tables of a run beside its output: `<stem>.quantities.csv` (a
+/// transient run's quantities, level by level) and `<stem>.probes.csv`,
+/// each when the report has them; the paths written.
+pub fn write_tables(
+    stem: &std::path::Path,
+    report: &Value,
+) -> Result<Vec<std::path::PathBuf>, crate::frontend::output::OutputError> {
+    let mut written: Vec<_> = super::write_quantities_csv(stem, report)?
+        .into_iter()
+        .collect();
+    written.extend(write_probes_csv(stem, report)?);
+    Ok(written)
+}
