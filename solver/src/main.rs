@@ -478,7 +478,7 @@ fn run_case(
     let writing = case.output.write || output.is_some();
     // A transient run writes each saved level as it completes to a partial
     // output, so that an interrupted or failed run keeps them.
-    let mut stream = writing.then(|| run::LevelStream::new(&case, &stem));
+    let mut stream = (writing && case.output.partial).then(|| run::LevelStream::new(&case, &stem));
     // With a [refine] table the case is solved, refined and re-solved; the
     // output holds every level, each on its own mesh.
     let (refined, study, result) = match &case.refine {
@@ -525,6 +525,9 @@ fn run_case(
         }
     };
     result.timings.insert(0, ("mesh".into(), mesh_seconds));
+    result
+        .warnings
+        .extend(run::unwritten_fields(&case, &result));
     let written = if writing {
         progress.phase("writing output");
         if let Some(e) = stream.as_ref().and_then(run::LevelStream::stopped) {

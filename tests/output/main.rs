@@ -13,4 +13,5 @@ mod flux_convention;
 mod level_files;
 mod output_files;
 mod output_python;
+mod output_selection;
 mod refine_series;

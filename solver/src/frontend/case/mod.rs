@@ -164,7 +164,7 @@ impl Default for SolverSpec {
 /// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [2, 2]\n[problem]\nmethod = \"fv\"\n";
 /// // By default the stem is the case file's, in the working directory.
 /// let output = Case::from_text("cases/plate.toml", text, &[]).unwrap().output;
-/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true, quantities: vec![], probes: vec![] });
+/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true, quantities: vec![], probes: vec![], fields: None, partial: true });
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct OutputSpec {
@@ -178,6 +178,20 @@ pub struct OutputSpec {
     pub quantities: Vec<QuantitySpec>,
     /// `[[output.probe]]` tables, in order.
     pub probes: Vec<ProbeSpec>,
+    /// `fields`: the names of the fields to write (`None`: all).
+    pub fields: Option<Vec<String>>,
+    /// `partial`: whether a transient run writes each level as it
+    /// completes to a partial output (default true).
+    pub partial: bool,
+}
+
+impl OutputSpec {
+    /// Whether the field called `name` is written.
+    pub fn keeps(&self, name: &str) -> bool {
+        self.fields
+            .as_ref()
+            .is_none_or(|fields| fields.iter().any(|f| f == name))
+    }
 }
 
 /// One `[regions]` entry: `name = "condition"` tags the top cells whose

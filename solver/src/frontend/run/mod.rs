@@ -64,7 +64,7 @@ pub(crate) use error::{diffusion_error, Keys, FINITE_HELP};
 pub use error::{Failure, RunError};
 pub use probes::{probes_csv, write_probes_csv, write_tables};
 pub use quantities::{quantities_csv, write_quantities_csv};
-pub use stream::{solve_streaming, write_levels, write_output, LevelStream};
+pub use stream::{solve_streaming, unwritten_fields, write_levels, write_output, LevelStream};
 
 /// What a run produced.
 #[derive(Clone, Debug)]

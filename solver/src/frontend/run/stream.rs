@@ -5,12 +5,41 @@
 use super::*;
 
 /// The run's cochains, each marked with the method that computed it.
-fn cochains(fields: &[Cochain], method: Option<&str>) -> Vec<Cochain> {
+/// The fields of a level as written: those `[output] fields` selects (all
+/// by default), each with the method that made it.
+fn cochains(case: &Case, fields: &[Cochain], method: Option<&str>) -> Vec<Cochain> {
     fields
         .iter()
+        .filter(|c| case.output.keeps(&c.name))
         .map(|c| match method {
             Some(m) => c.clone().with_method(m),
             None => c.clone(),
+        })
+        .collect()
+}
+
+/// A warning for each name of `[output] fields` that the run does not
+/// produce (a misspelt name would otherwise drop a field silently).
+pub fn unwritten_fields(case: &Case, result: &RunResult) -> Vec<String> {
+    let Some(wanted) = &case.output.fields else {
+        return Vec::new();
+    };
+    let mut produced: Vec<&str> = result
+        .fields
+        .iter()
+        .chain(result.series.iter().flat_map(|(_, f)| f))
+        .map(|c| c.name.as_str())
+        .collect();
+    produced.sort_unstable();
+    produced.dedup();
+    wanted
+        .iter()
+        .filter(|w| !produced.contains(&w.as_str()))
+        .map(|w| {
+            format!(
+                "output.fields names `{w}`, which this run does not produce (it produces {})",
+                produced.join(", ")
+            )
         })
         .collect()
 }
@@ -34,7 +63,7 @@ fn run_output<'c>(
     let steps = if result.series.is_empty() {
         vec![Step {
             time: 0.0,
-            cochains: cochains(&result.fields, method),
+            cochains: cochains(case, &result.fields, method),
         }]
     } else {
         result
@@ -42,7 +71,7 @@ fn run_output<'c>(
             .iter()
             .map(|(time, fields)| Step {
                 time: *time,
-                cochains: cochains(fields, method),
+                cochains: cochains(case, fields, method),
             })
             .collect()
     };
@@ -82,7 +111,7 @@ pub fn write_levels(
         .map(|(k, (complex, fields))| MeshStep {
             time: k as f64,
             complex,
-            cochains: cochains(fields, method),
+            cochains: cochains(case, fields, method),
         })
         .collect();
     crate::frontend::output::write_mesh_series(
@@ -208,7 +237,7 @@ impl<'a> LevelStream<'a> {
         };
         let step = Step {
             time,
-            cochains: cochains(fields, method),
+            cochains: cochains(self.case, fields, method),
         };
         match partial.push(&step) {
             Ok(()) => {}

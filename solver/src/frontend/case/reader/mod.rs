@@ -106,7 +106,15 @@ pub(super) const SOLVER_KEYS: &[&str] = &[
     "prolongation",
     "ordering",
 ];
-pub(super) const OUTPUT_KEYS: &[&str] = &["directory", "name", "write", "quantity", "probe"];
+pub(super) const OUTPUT_KEYS: &[&str] = &[
+    "directory",
+    "name",
+    "write",
+    "quantity",
+    "probe",
+    "fields",
+    "partial",
+];
 pub(super) const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "tolerance"];
 pub(super) const STRATEGIES: &[&str] = &[
     "uniform",

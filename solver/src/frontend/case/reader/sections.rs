@@ -410,6 +410,8 @@ impl Reader {
             write: true,
             quantities: Vec::new(),
             probes: Vec::new(),
+            fields: None,
+            partial: true,
         };
         let Some((table, _)) = self.subtable(root, "", "output") else {
             return spec;
@@ -435,6 +437,25 @@ impl Reader {
             match e.item.as_bool() {
                 Some(b) => spec.write = b,
                 None => self.type_error(&e, "true or false"),
+            }
+        }
+        if let Some(e) = self.entry(table, "output", "partial") {
+            match e.item.as_bool() {
+                Some(b) => spec.partial = b,
+                None => self.type_error(&e, "true or false"),
+            }
+        }
+        if let Some(e) = self.entry(table, "output", "fields") {
+            let names: Option<Vec<String>> = e
+                .item
+                .as_array()
+                .and_then(|a| a.iter().map(|v| v.as_str().map(str::to_string)).collect());
+            match names {
+                Some(names) if !names.is_empty() => spec.fields = Some(names),
+                _ => self.type_error(
+                    &e,
+                    "a non-empty array of field names, e.g. [\"u\", \"flux\"]",
+                ),
             }
         }
         spec.quantities = self.quantities(table);
