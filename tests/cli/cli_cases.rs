@@ -2,18 +2,10 @@
 //! it; its reported error is below a stated bound, and where the case has a
 //! closed-form or hand-derived answer the written field is compared with it.
 
+use crate::hasse::hasse;
 use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq};
 use hasse_complex::generate;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn hasse(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs")
-}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("hasse-cli-cases-{}-{name}", std::process::id()));

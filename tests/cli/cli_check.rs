@@ -2,16 +2,8 @@
 //! each expected problem at the right line, all at once; `hasse run` on them
 //! exits with code 2 and writes no output.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn hasse(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs")
-}
+use crate::hasse::hasse;
+use std::path::PathBuf;
 
 /// File, then the (line, text) pairs `hasse check` must print, in order.
 const EXPECTED: &[(&str, &[(usize, &str)])] = &[

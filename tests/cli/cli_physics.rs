@@ -4,18 +4,10 @@
 //! grid, the output holds the time series and the modes, and bad
 //! problem-kind input is refused with the key named.
 
+use crate::hasse::hasse;
 use approx::{abs_diff_eq, assert_relative_eq, relative_eq};
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn hasse(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs")
-}
+use std::path::PathBuf;
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("hasse-cli-physics-{}-{name}", std::process::id()));

@@ -9,6 +9,8 @@
 //! own scratch directory (test name and process id) and hands environment
 //! variables to the child `hasse` process, never to this one.
 
+#[path = "../common/hasse.rs"]
+mod hasse;
 #[path = "../common/pyenv.rs"]
 mod pyenv;
 #[path = "../common/scratch.rs"]

@@ -19,32 +19,7 @@
 //!   K_eff = Σ ω_e d_e d_eᵀ / (2|⋆v|) = [[(1+√5)/3, 1/3], [1/3, (1+√5)/3]]
 //!   = [[1.079, 0.333], [0.333, 1.079]], ‖K_eff − I‖₂ = (√5 − 1)/3 = 0.412.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn hasse(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs")
-}
-
-/// `hasse run case --set …` with output off: the summary (stdout).
-fn run(case: &str, sets: &[&str]) -> String {
-    let mut args = vec!["run", case, "--set", "output.write=false"];
-    for s in sets {
-        args.extend(["--set", s]);
-    }
-    let out = hasse(&args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "hasse {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
-}
+use crate::hasse::summary as run;
 
 /// The summary's warning lines.
 fn warnings(stdout: &str) -> Vec<&str> {

@@ -9,17 +9,9 @@
 //!   at most the nodal error plus the interpolation error,
 //!   h²/8 (|u_xx| + |u_yy|) ≤ 2π²/(8·32²) = 2.4e-3 at h = 1/32.
 
+use crate::hasse::hasse;
 use crate::scratch::Scratch;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn hasse(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs")
-}
 
 /// `case` with `extra` appended, in a scratch directory.
 fn case_with(dir: &Path, case: &str, extra: &str) -> String {

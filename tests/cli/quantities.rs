@@ -12,20 +12,12 @@
 //!   or is produced leaves, Σ outflow = ∫f = 2, and the flux out of xmin is
 //!   −g·|xmin| = −2 whatever the method.
 
+use crate::hasse::{hasse, summary};
 use crate::scratch::Scratch;
 use hdf5::types::VarLenUnicode;
 use std::path::Path;
-use std::process::{Command, Output};
 
 const CASE: &str = "cases/two-materials.toml";
-
-fn hasse(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs")
-}
 
 /// `cases/two-materials.toml` with `extra` appended (more quantity
 /// tables: `--set` cannot add tables), in a scratch directory.
@@ -38,22 +30,6 @@ fn case_with(test: &str, extra: &str) -> (Scratch, String) {
     std::fs::write(&path, format!("{text}\n{extra}")).unwrap();
     let path = path.to_str().unwrap().to_string();
     (dir, path)
-}
-
-/// The summary of `hasse run case` with output off and the overrides.
-fn summary(case: &str, sets: &[&str]) -> String {
-    let mut args = vec!["run", case, "--set", "output.write=false"];
-    for s in sets {
-        args.extend(["--set", s]);
-    }
-    let out = hasse(&args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "hasse {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
 }
 
 /// The value of the quantity named `name` in a summary.

@@ -7,16 +7,8 @@
 //! (piecewise linear, flux continuous across x = 1) and below (a source
 //! on the left half only).
 
+use crate::hasse::{hasse, summary};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn hasse(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hasse"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("the hasse binary runs")
-}
 
 fn with_sets<'a>(mut args: Vec<&'a str>, sets: &[&'a str]) -> Vec<&'a str> {
     for s in sets {
@@ -33,14 +25,7 @@ fn max_error(sets: &[&str]) -> f64 {
 
 /// [`max_error`] of another case file.
 fn max_error_of(case: &str, sets: &[&str]) -> f64 {
-    let args = with_sets(vec!["run", case, "--set", "output.write=false"], sets);
-    let out = hasse(&args);
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "hasse {args:?} failed:\n{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = summary(case, sets);
     let line = stdout
         .lines()
         .find(|l| l.starts_with("error "))

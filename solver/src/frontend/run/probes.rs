@@ -168,15 +168,23 @@ pub fn write_probes_csv(
     stem: &std::path::Path,
     report: &Value,
 ) -> Result<Option<std::path::PathBuf>, crate::frontend::output::OutputError> {
+    probes_csv(report)
+        .map(|text| write_beside(stem, "probes.csv", &text))
+        .transpose()
+}
+
+/// Write `text` to `<stem>.<suffix>`, atomically.
+pub(super) fn write_beside(
+    stem: &std::path::Path,
+    suffix: &str,
+    text: &str,
+) -> Result<std::path::PathBuf, crate::frontend::output::OutputError> {
     use crate::frontend::output::atomic;
-    let Some(text) = probes_csv(report) else {
-        return Ok(None);
-    };
     let mut name = stem.file_name().unwrap_or_default().to_os_string();
-    name.push(".probes.csv");
+    name.push(format!(".{suffix}"));
     let path = stem.with_file_name(name);
-    atomic::write_atomically(&path, |temporary| atomic::write_text(temporary, &text))?;
-    Ok(Some(path))
+    atomic::write_atomically(&path, |temporary| atomic::write_text(temporary, text))?;
+    Ok(path)
 }
 
 /// The CSV tables of a run beside its output: `<stem>.quantities.csv` (a

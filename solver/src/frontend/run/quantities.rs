@@ -158,15 +158,9 @@ pub fn write_quantities_csv(
     stem: &std::path::Path,
     report: &Value,
 ) -> Result<Option<std::path::PathBuf>, crate::frontend::output::OutputError> {
-    use crate::frontend::output::atomic;
-    let Some(text) = quantities_csv(report) else {
-        return Ok(None);
-    };
-    let mut name = stem.file_name().unwrap_or_default().to_os_string();
-    name.push(".quantities.csv");
-    let path = stem.with_file_name(name);
-    atomic::write_atomically(&path, |temporary| atomic::write_text(temporary, &text))?;
-    Ok(Some(path))
+    quantities_csv(report)
+        .map(|text| super::probes::write_beside(stem, "quantities.csv", &text))
+        .transpose()
 }
 
 fn quantity_json(q: &QuantitySpec, value: f64) -> Value {
