@@ -15,3 +15,4 @@ mod output_files;
 mod output_python;
 mod output_selection;
 mod refine_series;
+mod restart;

@@ -114,6 +114,14 @@ pub enum HeatBoundary {
 /// Why a transient run could not be made.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HeatError {
+    /// [`Heat::initial_field`] has not one value per unknown.
+    #[error("the initial field has {given} values, but the problem has {unknowns} unknowns")]
+    InitialField {
+        /// Values given.
+        given: usize,
+        /// Unknowns of the problem on this mesh.
+        unknowns: usize,
+    },
     /// [`Heat::dt`] is zero, negative, NaN or infinite.
     #[error("time step Δt = {dt} must be positive and finite")]
     TimeStep {
@@ -207,6 +215,10 @@ pub struct Heat {
     /// set ([`Diffusion::with_source_by_region`] says how each method
     /// integrates it).
     pub source_by_region: Option<Arc<Regional<TimeFn>>>,
+    /// u⁰ as values of the unknowns (a restart from a saved level),
+    /// instead of the initial function of [`Heat::run`]; Dirichlet values
+    /// at t₀ still win.
+    pub initial_field: Option<Vec<f64>>,
     /// Applied in order, as in [`Diffusion::boundary`].
     pub boundary: Vec<(String, HeatBoundary)>,
     /// 1: backward Euler (default), ½: Crank–Nicolson, 0: forward Euler.
@@ -292,6 +304,7 @@ impl Heat {
             conductivity,
             source: TimeFn::Steady(Arc::new(|_| 0.0)),
             source_by_region: None,
+            initial_field: None,
             boundary: Vec::new(),
             theta: 1.0,
             dt,
@@ -465,10 +478,21 @@ impl Heat {
                 .clone()
                 .unwrap_or_else(|| complex.centroid(n).to_vec()),
         };
+        if let Some(given) = &self.initial_field {
+            if given.len() != unknowns {
+                return Err(HeatError::InitialField {
+                    given: given.len(),
+                    unknowns,
+                });
+            }
+        }
         let mut u: Vec<f64> = Vec::with_capacity(unknowns);
         for i in 0..unknowns {
             let x = &points[i * d..(i + 1) * d];
-            let v = first.fixed[i].unwrap_or_else(|| initial(x));
+            let v = first.fixed[i].unwrap_or_else(|| match &self.initial_field {
+                Some(given) => given[i],
+                None => initial(x),
+            });
             if !v.is_finite() {
                 return Err(HeatError::NonFinite {
                     datum: Datum::Initial,

@@ -227,6 +227,9 @@ pub struct TimeSpec {
     pub theta: f64,
     /// Every how many steps a level is written (t₀ and the last always are).
     pub save_every: usize,
+    /// `end`, when the case gives it instead of `steps` (a restarted run
+    /// then stops at it).
+    pub end: Option<f64>,
 }
 
 /// ∂u/∂t − ∇·(K∇u) = f(x, t) from u(x, t₀) = `initial` (`kind = "heat"`).
@@ -250,7 +253,7 @@ pub struct TimeSpec {
 /// let case = Case::from_text("h.toml", text, &[]).unwrap();
 /// let Problem::Heat(spec) = &case.problem else { panic!() };
 /// // `end` is turned into a whole number of steps.
-/// let time = TimeSpec { dt: 0.25, steps: 4, start: 0.0, theta: 0.5, save_every: 1 };
+/// let time = TimeSpec { dt: 0.25, steps: 4, start: 0.0, theta: 0.5, save_every: 1, end: None };
 /// assert_eq!(spec.time, time);
 /// assert!(spec.source.uses_time() && !spec.initial.uses_time());
 /// ```
@@ -268,6 +271,19 @@ pub struct HeatSpec {
     pub boundary: Vec<BoundarySpec>,
     /// `[time]`.
     pub time: TimeSpec,
+    /// `initial = { from = "run.h5", level = … }`: u⁰ is a saved level of
+    /// an earlier run on the same mesh, and t₀ its time.
+    pub restart: Option<RestartSpec>,
+}
+
+/// Where a restarted heat run takes its initial temperature.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RestartSpec {
+    /// The earlier run's HDF5 output, relative to the case file's
+    /// directory.
+    pub from: PathBuf,
+    /// The saved level (`None`: the last one).
+    pub level: Option<usize>,
 }
 
 /// Mixed Darcy: u = −K∇p, ∇·u = f, flux on faces and pressure on cells.

@@ -78,6 +78,7 @@ fn run_error(case: &Case, spec: &HeatSpec, e: HeatError) -> RunError {
         HeatError::StartTime { .. } => RunError::input_at(case, "time.start", message, None),
         HeatError::Unsupported { .. } => RunError::input_at(case, "problem.method", message, None),
         HeatError::Overflow { .. } => RunError::solve(case, message, None),
+        HeatError::InitialField { .. } => RunError::input_at(case, "problem.initial.from", message, None),
         HeatError::Solve(_) | HeatError::Canonical(_) => RunError::solve(
             case,
             format!("factorising M/Δt + θK: {message}"),
@@ -105,8 +106,16 @@ pub(super) fn solve_streaming<'a>(
     phase: &mut dyn FnMut(&str),
     mut stream: Option<&mut LevelStream<'a>>,
 ) -> Result<RunResult, RunError> {
-    let heat = heat_problem(case, spec);
-    let time = &spec.time;
+    let mut heat = heat_problem(case, spec);
+    let mut time = spec.time.clone();
+    if let Some(restart) = &spec.restart {
+        let state = super::restart::read(case, spec, restart, complex)?;
+        heat.start = state.time;
+        heat.initial_field = Some(state.field);
+        time.start = state.time;
+        time.steps = state.steps;
+    }
+    let time = &time;
     phase("assembling and factorising");
     let started = Instant::now();
     let initial = |x: &[f64]| spec.initial.eval(x, time.start);
@@ -214,7 +223,7 @@ pub(super) fn solve_streaming<'a>(
         .map(|&(_, l2, max)| Errors::sampled(l2, max));
     let fields = series.last().map(|(_, f)| f.clone()).unwrap_or_default();
     let mut report = serde_json::Map::new();
-    report.insert("time".into(), time_json(spec, &history));
+    report.insert("time".into(), time_json(time, &history));
     if !level_errors.is_empty() {
         report.insert(
             "errors_per_level".into(),
@@ -290,11 +299,11 @@ pub(super) fn solve_streaming<'a>(
     })
 }
 
-fn time_json(spec: &HeatSpec, history: &History) -> serde_json::Value {
+fn time_json(time: &crate::frontend::case::TimeSpec, history: &History) -> serde_json::Value {
     serde_json::json!({
-        "dt": spec.time.dt,
-        "theta": spec.time.theta,
-        "start": spec.time.start,
+        "dt": time.dt,
+        "theta": time.theta,
+        "start": time.start,
         "steps": history.steps,
         "saved_times": history.times,
         "factorization_seconds": history.factorization_seconds,
@@ -311,6 +320,9 @@ pub(super) fn check(case: &Case, spec: &HeatSpec, complex: &Complex) -> Result<(
         coefficient: "conductivity",
         boundary: &spec.boundary,
     };
+    if let Some(restart) = &spec.restart {
+        super::restart::read(case, spec, restart, complex)?;
+    }
     heat_problem(case, spec)
         .at(spec.time.start)
         .check_data(complex)

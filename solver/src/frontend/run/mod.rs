@@ -56,6 +56,7 @@ mod maxwell;
 mod probes;
 mod quantities;
 pub mod refine;
+mod restart;
 mod stream;
 
 pub(crate) use diffusion::diffusion_problem;

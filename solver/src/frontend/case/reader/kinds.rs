@@ -165,7 +165,13 @@ impl Reader {
             Some(_) => self.expression_or_regions_at(table, "problem", "source", scope),
             None => scope.parse("0").ok(),
         };
+        let mut restart = None;
         let initial = match self.entry(table, "problem", "initial") {
+            Some(e) if e.item.is_table_like() => {
+                restart = self.restart(&e);
+                restart.as_ref()?;
+                scope.parse("0").ok()
+            }
             Some(_) => self.expression_at(table, "problem", "initial", scope),
             None => {
                 self.error(
@@ -189,7 +195,46 @@ impl Reader {
             initial: initial?,
             boundary,
             time: time?,
+            restart,
         }))
+    }
+
+    /// `problem.initial = { from = "run.h5", level = "last" | k }`.
+    fn restart(&mut self, entry: &super::Entry) -> Option<crate::frontend::case::RestartSpec> {
+        let table = entry.item.as_table_like()?;
+        self.check_keys(table, "problem.initial", &["from", "level"]);
+        let Some(from) = self.string_at(table, "problem.initial", "from") else {
+            self.error(
+                entry.span(),
+                "problem.initial.from",
+                "missing: the HDF5 output of the run to restart from",
+                Some("initial = { from = \"run.h5\", level = \"last\" }".into()),
+            );
+            return None;
+        };
+        let level = match self.entry(table, "problem.initial", "level") {
+            None => None,
+            Some(e) => match (e.item.as_str(), e.item.as_integer()) {
+                (Some("last"), _) => None,
+                (_, Some(k)) if k >= 0 => Some(k as usize),
+                _ => {
+                    self.error(
+                        e.span(),
+                        "problem.initial.level",
+                        "a saved level: \"last\" or its number k ≥ 0 (/steps/<k> of the file)",
+                        None,
+                    );
+                    return None;
+                }
+            },
+        };
+        let base = std::path::Path::new(&self.file)
+            .parent()
+            .unwrap_or(std::path::Path::new("."));
+        Some(crate::frontend::case::RestartSpec {
+            from: base.join(from),
+            level,
+        })
     }
 
     /// The `[time]` table of a heat problem.
@@ -256,12 +301,16 @@ impl Reader {
                 }
             },
         };
+        let end = self
+            .entry(table, "time", "end")
+            .and_then(|e| e.item.as_float().or(e.item.as_integer().map(|i| i as f64)));
         let time = TimeSpec {
             dt: dt?,
             steps: steps?,
             start: start?,
             theta: theta?,
             save_every: save_every?,
+            end,
         };
         self.time_advances(table, &time).then_some(time)
     }
