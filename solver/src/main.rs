@@ -476,6 +476,13 @@ fn run_case(
     };
     let mesh_seconds = mesh_started.elapsed().as_secs_f64();
     let writing = case.output.write || output.is_some();
+    if writing {
+        if let Err(message) = run::OutputEstimate::of(&case, &complex).check(&stem) {
+            progress.finish();
+            eprintln!("error: {}: {message}\n    help: free some space, write elsewhere (-o DIR/NAME), save fewer levels (time.save_every) or fewer fields ([output] fields)", path.display());
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    }
     // A transient run writes each saved level as it completes to a partial
     // output, so that an interrupted or failed run keeps them.
     let mut stream = (writing && case.output.partial).then(|| run::LevelStream::new(&case, &stem));

@@ -84,3 +84,33 @@ fn partial_false_writes_the_transient_output_once_at_the_end() {
         );
     }
 }
+
+#[test]
+fn an_output_larger_than_the_free_space_is_refused_before_solving() {
+    // heat-square: 21 levels of 33² vertices with u, u_exact and error, and
+    // its mesh, twice over with the partial output: well above 100 kB.
+    let dir = Scratch::new("output_disk");
+    let stem = dir.join("heat");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = Command::new(env!("CARGO_BIN_EXE_hasse"))
+        .args([
+            "run",
+            "cases/heat-square.toml",
+            "-o",
+            stem.to_str().unwrap(),
+        ])
+        .env("HASSE_DISK_LIMIT", "100000")
+        .current_dir(&root)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("the output would take at least")
+            && stderr.contains("97.7 KiB free (HASSE_DISK_LIMIT)"),
+        "{stderr}"
+    );
+    // Refused before solving: no time step was taken, nothing is written.
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("time "));
+    assert!(!stem.with_extension("h5").exists());
+}

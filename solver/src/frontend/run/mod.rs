@@ -48,6 +48,7 @@ mod consistency;
 mod coupled;
 mod darcy;
 mod diffusion;
+mod disk;
 mod elasticity;
 mod error;
 mod gradient;
@@ -61,6 +62,7 @@ mod stream;
 
 pub(crate) use diffusion::diffusion_problem;
 use diffusion::solve_diffusion;
+pub use disk::OutputEstimate;
 pub(crate) use error::{diffusion_error, Keys, FINITE_HELP};
 pub use error::{Failure, RunError};
 pub use probes::{probes_csv, write_probes_csv, write_tables};
