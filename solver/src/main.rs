@@ -180,7 +180,8 @@ enum Command {
     // Verbatim: the examples are one per line.
     #[command(verbatim_doc_comment)]
     Converge {
-        /// The case file (.toml); it needs an `[exact]` table.
+        /// The case file (.toml); it needs an exact solution (`[exact]`, or
+        /// `exact` in a coupled case's [[field]]).
         case: PathBuf,
         /// Number of levels: the case's own mesh (and Δt), then N − 1
         /// refinements.
