@@ -129,29 +129,43 @@ enum Command {
         #[arg(long)]
         timing: bool,
     },
-    /// Convergence study: solve CASE on N successively refined meshes and
-    /// report the errors against its `[exact]` solution and the observed
-    /// orders of convergence.
+    /// Convergence study: solve CASE on N successively refined meshes (or
+    /// time steps) and report the errors against its exact solution and
+    /// the observed orders of convergence.
     ///
-    /// For each method and level: the generator's resolution, the mesh size
-    /// h (largest top-cell diameter), unknowns, the L² error and the H¹
-    /// (seminorm, energy) error by quadrature of the field each method
-    /// represents (P1/Q1 shape functions, or cell values with their
-    /// reconstructed gradient; the H¹ error needs `exact.gradient`), the
-    /// max error at the unknowns' points, the face-flux error where the
-    /// method defines one, and seconds. `hasse run` also prints the
-    /// sampled figures (L² at the unknowns' points, gradient at the
-    /// centroids), which superconverge on grids. Orders: between consecutive levels, and the
-    /// least-squares slope of log e against log h over all levels.
+    /// Cases: diffusion (kind = "diffusion"), heat, darcy and coupled. For
+    /// each method and level: the resolution, the mesh size h (largest
+    /// top-cell diameter; Δt in a time study), unknowns, and the errors the
+    /// case's run reports. Diffusion: the L² and H¹ (seminorm, energy)
+    /// error by quadrature of the field each method represents (P1/Q1
+    /// shape functions, or cell values with their reconstructed gradient;
+    /// the H¹ error needs `exact.gradient`), the max error at the unknowns'
+    /// points, the face-flux error where the method defines one. Heat: L²
+    /// and max at the unknowns' points at the last step. Darcy: pressure at
+    /// the cell points, and the flux error with `exact.gradient`. Coupled:
+    /// one row per [[field]] with `exact`, named FIELD (METHOD). `hasse run`
+    /// also prints the sampled figures (L² at the unknowns' points,
+    /// gradient at the centroids), which superconverge on grids. Orders:
+    /// between consecutive levels, and the least-squares slope of log e
+    /// against log h (log Δt) over all levels.
     ///
     /// Refinement `uniform` re-generates the case's mesh with 2^k times its
     /// mesh.n on level k (voronoi: 4^k times the sites; sphere: k more
-    /// subdivisions). A mesh read from a file cannot be refined this way;
-    /// `hasse refine` refines any mesh by SPLIT and reports each step's
-    /// errors.
+    /// subdivisions); a mesh read from a file has no mesh.n: use `split`.
+    /// `split` starts from the case's mesh (generated or a file) and splits
+    /// every cell of the previous level through its centroid by the axis
+    /// planes (quads → 4 quads, triangles → polygons), halving h; the
+    /// resolution column is the number of cells. `time` (heat only) keeps
+    /// the mesh and halves Δt, doubling the steps to the same end time; the
+    /// resolution column is the number of steps.
+    ///
+    /// A spatial study of a heat case keeps the case's Δt, whose time
+    /// error is the same on every level: the spatial order shows only while
+    /// the spatial error dominates it (use a small time.dt). A time study
+    /// likewise needs a mesh whose spatial error is below the time error.
     ///
     /// Prints the table, writes DIR/convergence.csv, .json, .png and .svg
-    /// (log–log error against h, reference slopes 1 and 2).
+    /// (log–log error against h or Δt, reference slopes 1 and 2).
     /// Exit code 0 on success, 1 when a solve fails or an --expect order is
     /// missed, 2 for bad input.
     ///
@@ -160,19 +174,26 @@ enum Command {
     ///   hasse converge cases/distorted-quads.toml --levels 5 --methods fv,fv-mimetic,fe -o out/dq
     ///   hasse converge cases/box-3d.toml --levels 3 --set mesh.n=\[8,8,8\] --expect 2
     ///   hasse converge cases/poisson-square.toml --levels 4 --methods dec,fe --set mesh.cells=simplex
+    ///   hasse converge cases/l-shape.toml --refine split --levels 3 --methods fe
+    ///   hasse converge cases/heat-square.toml --refine time --levels 3 --set mesh.n=\[64,64\] --set time.scheme=backward-euler
+    ///   hasse converge cases/darcy-layered.toml --levels 3 --set mesh.n=\[8,8\]
     // Verbatim: the examples are one per line.
     #[command(verbatim_doc_comment)]
     Converge {
-        /// The case file (.toml); it needs an `[exact]` table.
+        /// The case file (.toml); it needs an exact solution (`[exact]`, or
+        /// `exact` in a coupled case's [[field]]).
         case: PathBuf,
-        /// Number of meshes: the case's own resolution, then N − 1 refinements.
+        /// Number of levels: the case's own mesh (and Δt), then N − 1
+        /// refinements.
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=16))]
         levels: u32,
-        /// How meshes are refined (SPLIT refinement: `hasse refine`).
+        /// How each level is refined: uniform (re-generate at 2× mesh.n),
+        /// split (split every cell; any mesh, files too), time (halve Δt).
         #[arg(long, value_enum, default_value_t = RefineArg::Uniform)]
         refine: RefineArg,
         /// Methods side by side on the same meshes (default: the case's own):
-        /// fd, fe, fv, fv-mimetic, dec, dec-barycentric.
+        /// fd, fe, fv, fv-mimetic, dec, dec-barycentric (diffusion and heat
+        /// cases; a darcy or coupled case studies its own methods).
         #[arg(long, value_delimiter = ',', value_name = "METHOD,...")]
         methods: Vec<String>,
         /// Output directory (default: converge-STEM, STEM the case
@@ -198,6 +219,10 @@ enum Command {
 enum RefineArg {
     /// Re-generate the mesh at 2^k times the case's resolution.
     Uniform,
+    /// Split every cell of the previous level through its centroid.
+    Split,
+    /// Halve the time step of a transient case, same mesh.
+    Time,
 }
 
 /// Exit code for bad input (case file, mesh file, parameters).
@@ -695,11 +720,14 @@ fn converge(
     if expect.is_some() && levels < 2 {
         return bad_input("--expect needs at least 2 levels to observe an order".into());
     }
+    let refinement = match refine {
+        RefineArg::Uniform => Refinement::Uniform,
+        RefineArg::Split => Refinement::Split,
+        RefineArg::Time => Refinement::Time,
+    };
     let study = Study {
         levels,
-        refinement: match refine {
-            RefineArg::Uniform => Refinement::Uniform,
-        },
+        refinement,
         methods,
     };
     let result = study.run(path, set, &mut |level, rows| {
@@ -711,11 +739,18 @@ fn converge(
             .iter()
             .map(|r| format!("{} {:.2} s", r.method, r.solve_seconds))
             .collect();
+        let size = match refinement {
+            Refinement::Uniform => format!("n = {:?}, h = {:.3e}", first.resolution, first.h),
+            Refinement::Split => format!("h = {:.3e}", first.h),
+            Refinement::Time => format!(
+                "{} steps of Δt = {:.3e}",
+                first.resolution.first().copied().unwrap_or(0),
+                first.h
+            ),
+        };
         eprintln!(
-            "level {level} of 0–{}: n = {:?}, h = {:.3e}, {} cells, mesh {:.2} s; {}",
+            "level {level} of 0–{}: {size}, {} cells, mesh {:.2} s; {}",
             levels - 1,
-            first.resolution,
-            first.h,
             first.cells,
             first.mesh_seconds,
             solves.join(", ")

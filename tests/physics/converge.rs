@@ -362,11 +362,11 @@ fn bad_studies_exit_2_and_write_nothing() {
     for (args, message) in [
         (
             vec!["converge", "cases/l-shape.toml", "--levels", "2", "-o", o],
-            "a mesh file cannot be refined uniformly",
+            "a mesh file has none; use --refine split",
         ),
         (
             vec!["converge", "cases/torus.toml", "--levels", "2", "-o", o],
-            "on a diffusion problem; this case is kind = \"gradient\"",
+            "measures diffusion, heat, darcy and coupled cases; this case is kind = \"gradient\"",
         ),
         (
             vec![
@@ -393,6 +393,34 @@ fn bad_studies_exit_2_and_write_nothing() {
                 o,
             ],
             "at least 2 levels",
+        ),
+        (
+            // A steady case has no time step to halve.
+            vec![
+                "converge",
+                "cases/poisson-square.toml",
+                "--levels",
+                "2",
+                "--refine",
+                "time",
+                "-o",
+                o,
+            ],
+            "--refine time halves the time step of a transient case; this case is kind = \"diffusion\"",
+        ),
+        (
+            // Darcy's methods are flux masses, not the diffusion methods.
+            vec![
+                "converge",
+                "cases/darcy-layered.toml",
+                "--levels",
+                "2",
+                "--methods",
+                "fe",
+                "-o",
+                o,
+            ],
+            "a darcy case's method is its own",
         ),
         (
             // DEC's circumcentric dual needs simplices; the case has quads.

@@ -1,6 +1,7 @@
 //! Integration tests of the physics through the library: diffusion by
 //! every method, Darcy, Maxwell, transient heat, elasticity, coupled
-//! fields, re-solving on refined meshes and convergence studies.
+//! fields, re-solving on refined meshes and convergence studies (of any
+//! mesh, in space and in time).
 //!
 //! One test binary per area (methods, physics, cli, output); the former
 //! test files are the modules below, e.g.
@@ -10,6 +11,7 @@
 mod orders;
 
 mod converge;
+mod converge_any;
 mod coupled;
 mod darcy;
 mod diffusion;

@@ -20,13 +20,17 @@ pub use plot::{PlotError, PlotFormat, PlotOptions};
 use serde::Serialize;
 use std::str::FromStr;
 
-/// How each level's mesh is made from the previous one.
+/// How each level is made from the previous one: a finer mesh, or (for a
+/// transient case) a smaller time step on the same mesh.
 ///
 /// ```
 /// use hasse_solver::study::Refinement;
 /// assert_eq!(Refinement::Uniform.name(), "uniform");
 /// // Reports (the study's JSON) use the same name.
-/// assert_eq!(serde_json::to_value(Refinement::Uniform).unwrap(), "uniform");
+/// assert_eq!(serde_json::to_value(Refinement::Split).unwrap(), "split");
+/// // A time study's orders are against Δt, not the (fixed) mesh size.
+/// assert_eq!(Refinement::Time.size_name(), "Δt");
+/// assert_eq!(Refinement::Split.size_name(), "h");
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -39,6 +43,16 @@ pub enum Refinement {
     /// stretching stays that of the coarse mesh. Mesh files cannot be
     /// refined this way.
     Uniform,
+    /// Level 0 is the case's mesh (generated or read from a file); each
+    /// next level is the uniform SPLIT refinement of the previous one
+    /// ([`hasse_complex::refine::uniform`]: every top cell cut through
+    /// its centroid by the axis hyperplanes, which halves h). Simplices
+    /// become convex polygons or polyhedra from level 1 on.
+    Split,
+    /// The same mesh on every level; level k takes Δt/2ᵏ and 2ᵏ times
+    /// the steps to the same end time (transient cases only). The orders
+    /// are against Δt.
+    Time,
 }
 
 impl Refinement {
@@ -46,6 +60,26 @@ impl Refinement {
     pub fn name(&self) -> &'static str {
         match self {
             Refinement::Uniform => "uniform",
+            Refinement::Split => "split",
+            Refinement::Time => "time",
+        }
+    }
+
+    /// The size that the levels halve and the orders are measured
+    /// against: the mesh size h, or the time step Δt.
+    pub fn size_name(&self) -> &'static str {
+        match self {
+            Refinement::Uniform | Refinement::Split => "h",
+            Refinement::Time => "Δt",
+        }
+    }
+
+    /// What the resolution column of a row holds.
+    pub fn resolution_name(&self) -> &'static str {
+        match self {
+            Refinement::Uniform => "generator resolution (mesh.n)",
+            Refinement::Split => "top cells",
+            Refinement::Time => "time steps",
         }
     }
 }
@@ -109,11 +143,15 @@ pub struct StudyRow {
     pub method: String,
     /// 0 = the case's own mesh.
     pub level: usize,
-    /// The generator's resolution on this level (`mesh.n`, or the
-    /// subdivisions of a sphere).
+    /// What the level refines: the generator's resolution (`mesh.n`, or
+    /// the subdivisions of a sphere) in a uniform study, the number of top
+    /// cells in a SPLIT study, the number of time steps in a time study
+    /// ([`Refinement::resolution_name`]).
     pub resolution: Vec<usize>,
-    /// Mesh size: the largest diameter of a top cell
-    /// ([`hasse_complex::Complex::mesh_size`]).
+    /// The size the orders are measured against
+    /// ([`Refinement::size_name`]): the mesh size, the largest diameter of
+    /// a top cell ([`hasse_complex::Complex::mesh_size`]), or the time
+    /// step Δt in a time study (whose mesh is fixed).
     pub h: f64,
     /// Number of top cells.
     pub cells: usize,

@@ -7,7 +7,7 @@
 //! font library; SVGs name the font family and leave rendering to the
 //! viewer.
 
-use super::{Norm, StudyResult};
+use super::{Norm, Refinement, StudyResult};
 use image::ImageEncoder;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -277,7 +277,10 @@ impl StudyResult {
             .map_err(draw_error)?;
         chart
             .configure_mesh()
-            .x_desc("mesh size h (largest cell diameter)")
+            .x_desc(match self.refinement {
+                Refinement::Uniform | Refinement::Split => "mesh size h (largest cell diameter)",
+                Refinement::Time => "time step Δt",
+            })
             .y_desc("error")
             .label_style((FAMILY, 13))
             .axis_desc_style((FAMILY, 15))

@@ -1,7 +1,7 @@
 //! The study as one plain-text table: a row per method and level, a
 //! least-squares row per method, the orders next to their errors.
 
-use super::{Norm, StudyResult};
+use super::{Norm, Refinement, StudyResult};
 use std::fmt;
 
 fn resolution(r: &[usize]) -> String {
@@ -54,12 +54,17 @@ impl StudyResult {
             Some(t) => writeln!(f, "case     {} ({t})", self.case)?,
             None => writeln!(f, "case     {}", self.case)?,
         }
+        let size = match self.refinement {
+            Refinement::Uniform | Refinement::Split => "h = largest top-cell diameter",
+            Refinement::Time => "Δt = time step (one mesh)",
+        };
         writeln!(
             f,
-            "study    {} level{}, {} refinement; h = largest top-cell diameter; p = observed order (from the previous level; least squares over all levels); L² and H¹ error by quadrature of each method's field, max at the unknowns' points",
+            "study    {} level{}, {} refinement; resolution = {}; {size}; p = observed order (from the previous level; least squares over all levels); errors as the run reports them (diffusion: L² and H¹ by quadrature of each method's field, max at the unknowns' points; heat, darcy, coupled: at the unknowns' points)",
             self.levels,
             if self.levels == 1 { "" } else { "s" },
-            self.refinement.name()
+            self.refinement.name(),
+            self.refinement.resolution_name()
         )?;
         let norms: Vec<Norm> = Norm::ALL
             .into_iter()
@@ -91,7 +96,7 @@ impl StudyResult {
             "method",
             "level",
             "resolution",
-            "h",
+            self.refinement.size_name(),
             "unknowns",
             mw = method_width,
             rw = resolution_width
@@ -182,7 +187,12 @@ impl StudyResult {
     /// assert!((l2_order - 2.0).abs() < 1e-12);
     /// ```
     pub fn csv(&self) -> String {
-        let mut out = String::from("method,level,resolution,h,cells,unknowns");
+        // A time study's size column is its time step, not a mesh size.
+        let size = match self.refinement {
+            Refinement::Uniform | Refinement::Split => "h",
+            Refinement::Time => "dt",
+        };
+        let mut out = format!("method,level,resolution,{size},cells,unknowns");
         for n in Norm::ALL {
             out.push_str(&format!(",{0},{0}_order", n.key()));
         }
@@ -250,6 +260,8 @@ impl StudyResult {
             "refinement": self.refinement,
             "levels": self.levels,
             "mesh_size": "largest diameter of a top cell",
+            // The rows' `h`: the mesh size, or Δt in a time study.
+            "size": self.refinement.size_name(),
             "methods": methods,
         })
     }
