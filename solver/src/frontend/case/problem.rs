@@ -253,7 +253,7 @@ pub struct TimeSpec {
 /// let case = Case::from_text("h.toml", text, &[]).unwrap();
 /// let Problem::Heat(spec) = &case.problem else { panic!() };
 /// // `end` is turned into a whole number of steps.
-/// let time = TimeSpec { dt: 0.25, steps: 4, start: 0.0, theta: 0.5, save_every: 1, end: None };
+/// let time = TimeSpec { dt: 0.25, steps: 4, start: 0.0, theta: 0.5, save_every: 1, end: Some(1.0) };
 /// assert_eq!(spec.time, time);
 /// assert!(spec.source.uses_time() && !spec.initial.uses_time());
 /// ```
