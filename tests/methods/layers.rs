@@ -9,7 +9,7 @@
 //! names (`crate::…`) a module of its own layer's rank or higher, other
 //! than itself, or when the complex is named where it must not be: `la`
 //! knows no complex, and in `multigrid` only the transfers do. Comments
-//! and test code (`tests.rs` files, and everything after `#[cfg(test)]`)
+//! and test code (`tests.rs` files, `tests/` directories, and everything after `#[cfg(test)]`)
 //! do not count: a test may build realistic input with a higher layer (an
 //! FE metric to exercise the operator) without making the library depend
 //! on it.
@@ -100,7 +100,9 @@ fn lower_layers_never_name_higher_ones() {
         };
         let own = rank(layer)
             .unwrap_or_else(|| panic!("{}: `{layer}` is not in LAYERS", relative.display()));
-        if relative.ends_with("tests.rs") {
+        // Test code: `tests.rs` files and `tests/` directories of a layer.
+        if relative.ends_with("tests.rs") || relative.components().any(|c| c.as_os_str() == "tests")
+        {
             continue;
         }
         let text = std::fs::read_to_string(file).unwrap();

@@ -609,7 +609,7 @@ pub(crate) fn available_memory() -> Option<(u64, &'static str)> {
     Some((kib.saturating_mul(1024), "MemAvailable in /proc/meminfo"))
 }
 
-fn human_bytes(bytes: f64) -> String {
+pub(crate) fn human_bytes(bytes: f64) -> String {
     let units = ["B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"];
     let mut value = bytes;
     let mut unit = 0;

@@ -4,6 +4,7 @@
 //! large for the memory is.
 
 use crate::frontend::case::{Case, Problem};
+use crate::frontend::mesh_spec::human_bytes;
 use hasse_complex::Complex;
 use std::path::Path;
 
@@ -89,10 +90,10 @@ impl OutputEstimate {
         }
         Err(format!(
             "the output would take at least {} ({} saved levels), but {} has {} free ({source})",
-            human(self.bytes),
+            human_bytes(self.bytes),
             self.levels,
             dir.display(),
-            human(free as f64)
+            human_bytes(free as f64)
         ))
     }
 }
@@ -121,15 +122,4 @@ fn free_space(dir: &Path) -> Option<(u64, &'static str)> {
         .parse()
         .ok()?;
     Some((available, "df"))
-}
-
-fn human(bytes: f64) -> String {
-    let units = ["B", "KiB", "MiB", "GiB", "TiB", "PiB"];
-    let mut value = bytes;
-    let mut unit = 0;
-    while value >= 1024.0 && unit + 1 < units.len() {
-        value /= 1024.0;
-        unit += 1;
-    }
-    format!("{value:.1} {}", units[unit])
 }
