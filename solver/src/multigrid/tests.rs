@@ -6,6 +6,9 @@ use super::*;
 use crate::la::fixed::FixedSplit;
 use crate::la::iterative::RowMatrix;
 
+/// What a test returns: a failed step is its error.
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
 fn apply(p: &RowMatrix, x: &[f64]) -> Vec<f64> {
     let mut y = vec![0.0; p.nrows()];
     p.multiply(x, &mut y);
@@ -13,13 +16,13 @@ fn apply(p: &RowMatrix, x: &[f64]) -> Vec<f64> {
 }
 
 #[test]
-fn grid_prolongation_interpolates_affine_nodal_fields_and_copies_cell_values() {
+fn grid_prolongation_interpolates_affine_nodal_fields_and_copies_cell_values() -> TestResult {
     // 4×2×2 cells → 2×1×1: u = 1 + x − 2y + 3z at the coarse vertices
     // must come out exact at the fine ones (trilinear interpolation
     // reproduces affine functions), in vertex units (h = 1 per cell).
     let fine = [4, 2, 2];
     let coarse = [2, 1, 1];
-    let p = grid_prolongation(&fine, &coarse, Transfer::Nodal).unwrap();
+    let p = grid_prolongation(&fine, &coarse, Transfer::Nodal)?;
     let u = |x: f64, y: f64, z: f64| 1.0 + x - 2.0 * y + 3.0 * z;
     let mut uc = Vec::new();
     for k in 0..2 {
@@ -40,34 +43,36 @@ fn grid_prolongation_interpolates_affine_nodal_fields_and_copies_cell_values() {
         }
     }
     // Cells: child (i, j, k) takes parent (i/2, j/2, k/2).
-    let p = grid_prolongation(&fine, &coarse, Transfer::Cells).unwrap();
+    let p = grid_prolongation(&fine, &coarse, Transfer::Cells)?;
     let fine_values = apply(&p, &[10.0, 20.0]);
     let expected: Vec<f64> = (0..16)
         .map(|c| if c % 4 < 2 { 10.0 } else { 20.0 })
         .collect();
     assert_eq!(fine_values, expected);
+    Ok(())
 }
 
 #[test]
-fn dirichlet_vertices_remove_their_coarse_twins() {
+fn dirichlet_vertices_remove_their_coarse_twins() -> TestResult {
     // 1D, 4 cells: vertices 0..4, coarse 0..2; both ends fixed.
-    let p = grid_prolongations(&[4], Transfer::Nodal).unwrap();
+    let p = grid_prolongations(&[4], Transfer::Nodal)?;
     let fixed = FixedSplit::from_mask([true, false, false, false, true]);
-    let free = restrict_to_free(&p, &fixed).unwrap();
+    let free = restrict_to_free(&p, &fixed)?;
     // Fine free 1, 2, 3; coarse free: only the middle vertex (fine 2).
     assert_eq!((free[0].matrix.nrows(), free[0].matrix.ncols()), (3, 1));
     assert_eq!(apply(&free[0].matrix, &[1.0]), vec![0.5, 1.0, 0.5]);
     // Cells: a coarse cell goes only with all its children.
-    let p = grid_prolongations(&[4], Transfer::Cells).unwrap();
+    let p = grid_prolongations(&[4], Transfer::Cells)?;
     let fixed = FixedSplit::from_mask([true, true, false, false]);
-    let free = restrict_to_free(&p, &fixed).unwrap();
+    let free = restrict_to_free(&p, &fixed)?;
     assert_eq!((free[0].matrix.nrows(), free[0].matrix.ncols()), (2, 1));
+    Ok(())
 }
 
 #[test]
-fn a_prolongation_of_the_wrong_size_and_bad_options_are_errors() {
-    let m = RowMatrix::from_rows(2, vec![vec![(0, 2.0)], vec![(1, 2.0)]]).unwrap();
-    let p = grid_prolongations(&[8], Transfer::Cells).unwrap();
+fn a_prolongation_of_the_wrong_size_and_bad_options_are_errors() -> TestResult {
+    let m = RowMatrix::from_rows(2, vec![vec![(0, 2.0)], vec![(1, 2.0)]])?;
+    let p = grid_prolongations(&[8], Transfer::Cells)?;
     let options = MultigridOptions {
         coarse_size: 1,
         ..Default::default()
@@ -91,15 +96,16 @@ fn a_prolongation_of_the_wrong_size_and_bad_options_are_errors() {
         Multigrid::new(m.clone(), Vec::new(), &bad),
         Err(MultigridError::Option { .. })
     ));
-    let negative = RowMatrix::from_rows(2, vec![vec![(0, 2.0)], vec![(1, -1.0)]]).unwrap();
+    let negative = RowMatrix::from_rows(2, vec![vec![(0, 2.0)], vec![(1, -1.0)]])?;
     assert!(matches!(
         Multigrid::new(negative, Vec::new(), &MultigridOptions::default()),
         Err(MultigridError::Coarse { size: 2, .. })
     ));
+    Ok(())
 }
 
 #[test]
-fn the_spectral_bound_covers_the_spectrum() {
+fn the_spectral_bound_covers_the_spectrum() -> TestResult {
     // D⁻¹M of tridiag(−1, 2, −1) has eigenvalues 1 − cos(kπ/(n+1)) ∈ (0, 2).
     let n = 500;
     let rows = (0..n)
@@ -115,14 +121,15 @@ fn the_spectral_bound_covers_the_spectrum() {
             row
         })
         .collect();
-    let m = RowMatrix::from_rows(n, rows).unwrap();
+    let m = RowMatrix::from_rows(n, rows)?;
     let lambda = spectral_bound(&m, &vec![0.5; n]);
     let top = 1.0 - (n as f64 * std::f64::consts::PI / (n + 1) as f64).cos();
     assert!(lambda >= top && lambda <= 2.0, "{lambda} vs {top}");
+    Ok(())
 }
 
 #[test]
-fn a_grid_hierarchy_solves_the_1d_laplacian_in_few_iterations() {
+fn a_grid_hierarchy_solves_the_1d_laplacian_in_few_iterations() -> TestResult {
     use crate::la::iterative::CgOptions;
     // The 1D Dirichlet Laplacian on 64 cells (cell-centred, ghost at both ends).
     let n = 64;
@@ -139,27 +146,29 @@ fn a_grid_hierarchy_solves_the_1d_laplacian_in_few_iterations() {
             row
         })
         .collect();
-    let m = RowMatrix::from_rows(n, rows).unwrap();
+    let m = RowMatrix::from_rows(n, rows)?;
     let options = MultigridOptions {
         coarse_size: 4,
         ..Default::default()
     };
-    let p = Hierarchy::Grid { cells: vec![n] }.prolongations(n).unwrap();
-    let mg = Multigrid::new(m, p, &options).unwrap();
+    let p = Hierarchy::Grid { cells: vec![n] }.prolongations(n)?;
+    let mg = Multigrid::new(m, p, &options)?;
     assert!(mg.levels().len() > 3);
     let cg = CgOptions {
         tolerance: 1e-10,
         max_iterations: 50,
     };
-    let (_, report) = mg.solve(&vec![1.0; n], None, &cg).unwrap();
+    let (_, report) = mg.solve(&vec![1.0; n], None, &cg)?;
     assert!(report.iterations < 15);
+    Ok(())
 }
 
 #[test]
-fn grid_prolongations_stop_before_an_axis_of_one_cell() {
-    let p = grid_prolongations(&[8, 4], Transfer::Nodal).unwrap();
+fn grid_prolongations_stop_before_an_axis_of_one_cell() -> TestResult {
+    let p = grid_prolongations(&[8, 4], Transfer::Nodal)?;
     assert_eq!(p.len(), 1); // 8×4 → 4×2, then stop: 2×1 would have an axis of one cell
     assert_eq!((p[0].matrix.nrows(), p[0].matrix.ncols()), (45, 15));
+    Ok(())
 }
 
 /// The cell-centred two-point-flux Laplacian of an n×n×n grid of unit
@@ -194,7 +203,7 @@ fn seven_point(n: usize, boundary: f64) -> RowMatrix {
             }
         }
     }
-    RowMatrix::from_rows(n * n * n, rows).unwrap()
+    RowMatrix::from_rows(n * n * n, rows).expect("rows of the 7-point stencil")
 }
 
 fn dense(m: &RowMatrix) -> nalgebra::DMatrix<f64> {
@@ -209,7 +218,7 @@ fn dense(m: &RowMatrix) -> nalgebra::DMatrix<f64> {
 }
 
 #[test]
-fn the_galerkin_product_is_the_dense_triple_product() {
+fn the_galerkin_product_is_the_dense_triple_product() -> TestResult {
     // A 5×5 symmetric matrix with a full row and an empty-coupling row, and
     // a 5×3 P with overlapping columns, a zero row and an entry of each
     // sign: Pᵀ(AP) from the sparse products against nalgebra's dense
@@ -224,16 +233,14 @@ fn the_galerkin_product_is_the_dense_triple_product() {
             vec![(0, -1.0), (3, 2.0)],
             vec![(0, -1.0), (4, 1.5)],
         ],
-    )
-    .unwrap();
+    )?;
     let p = RowMatrix::new(
         5,
         3,
         vec![0, 2, 3, 5, 5, 6],
         vec![0, 2, 0, 1, 2, 1],
         vec![1.0, 0.5, 1.0, -0.5, 2.0, 1.0],
-    )
-    .unwrap();
+    )?;
     let coarse = p.transpose().product(&a.product(&p));
     let expected = dense(&p).transpose() * dense(&a) * dense(&p);
     assert_eq!((coarse.nrows(), coarse.ncols()), (3, 3));
@@ -243,10 +250,11 @@ fn the_galerkin_product_is_the_dense_triple_product() {
     for i in 0..3 {
         assert!(coarse.row(i).0.windows(2).all(|w| w[0] < w[1]));
     }
+    Ok(())
 }
 
 #[test]
-fn aggregation_coarsens_every_level_of_a_3d_seven_point_stencil() {
+fn aggregation_coarsens_every_level_of_a_3d_seven_point_stencil() -> TestResult {
     // With one θ for all levels the coarsening stalled on level 1 (its
     // Galerkin operator spreads each row over ~30 neighbours, every
     // scaled coupling below θ = 0.08): the hierarchy stopped at 4096
@@ -257,11 +265,14 @@ fn aggregation_coarsens_every_level_of_a_3d_seven_point_stencil() {
         coarse_size: 50,
         ..Default::default()
     };
-    let mg = Multigrid::algebraic(m, &options).unwrap();
+    let mg = Multigrid::algebraic(m, &options)?;
     let levels = mg.levels();
     let sizes: Vec<usize> = levels.iter().map(|l| l.unknowns).collect();
     assert!(levels.len() >= 3, "{sizes:?}");
-    assert!(levels.last().unwrap().unknowns <= 50, "{sizes:?}");
+    assert!(
+        levels.last().ok_or("no levels")?.unknowns <= 50,
+        "{sizes:?}"
+    );
     // Aggregates of a 3D stencil hold a node and its strong neighbours
     // (7 on the fine level), so each level is at least 4× smaller.
     for pair in sizes.windows(2) {
@@ -274,10 +285,11 @@ fn aggregation_coarsens_every_level_of_a_3d_seven_point_stencil() {
     // 100³).
     let complexity = mg.operator_complexity();
     assert!(complexity <= 1.8, "{complexity} for levels {sizes:?}");
+    Ok(())
 }
 
 #[test]
-fn the_coarse_operators_of_a_neumann_laplacian_keep_its_kernel() {
+fn the_coarse_operators_of_a_neumann_laplacian_keep_its_kernel() -> TestResult {
     use super::aggregation::{aggregate, smooth_prolongation};
     use super::cycle::level_strength;
     // Pure Neumann: A·1 = 0. P₀ b_c = 1 for the coarse near-null vector
@@ -289,12 +301,11 @@ fn the_coarse_operators_of_a_neumann_laplacian_keep_its_kernel() {
     let mut a = seven_point(16, 0.0);
     let mut candidate = vec![1.0; a.nrows()];
     for level in 0..3 {
-        let (tentative, coarse_candidate) = aggregate(&a, level_strength(0.08, level), &candidate)
-            .unwrap()
-            .unwrap();
+        let (tentative, coarse_candidate) = aggregate(&a, level_strength(0.08, level), &candidate)?
+            .ok_or("no two unknowns aggregate")?;
         let inverse_diagonal: Vec<f64> = a.diagonal().iter().map(|d| 1.0 / d).collect();
         let lambda = spectral_bound(&a, &inverse_diagonal);
-        let p = smooth_prolongation(&a, &inverse_diagonal, lambda, &tentative).unwrap();
+        let p = smooth_prolongation(&a, &inverse_diagonal, lambda, &tentative)?;
         // P b_c reproduces the fine near-null vector.
         let fine = apply(&p, &coarse_candidate);
         let scale = candidate.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -331,4 +342,5 @@ fn the_coarse_operators_of_a_neumann_laplacian_keep_its_kernel() {
         a = coarse;
         candidate = coarse_candidate;
     }
+    Ok(())
 }

@@ -5,8 +5,11 @@ use faer::sparse::SparseColMat;
 use sprs::CsMat;
 use std::sync::Arc;
 
+/// What a test returns: a failed step is its error.
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
 #[test]
-fn square_blocks_read_like_records_and_turn_into_them_on_a_push() {
+fn square_blocks_read_like_records_and_turn_into_them_on_a_push() -> TestResult {
     // Two square blocks, over rows {0, 2} and {1, 2, 3}, back to back.
     let first = [2.0, -1.0, -1.0, 2.0];
     let second = [3.0, 0.5, 0.0, 0.5, 4.0, 1.0, 0.0, 1.0, 5.0];
@@ -35,6 +38,7 @@ fn square_blocks_read_like_records_and_turn_into_them_on_a_push() {
     pushed.push_block(&[4], &[4], &[7.0]);
     assert_eq!(more, pushed);
     assert_eq!(more.apply(&[1.0; 5]), vec![1.0, 3.5, 6.5, 6.0, 7.0]);
+    Ok(())
 }
 
 /// The error of a five-row Ω whose block 1 lists row 7.
@@ -54,7 +58,7 @@ fn assert_row_7_of_block_1(built: Result<Canonical, CanonicalError>) {
 }
 
 #[test]
-fn square_blocks_skip_the_value_scans_until_their_values_are_changed() {
+fn square_blocks_skip_the_value_scans_until_their_values_are_changed() -> TestResult {
     let square = |indices: Vec<usize>| {
         let values = [
             2.0, -1.0, -1.0, 2.0, 3.0, 0.5, 0.0, 0.5, 4.0, 1.0, 0.0, 1.0, 5.0,
@@ -83,10 +87,11 @@ fn square_blocks_skip_the_value_scans_until_their_values_are_changed() {
         matches!(error, CanonicalError::NonFinite { block: 0 }),
         "{error:?}"
     );
+    Ok(())
 }
 
 #[test]
-fn blocks_over_shared_columns_read_like_listed_rows() {
+fn blocks_over_shared_columns_read_like_listed_rows() -> TestResult {
     // The two blocks of the test above, their rows {0, 2} and
     // {1, 2, 3} as the columns of a 5 × 2 CSC matrix.
     let values = vec![
@@ -137,6 +142,7 @@ fn blocks_over_shared_columns_read_like_listed_rows() {
     expected.push_block(&[4], &[4], &[7.0]);
     assert_eq!(pushed, expected);
     assert_eq!(pushed.apply(&[1.0; 5]), vec![1.0, 3.5, 6.5, 6.0, 7.0]);
+    Ok(())
 }
 
 /// M of `omega` on the nodal operator of `k`, through the blocks'
@@ -145,20 +151,21 @@ fn both_ways(
     k: &hasse_complex::Complex,
     omega: BlockMetric,
 ) -> (SparseColMat<usize, f64>, SparseColMat<usize, f64>) {
-    let gathered = Canonical::new(k.shared_coboundary(0), omega.clone()).unwrap();
-    let from_cells = Canonical::with_cell_blocks(k.shared_coboundary(0), omega, k).unwrap();
+    let gathered = Canonical::new(k.shared_coboundary(0), omega.clone()).expect("δ⁰ and Ω fit");
+    let from_cells =
+        Canonical::with_cell_blocks(k.shared_coboundary(0), omega, k).expect("δ⁰ and Ω fit");
     (gathered.assemble(), from_cells.assemble())
 }
 
 #[test]
-fn cell_blocks_give_the_nine_point_stencil_of_the_unit_grid() {
+fn cell_blocks_give_the_nine_point_stencil_of_the_unit_grid() -> TestResult {
     // Q1 on a 3 × 3 grid of unit squares (h = 1): from the element
     // matrix (4, −1, −2 over 6 on the diagonal, along an edge, across
     // a diagonal), vertex (i, j) gets 4/6 from each of its cells, and
     // a neighbour −1/6 from each shared cell along an edge (two inside,
     // one on the boundary) or −2/6 across a diagonal (one cell).
-    let k = hasse_complex::generate::rectangle(3, 3, [0.0, 3.0], [0.0, 3.0]).unwrap();
-    let omega = crate::metric::fe::stiffness_metric(&k, &[1.0; 9]).unwrap();
+    let k = hasse_complex::generate::rectangle(3, 3, [0.0, 3.0], [0.0, 3.0])?;
+    let omega = crate::metric::fe::stiffness_metric(&k, &[1.0; 9])?;
     let (gathered, from_cells) = both_ways(&k, omega);
     assert_eq!(
         gathered.symbolic().col_ptr(),
@@ -203,12 +210,13 @@ fn cell_blocks_give_the_nine_point_stencil_of_the_unit_grid() {
             );
         }
     }
+    Ok(())
 }
 
 #[test]
-fn cell_blocks_assemble_like_the_gathered_pattern_on_hexahedra_and_polygons() {
+fn cell_blocks_assemble_like_the_gathered_pattern_on_hexahedra_and_polygons() -> TestResult {
     // Moved vertices: no two blocks are alike.
-    let hexes = hasse_complex::generate::box3(3, 2, 2, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
+    let hexes = hasse_complex::generate::box3(3, 2, 2, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0])?;
     let moved: Vec<[f64; 3]> = (0..hexes.cell_count(0))
         .map(|v| {
             let p = hexes.vertices().point(v);
@@ -220,11 +228,9 @@ fn cell_blocks_assemble_like_the_gathered_pattern_on_hexahedra_and_polygons() {
             ]
         })
         .collect();
-    let hexes = hexes
-        .with_vertices(hasse_complex::Vertices::from_points(&moved).unwrap())
-        .unwrap();
+    let hexes = hexes.with_vertices(hasse_complex::Vertices::from_points(&moved)?)?;
     let tensors = vec![1.5; hexes.cell_count(3)];
-    let omega = crate::metric::fe::stiffness_metric(&hexes, &tensors).unwrap();
+    let omega = crate::metric::fe::stiffness_metric(&hexes, &tensors)?;
     let (gathered, from_cells) = both_ways(&hexes, omega);
     assert_eq!(
         gathered.symbolic().row_idx(),
@@ -232,8 +238,8 @@ fn cell_blocks_assemble_like_the_gathered_pattern_on_hexahedra_and_polygons() {
     );
     assert_eq!(gathered.val(), from_cells.val());
     // Virtual elements on quadrilaterals.
-    let quads = hasse_complex::generate::rectangle(4, 3, [0.0, 1.0], [0.0, 1.0]).unwrap();
-    let omega = crate::metric::fe::vem_stiffness_metric(&quads, &[1.0; 12]).unwrap();
+    let quads = hasse_complex::generate::rectangle(4, 3, [0.0, 1.0], [0.0, 1.0])?;
+    let omega = crate::metric::fe::vem_stiffness_metric(&quads, &[1.0; 12])?;
     let (gathered, from_cells) = both_ways(&quads, omega);
     assert_eq!(gathered.val(), from_cells.val());
     // Constants are the kernel: every row of M sums to zero.
@@ -242,12 +248,13 @@ fn cell_blocks_assemble_like_the_gathered_pattern_on_hexahedra_and_polygons() {
         let sum: f64 = (0..dense.ncols()).map(|j| dense[(i, j)]).sum();
         assert!(sum.abs() < 1e-13, "row {i} sums to {sum}");
     }
+    Ok(())
 }
 
 #[test]
-fn a_metric_pushed_to_after_it_was_built_per_cell_uses_its_own_pattern() {
-    let k = hasse_complex::generate::rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
-    let mut omega = crate::metric::fe::stiffness_metric(&k, &[1.0; 4]).unwrap();
+fn a_metric_pushed_to_after_it_was_built_per_cell_uses_its_own_pattern() -> TestResult {
+    let k = hasse_complex::generate::rectangle(2, 2, [0.0, 1.0], [0.0, 1.0])?;
+    let mut omega = crate::metric::fe::stiffness_metric(&k, &[1.0; 4])?;
     assert!(omega.per_cell);
     // One block more than cells: not one block per cell any longer.
     omega.push_symmetric(&[0], &[7.0]);
@@ -259,18 +266,18 @@ fn a_metric_pushed_to_after_it_was_built_per_cell_uses_its_own_pattern() {
     let (tail, head) = (k.cell_vertices(1, 0)[0], k.cell_vertices(1, 0)[1]);
     let plain = Canonical::new(
         k.shared_coboundary(0),
-        crate::metric::fe::stiffness_metric(&k, &[1.0; 4]).unwrap(),
-    )
-    .unwrap()
+        crate::metric::fe::stiffness_metric(&k, &[1.0; 4])?,
+    )?
     .assemble()
     .to_dense();
     let dense = from_cells.to_dense();
     assert!((dense[(tail, tail)] - plain[(tail, tail)] - 7.0).abs() < 1e-14);
     assert!((dense[(tail, head)] - plain[(tail, head)] + 7.0).abs() < 1e-14);
+    Ok(())
 }
 
 #[test]
-fn the_diagonal_pattern_is_the_cells_coupled_through_faces() {
+fn the_diagonal_pattern_is_the_cells_coupled_through_faces() -> TestResult {
     // Three cells in a row, four faces: ∂ by faces has rows (1), (−1, 1),
     // (−1, 1), (−1); ∂ᵀ∂ is tridiagonal whatever the face weights.
     let rows = CsMat::new(
@@ -285,9 +292,10 @@ fn the_diagonal_pattern_is_the_cells_coupled_through_faces() {
     assert_eq!(pattern.row_idx(), &[0, 1, 0, 1, 2, 1, 2]);
     // The operator with real weights has that pattern too.
     let metric = BlockMetric::diagonal(&[2.0, 0.5, 3.0, 1.0]);
-    let m = Canonical::new(rows, metric).unwrap().assemble();
+    let m = Canonical::new(rows, metric)?.assemble();
     assert_eq!(m.symbolic().col_ptr(), pattern.col_ptr());
     assert_eq!(m.symbolic().row_idx(), pattern.row_idx());
+    Ok(())
 }
 
 mod products;

@@ -7,8 +7,11 @@ use nalgebra::DMatrix;
 use sprs::CsMat;
 use std::sync::Arc;
 
+/// What a test returns: a failed step is its error.
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
 #[test]
-fn theorem_one_reproduces_any_matrix_when_the_kernel_is_trivial() {
+fn theorem_one_reproduces_any_matrix_when_the_kernel_is_trivial() -> TestResult {
     // A = ∂_1 of a path of 6 edges with all 7 vertices kept (7 × 6, full
     // column rank); M = tridiag(−1, 3, −1), the thesis's implicit heat matrix.
     let mut a = DMatrix::zeros(7, 6);
@@ -21,7 +24,7 @@ fn theorem_one_reproduces_any_matrix_when_the_kernel_is_trivial() {
         1 => -1.0,
         _ => 0.0,
     });
-    let omega = metric_from_matrix(&a, &m).unwrap();
+    let omega = metric_from_matrix(&a, &m).ok_or("no metric reproduces the matrix")?;
     let back = a.transpose() * &omega * &a;
     assert!((back - &m).abs().max() < 1e-12);
     // A with a kernel (the closed cycle of 3 edges) has no left inverse.
@@ -31,10 +34,11 @@ fn theorem_one_reproduces_any_matrix_when_the_kernel_is_trivial() {
         cycle[((e + 1) % 3, e)] = 1.0;
     }
     assert!(metric_from_matrix(&cycle, &DMatrix::identity(3, 3)).is_none());
+    Ok(())
 }
 
 #[test]
-fn one_dimensional_identity_metric_gives_the_fe_stiffness() {
+fn one_dimensional_identity_metric_gives_the_fe_stiffness() -> TestResult {
     // A = ∂_1ᵀ... thesis: A = ∂_1 ((n+1) × n, boundary vertices kept), Ω = I:
     // AᵀA = tridiag(−1, 2, −1).
     let n = 5;
@@ -43,7 +47,7 @@ fn one_dimensional_identity_metric_gives_the_fe_stiffness() {
         tri.add_triplet(e, e, -1i8);
         tri.add_triplet(e + 1, e, 1i8);
     }
-    let op = Canonical::new(tri.to_csr(), BlockMetric::diagonal(&vec![1.0; n + 1])).unwrap();
+    let op = Canonical::new(tri.to_csr(), BlockMetric::diagonal(&vec![1.0; n + 1]))?;
     let m = op.assemble().to_dense();
     for i in 0..n {
         for j in 0..n {
@@ -55,10 +59,11 @@ fn one_dimensional_identity_metric_gives_the_fe_stiffness() {
             assert_eq!(m[(i, j)], expected);
         }
     }
+    Ok(())
 }
 
 #[test]
-fn dense_blocks_assemble_like_the_dense_triple_product() {
+fn dense_blocks_assemble_like_the_dense_triple_product() -> TestResult {
     // A: 4 rows × 3 unknowns; Ω: one 2×2 symmetric block + a diagonal entry
     // + an off-diagonal triplet pair (symmetric).
     let a = CsMat::new(
@@ -72,7 +77,7 @@ fn dense_blocks_assemble_like_the_dense_triple_product() {
     omega.push_block(&[2], &[2], &[1.5]);
     omega.push_block(&[3], &[0], &[0.25]);
     omega.push_block(&[0], &[3], &[0.25]);
-    let op = Canonical::new(a.clone(), omega.clone()).unwrap();
+    let op = Canonical::new(a.clone(), omega.clone())?;
     let m = op.assemble().to_dense();
     let ad = DMatrix::from_fn(4, 3, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
     let od = DMatrix::from_fn(4, 4, |i, j| omega.to_dense()[i][j]);
@@ -90,10 +95,11 @@ fn dense_blocks_assemble_like_the_dense_triple_product() {
         assert!((mu[i] - row).abs() < 1e-14);
     }
     assert!(!omega.is_symmetric(0.0));
+    Ok(())
 }
 
 #[test]
-fn coupling_blocks_assemble_like_the_dense_product_with_two_incidences() {
+fn coupling_blocks_assemble_like_the_dense_product_with_two_incidences() -> TestResult {
     // A: 4 rows × 3 unknowns, B: the same 4 rows × 2 other unknowns; Ω
     // with a dense 2×2 block, a diagonal entry and an unsymmetric pair,
     // and then diagonal. Expected: the dense Aᵀ Ω B by nalgebra.
@@ -119,7 +125,7 @@ fn coupling_blocks_assemble_like_the_dense_product_with_two_incidences() {
     };
     let (ad, bd) = (dense(&a, 3), dense(&b, 2));
     for omega in [blocks, diagonal] {
-        let op = Canonical::coupling(a.clone(), omega.clone(), b.clone()).unwrap();
+        let op = Canonical::coupling(a.clone(), omega.clone(), b.clone())?;
         assert_eq!((op.shape(), op.unknowns()), ((3, 2), 2));
         let m = op.assemble().to_dense();
         let od = DMatrix::from_fn(4, 4, |i, j| omega.to_dense()[i][j]);
@@ -144,10 +150,11 @@ fn coupling_blocks_assemble_like_the_dense_product_with_two_incidences() {
         Canonical::coupling(a, BlockMetric::diagonal(&[1.0; 4]), short).unwrap_err(),
         CanonicalError::SizeMismatch { metric: 4, rows: 3 }
     );
+    Ok(())
 }
 
 #[test]
-fn a_sum_of_operators_is_the_stacked_operator() {
+fn a_sum_of_operators_is_the_stacked_operator() -> TestResult {
     // 2·(Aᵀ Ω₁ A) + ½·(Iᵀ diag(m) I) against the dense sum, with a block
     // Ω₁ (the general path) and with a diagonal one.
     let a = CsMat::new(
@@ -160,13 +167,12 @@ fn a_sum_of_operators_is_the_stacked_operator() {
     blocks.push_symmetric(&[0, 1], &[2.0, 0.5, 0.5, 3.0]);
     blocks.push_block(&[2], &[2], &[1.5]);
     blocks.push_block(&[3], &[3], &[0.75]);
-    let mass =
-        Canonical::new(CsMat::<i8>::eye(3), BlockMetric::diagonal(&[1.0, 2.0, 4.0])).unwrap();
+    let mass = Canonical::new(CsMat::<i8>::eye(3), BlockMetric::diagonal(&[1.0, 2.0, 4.0]))?;
     let ad = DMatrix::from_fn(4, 3, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
     for omega in [blocks, BlockMetric::diagonal(&[2.0, 3.0, 1.5, 0.75])] {
         let od = DMatrix::from_fn(4, 4, |i, j| omega.to_dense()[i][j]);
-        let stiffness = Canonical::new(a.clone(), omega).unwrap();
-        let sum = Canonical::sum(&[(2.0, &stiffness), (0.5, &mass)]).unwrap();
+        let stiffness = Canonical::new(a.clone(), omega)?;
+        let sum = Canonical::sum(&[(2.0, &stiffness), (0.5, &mass)])?;
         let m = sum.assemble().to_dense();
         let expected = ad.transpose() * od * &ad * 2.0
             + DMatrix::from_diagonal(&nalgebra::DVector::from_vec(vec![0.5, 1.0, 2.0]));
@@ -176,7 +182,7 @@ fn a_sum_of_operators_is_the_stacked_operator() {
             }
         }
     }
-    let other = Canonical::new(CsMat::<i8>::eye(2), BlockMetric::diagonal(&[1.0, 1.0])).unwrap();
+    let other = Canonical::new(CsMat::<i8>::eye(2), BlockMetric::diagonal(&[1.0, 1.0]))?;
     assert_eq!(
         Canonical::sum(&[(1.0, &mass), (1.0, &other)]).unwrap_err(),
         CanonicalError::SumMismatch {
@@ -184,10 +190,11 @@ fn a_sum_of_operators_is_the_stacked_operator() {
             found: 2
         }
     );
+    Ok(())
 }
 
 #[test]
-fn the_clique_pattern_couples_the_kept_vertices_of_each_cell() {
+fn the_clique_pattern_couples_the_kept_vertices_of_each_cell() -> TestResult {
     // Two quadrilaterals side by side: bottom vertices 0 1 2, top 3 4
     // 5; cell 0 = {0, 1, 3, 4}, cell 1 = {1, 2, 4, 5}. Vertex 0 is
     // dropped, so vertices 1..5 become 0..4.
@@ -206,10 +213,11 @@ fn the_clique_pattern_couples_the_kept_vertices_of_each_cell() {
         pattern.row_idx(),
         &[0, 1, 2, 3, 4, 0, 1, 3, 4, 0, 2, 3, 0, 1, 2, 3, 4, 0, 1, 3, 4]
     );
+    Ok(())
 }
 
 #[test]
-fn blocks_numbered_apart_from_their_unknowns_assemble_like_the_dense_product() {
+fn blocks_numbered_apart_from_their_unknowns_assemble_like_the_dense_product() -> TestResult {
     // A cycle of 240 unknowns numbered by a stride permutation, one row
     // (edge) per consecutive pair; blocks of three rows picked by
     // another stride, some symmetric, some with different row and
@@ -249,8 +257,7 @@ fn blocks_numbered_apart_from_their_unknowns_assemble_like_the_dense_product() {
     for r in 0..n {
         omega.push_block(&[r], &[r], &[1.0 + r as f64 / n as f64]);
     }
-    let m = Canonical::new(a.clone(), omega.clone())
-        .unwrap()
+    let m = Canonical::new(a.clone(), omega.clone())?
         .assemble()
         .to_dense();
     let ad = DMatrix::from_fn(n, n, |i, j| f64::from(*a.get(i, j).unwrap_or(&0)));
@@ -264,10 +271,11 @@ fn blocks_numbered_apart_from_their_unknowns_assemble_like_the_dense_product() {
             assert!((m[(i, j)] - expected[(i, j)]).abs() < 1e-12, "({i},{j})");
         }
     }
+    Ok(())
 }
 
 #[test]
-fn a_diagonal_metric_stays_compact_until_a_block_breaks_the_pattern() {
+fn a_diagonal_metric_stays_compact_until_a_block_breaks_the_pattern() -> TestResult {
     let mut omega = BlockMetric::new(3);
     omega.push_block(&[0], &[0], &[2.0]);
     omega.push_block(&[1], &[1], &[3.0]);
@@ -319,15 +327,16 @@ fn a_diagonal_metric_stays_compact_until_a_block_breaks_the_pattern() {
         Canonical::new(a, BlockMetric::diagonal(&[1.0, f64::NAN])).err(),
         Some(CanonicalError::NonFinite { block: 1 })
     );
+    Ok(())
 }
 
 #[test]
-fn diagonal_metrics_assemble_like_the_dense_triple_product_and_the_block_path() {
+fn diagonal_metrics_assemble_like_the_dense_triple_product_and_the_block_path() -> TestResult {
     // A = ∂_2 of a 3×2 grid of squares (17 edges × 6 cells): the
     // two-point flux operator. Dyadic weights make every sum exact, so
     // the column-wise diagonal assembly, the block-wise assembly and
     // the dense product must agree to the last bit.
-    let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
+    let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0])?;
     let a = grid.boundary(2).clone();
     let rows = a.rows();
     let weights: Vec<f64> = (0..rows).map(|r| 0.25 * (r % 5 + 1) as f64).collect();
@@ -349,11 +358,10 @@ fn diagonal_metrics_assemble_like_the_dense_triple_product_and_the_block_path() 
             grid.shared_boundary(2),
             grid.shared_boundary_csc(2),
             diagonal.clone(),
-        )
-        .unwrap()
+        )?
         .assemble();
-        let fast = Canonical::new(a.clone(), diagonal).unwrap().assemble();
-        let general = Canonical::new(a.clone(), by_blocks).unwrap().assemble();
+        let fast = Canonical::new(a.clone(), diagonal)?.assemble();
+        let general = Canonical::new(a.clone(), by_blocks)?.assemble();
         for other in [&general, &shared] {
             assert_eq!(fast.symbolic().col_ptr(), other.symbolic().col_ptr());
             assert_eq!(fast.symbolic().row_idx(), other.symbolic().row_idx());
@@ -379,25 +387,26 @@ fn diagonal_metrics_assemble_like_the_dense_triple_product_and_the_block_path() 
         }
     }
     // Cells 0 and 5 (opposite corners) share no edge: no stored entry.
-    let op = Canonical::new(a, BlockMetric::diagonal(&weights)).unwrap();
+    let op = Canonical::new(a, BlockMetric::diagonal(&weights))?;
     let m = op.assemble();
     let column = &m.symbolic().row_idx()[m.symbolic().col_ptr()[0]..m.symbolic().col_ptr()[1]];
     assert!(!column.contains(&5));
+    Ok(())
 }
 
 #[test]
-fn the_last_assembly_takes_the_pattern_and_a_later_one_rebuilds_it() {
+fn the_last_assembly_takes_the_pattern_and_a_later_one_rebuilds_it() -> TestResult {
     // Q1 blocks on a 3×2 grid (block path) and two-point weights
     // (diagonal path): the owned assembly and the assemblies before and
     // after it, which rebuild the pattern, agree to the last bit.
-    let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0]).unwrap();
-    let q1 = crate::metric::fe::stiffness_metric(&grid, &[1.0; 6]).unwrap();
-    let tpfa = crate::metric::fv::two_point(&grid, &[1.0; 6]).unwrap();
+    let grid = hasse_complex::generate::rectangle(3, 2, [0.0, 3.0], [0.0, 2.0])?;
+    let q1 = crate::metric::fe::stiffness_metric(&grid, &[1.0; 6])?;
+    let tpfa = crate::metric::fv::two_point(&grid, &[1.0; 6])?;
     for (a, metric) in [
         (Arc::new(grid.coboundary(0)), q1),
         (grid.shared_boundary(2), tpfa),
     ] {
-        let mut op = Canonical::new(a, metric).unwrap();
+        let mut op = Canonical::new(a, metric)?;
         let before = op.assemble();
         let owned = op.assemble_owned();
         let after = op.assemble();
@@ -408,23 +417,25 @@ fn the_last_assembly_takes_the_pattern_and_a_later_one_rebuilds_it() {
         }
         assert_eq!(op.nonzeros(), before.val().len());
     }
+    Ok(())
 }
 
 #[test]
-fn metric_values_can_change_without_a_new_pattern() {
+fn metric_values_can_change_without_a_new_pattern() -> TestResult {
     let a = CsMat::new((2, 2), vec![0, 1, 3], vec![0, 0, 1], vec![1i8, -1, 1]);
-    let mut op = Canonical::new(a, BlockMetric::diagonal(&[1.0, 1.0])).unwrap();
-    op.set_metric(BlockMetric::diagonal(&[2.0, 3.0])).unwrap();
+    let mut op = Canonical::new(a, BlockMetric::diagonal(&[1.0, 1.0]))?;
+    op.set_metric(BlockMetric::diagonal(&[2.0, 3.0]))?;
     let m = op.assemble().to_dense();
     assert_eq!((m[(0, 0)], m[(0, 1)], m[(1, 1)]), (5.0, -3.0, 3.0));
     assert_eq!(
         op.set_metric(BlockMetric::from_triplets(2, &[(0, 1, 1.0)])),
         Err(CanonicalError::PatternChanged)
     );
+    Ok(())
 }
 
 #[test]
-fn restricted_columns_give_the_free_block_of_the_canonical_operator() {
+fn restricted_columns_give_the_free_block_of_the_canonical_operator() -> TestResult {
     use crate::la::fixed::FixedSplit;
     // A path of 4 vertices (3 edges), Ω = diag(1, 2, 3): the vertex
     // Laplacian; dropping vertices 0 and 3 leaves [[3, −2], [−2, 5]].
@@ -436,63 +447,62 @@ fn restricted_columns_give_the_free_block_of_the_canonical_operator() {
     );
     let omega = BlockMetric::diagonal(&[1.0, 2.0, 3.0]);
     let split = FixedSplit::from_mask([true, false, false, true]);
-    let reduced = Canonical::new(split.restrict_columns(&a), omega.clone())
-        .unwrap()
+    let reduced = Canonical::new(split.restrict_columns(&a), omega.clone())?
         .assemble()
         .to_dense();
     assert_eq!(
         (reduced[(0, 0)], reduced[(0, 1)], reduced[(1, 1)]),
         (3.0, -2.0, 5.0)
     );
-    let full = Canonical::new(a, omega).unwrap().assemble();
+    let full = Canonical::new(a, omega)?.assemble();
     assert_eq!(split.free_block(&full).to_dense(), reduced);
     // Eᵀ diag(w) E keeps the free weights.
     let e = split.selection();
-    let w = Canonical::new(e, BlockMetric::diagonal(&[1.0, 2.0, 3.0, 4.0]))
-        .unwrap()
+    let w = Canonical::new(e, BlockMetric::diagonal(&[1.0, 2.0, 3.0, 4.0]))?
         .assemble()
         .to_dense();
     assert_eq!((w[(0, 0)], w[(1, 1)], w[(0, 1)]), (2.0, 3.0, 0.0));
+    Ok(())
 }
 
 #[test]
-fn a_coupling_block_with_the_identity_and_minus_one_is_minus_the_boundary() {
+fn a_coupling_block_with_the_identity_and_minus_one_is_minus_the_boundary() -> TestResult {
     use hasse_complex::generate::rectangle;
     // Two squares: ∂₂ is 7 edges × 2 cells. With A = I on the edges and
     // Ω = −I, Aᵀ Ω ∂₂ = −∂₂, the flux–pressure block of mixed Darcy.
-    let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0])?;
     let edges = k.cell_count(1);
     let b = Canonical::coupling(
         sprs::CsMat::<i8>::eye(edges),
         BlockMetric::diagonal(&vec![-1.0; edges]),
         k.shared_boundary(2),
-    )
-    .unwrap();
+    )?;
     let m = b.assemble().to_dense();
     assert_eq!((m.nrows(), m.ncols()), (7, 2));
     for (v, (e, c)) in k.boundary(2).iter() {
         assert_eq!(m[(e, c)], -f64::from(*v));
     }
+    Ok(())
 }
 
 #[test]
-fn a_sum_of_operators_is_one_canonical_operator() {
+fn a_sum_of_operators_is_one_canonical_operator() -> TestResult {
     use hasse_complex::generate::interval;
-    let k = interval(2, 0.0, 1.0).unwrap();
-    let stiffness = Canonical::new(k.coboundary(0), BlockMetric::diagonal(&[2.0, 2.0])).unwrap();
+    let k = interval(2, 0.0, 1.0)?;
+    let stiffness = Canonical::new(k.coboundary(0), BlockMetric::diagonal(&[2.0, 2.0]))?;
     let mass = Canonical::new(
         sprs::CsMat::<i8>::eye(3),
         BlockMetric::diagonal(&[0.25, 0.5, 0.25]),
-    )
-    .unwrap();
-    let step = Canonical::sum(&[(4.0, &mass), (0.5, &stiffness)]).unwrap();
+    )?;
+    let step = Canonical::sum(&[(4.0, &mass), (0.5, &stiffness)])?;
     let m = step.assemble().to_dense();
     // 4·0.5 + 0.5·(2 + 2) at the middle vertex, 0.5·(−2) beside it.
     assert_eq!((m[(1, 1)], m[(0, 1)]), (4.0, -1.0));
+    Ok(())
 }
 
 #[test]
-fn a_diagonal_metric_stays_diagonal_until_a_block_breaks_the_layout() {
+fn a_diagonal_metric_stays_diagonal_until_a_block_breaks_the_layout() -> TestResult {
     let mut omega = BlockMetric::from_weights(vec![2.0, 3.0]);
     omega.add_rows(1);
     omega.push_block(&[2], &[2], &[4.0]);
@@ -501,10 +511,11 @@ fn a_diagonal_metric_stays_diagonal_until_a_block_breaks_the_layout() {
     omega.push_block(&[0], &[1], &[1.0]);
     assert_eq!(omega.diagonal_weights(), None);
     assert_eq!(omega.block(1), (&[1][..], &[1][..], &[3.0][..]));
+    Ok(())
 }
 
 #[test]
-fn stacked_metrics_sit_along_the_diagonal() {
+fn stacked_metrics_sit_along_the_diagonal() -> TestResult {
     let mut dense = BlockMetric::new(2);
     dense.push_symmetric(&[0, 1], &[2.0, -1.0, -1.0, 2.0]);
     let both = BlockMetric::stacked(&[(2.0, &BlockMetric::diagonal(&[1.0])), (0.5, &dense)]);
@@ -516,12 +527,14 @@ fn stacked_metrics_sit_along_the_diagonal() {
             vec![0.0, -0.5, 1.0]
         ]
     );
+    Ok(())
 }
 
 #[test]
-fn pushed_blocks_apply_as_their_sum() {
+fn pushed_blocks_apply_as_their_sum() -> TestResult {
     let mut omega = BlockMetric::new(3);
     omega.push_symmetric(&[0, 2], &[2.0, -1.0, -1.0, 2.0]);
     omega.push_block(&[1], &[1], &[5.0]);
     assert_eq!(omega.apply(&[1.0, 1.0, 1.0]), vec![1.0, 5.0, 1.0]);
+    Ok(())
 }

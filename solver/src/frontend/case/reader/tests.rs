@@ -4,16 +4,18 @@
 use super::overrides::apply_overrides;
 use crate::frontend::case::Case;
 
+/// What a test returns: a failed step is its error.
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
 const CASE: &str = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n\n[problem]\nmethod = \"fe\"\nsource = \"x*y\"\n\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = 0\n";
 
 #[test]
-fn set_keys_are_named_as_diagnostics_name_them() {
+fn set_keys_are_named_as_diagnostics_name_them() -> TestResult {
     let (text, keys) = apply_overrides(
         "c.toml",
         CASE,
         &["boundary.0.value=2".into(), "mesh.n=[8,8]".into()],
-    )
-    .unwrap();
+    )?;
     assert_eq!(
         keys,
         [
@@ -29,15 +31,13 @@ fn set_keys_are_named_as_diagnostics_name_them() {
         "{text}"
     );
     // Without overrides the text is unchanged and nothing is overridden.
-    assert_eq!(
-        apply_overrides("c.toml", CASE, &[]).unwrap(),
-        (CASE.into(), vec![])
-    );
+    assert_eq!(apply_overrides("c.toml", CASE, &[])?, (CASE.into(), vec![]));
+    Ok(())
 }
 
 #[test]
-fn diagnostics_point_at_the_key_or_at_the_set_text() {
-    let case = Case::from_text("c.toml", CASE, &[]).unwrap();
+fn diagnostics_point_at_the_key_or_at_the_set_text() -> TestResult {
+    let case = Case::from_text("c.toml", CASE, &[])?;
     // `source = "x*y"` is line 7; its value starts at column 10.
     let d = case.diagnostic("problem.source", "bad", None);
     assert_eq!((d.line, d.column, d.set.as_deref()), (7, 10, None));
@@ -52,7 +52,7 @@ fn diagnostics_point_at_the_key_or_at_the_set_text() {
     );
     // Given with --set: the assignment, not a line of the file (the
     // override may have been written anywhere in the edited text).
-    let case = Case::from_text("c.toml", CASE, &["problem.source=ln(x)".into()]).unwrap();
+    let case = Case::from_text("c.toml", CASE, &["problem.source=ln(x)".into()])?;
     let d = case.diagnostic("problem.source", "bad", Some("fix it".into()));
     assert_eq!(d.set.as_deref(), Some("problem.source=ln(x)"));
     assert_eq!(
@@ -60,7 +60,7 @@ fn diagnostics_point_at_the_key_or_at_the_set_text() {
         "c.toml: --set problem.source=ln(x): `problem.source`: bad\n    help: fix it"
     );
     // A key under an overridden table is the override's too.
-    let case = Case::from_text("c.toml", CASE, &["boundary.0.value=1".into()]).unwrap();
+    let case = Case::from_text("c.toml", CASE, &["boundary.0.value=1".into()])?;
     assert!(case
         .diagnostic("boundary[0].value", "bad", None)
         .set
@@ -69,10 +69,11 @@ fn diagnostics_point_at_the_key_or_at_the_set_text() {
         .diagnostic("boundary[0].tag", "bad", None)
         .set
         .is_none());
+    Ok(())
 }
 
 #[test]
-fn choices_are_read_by_the_enums_own_names() {
+fn choices_are_read_by_the_enums_own_names() -> TestResult {
     let darcy = "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"darcy\"\nmethod = \"mimetc\"\n";
     let errors = Case::from_text("d.toml", darcy, &[])
         .unwrap_err()
@@ -101,4 +102,5 @@ fn choices_are_read_by_the_enums_own_names() {
         errors.contains("did you mean \"stress\"? choices: strain, stress"),
         "{errors}"
     );
+    Ok(())
 }
