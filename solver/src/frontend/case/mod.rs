@@ -34,10 +34,10 @@
 
 pub mod diagnostic;
 pub mod expr;
+mod mesh_checks;
 mod problem;
 mod quantity;
 mod reader;
-mod regions;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use problem::*;

@@ -158,8 +158,11 @@ pub(super) fn solve_diffusion(
         vec![Cochain::new("u", field_dim, field.clone()).with_description("the solution")];
     // One convention for every method: the physical flux −K∇u·n through
     // each (n−1)-cell along its orientation (OUTPUT.md).
+    let outflow = problem
+        .boundary_outflow(complex, &solution)
+        .map_err(|e| diffusion_error(case, &keys, e))?;
     let oriented = problem
-        .oriented_flux(complex, &solution)
+        .oriented_flux(complex, &solution, &outflow)
         .map_err(|e| diffusion_error(case, &keys, e))?;
     if let Some(flux) = oriented {
         let how = match solution.location {
@@ -170,10 +173,7 @@ pub(super) fn solve_diffusion(
             "−K∇u·n through each (n−1)-cell along its orientation ({how})"
         )));
     }
-    let outflow = problem
-        .boundary_outflow(complex, &solution)
-        .map_err(|e| diffusion_error(case, &keys, e))?;
-    fields.push(Cochain::new("outflow", n - 1, outflow).with_description(
+    fields.push(Cochain::new("outflow", n - 1, outflow.clone()).with_description(
         "−K∇u·n leaving the domain through each boundary (n−1)-cell (0 inside): the method's own flux; Σ over a tag is the flux out through it",
     ));
     if solution.location == Location::Nodal && n > 1 {
@@ -253,8 +253,9 @@ pub(super) fn solve_diffusion(
             (Some(errors), flux_error)
         }
     };
-    let quantities = super::quantities::diffusion_quantities(case, &problem, complex, &solution)
-        .map_err(|e| diffusion_error(case, &keys, e))?;
+    let quantities =
+        super::quantities::diffusion_quantities(case, &problem, complex, &solution, &outflow)
+            .map_err(|e| diffusion_error(case, &keys, e))?;
     notes.extend(quantities.notes);
     let mut run_report = quantities.report;
     let probed = super::probes::probe_values(

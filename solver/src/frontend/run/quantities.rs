@@ -16,15 +16,16 @@ pub(super) struct Quantities {
     pub report: serde_json::Map<String, Value>,
 }
 
-/// The balance Σ outflow = ∫f and every quantity of the case.
+/// The balance Σ outflow = ∫f and every quantity of the case, from the
+/// solution's `outflow` ([`Diffusion::boundary_outflow`]).
 pub(super) fn diffusion_quantities(
     case: &Case,
     problem: &Diffusion,
     complex: &Complex,
     solution: &Solution,
+    outflow: &[f64],
 ) -> Result<Quantities, DiffusionError> {
     let n = complex.dim();
-    let outflow = problem.boundary_outflow(complex, solution)?;
     let sources = problem.source_total(complex)?;
     let total: f64 = outflow.iter().sum();
     let scale = outflow

@@ -116,8 +116,8 @@ impl Diffusion {
 
     /// −K∇u·n through every (n−1)-cell along its orientation, for every
     /// method: [`Diffusion::face_flux`] where the unknowns make face fluxes;
-    /// for nodal methods the residual outflow of [`Diffusion::boundary_outflow`]
-    /// on boundary faces and, on interior faces, |F| times the mean of the
+    /// for nodal methods `outflow` (what [`Diffusion::boundary_outflow`]
+    /// returned for this solution) on boundary faces and, on interior faces, |F| times the mean of the
     /// two cells' −K∇u_h·n (a reconstruction: the conservative fluxes of
     /// nodal methods cross the dual cells). `None` for a nodal method on a
     /// surface, whose faces have no normal in the embedding space.
@@ -125,6 +125,7 @@ impl Diffusion {
         &self,
         complex: &Complex,
         solution: &Solution,
+        outflow: &[f64],
     ) -> Result<Option<Vec<f64>>, DiffusionError> {
         if let Some(flux) = self.face_flux(complex, solution) {
             return Ok(Some(flux));
@@ -133,7 +134,6 @@ impl Diffusion {
         if n != d {
             return Ok(None);
         }
-        let outflow = self.boundary_outflow(complex, solution)?;
         let gradient = post::reconstruct_gradient(complex, solution);
         let conductivity = self.cell_conductivity(complex)?;
         let normal = complex.normal();

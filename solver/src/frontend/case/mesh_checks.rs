@@ -1,6 +1,6 @@
-//! Regions of a case: the tags `[regions]` defines by conditions, and the
-//! check that every value given per region fits the mesh's tags, made
-//! when the mesh is built so that `hasse check` refuses it before solving.
+//! What a case asks of its mesh, checked when the mesh is built so that
+//! `hasse check` refuses it before solving: the tags `[regions]` defines,
+//! values per region, quantities of interest and probes.
 
 use super::diagnostic::Collector;
 use super::expr::Expression;
