@@ -31,7 +31,7 @@
 //! never one after it:
 //!
 //! ```text
-//! la  ←  multigrid, operator  ←  metric  ←  physics  ←  refine, study  ←  frontend
+//! la  ←  multigrid, operator  ←  metric  ←  physics  ←  refine, study, distributed  ←  frontend
 //! ```
 //!
 //! - [`la`]: linear algebra: direct factorisations (faer) and their
@@ -51,6 +51,9 @@
 //!   elasticity, coupled fields, normal gradients.
 //! - [`refine`] (re-solving on SPLIT-refined meshes) and [`study`]
 //!   (convergence orders and their tables).
+//! - [`distributed`]: the partitioned complex (owned top cells and their
+//!   ghost star) and, with the cargo feature `mpi`, distributed solves on
+//!   PETSc over MPI.
 //! - [`frontend`]: case files, running them, output files, and the
 //!   `hasse` command line (`main.rs`); nothing in the library depends on
 //!   it.
@@ -60,6 +63,7 @@
 
 #![warn(missing_docs)]
 
+pub mod distributed;
 pub mod frontend;
 pub mod la;
 pub mod metric;

@@ -12,4 +12,5 @@ mod complex_invariants;
 mod layers;
 mod multigrid;
 mod nodal_metrics;
+mod partition;
 mod properties;
