@@ -186,3 +186,23 @@ fn set_overrides_are_checked_and_applied() {
     assert!(out.status.success());
     assert!(stdout.contains("[81, 144, 64]"), "{stdout}");
 }
+
+/// A build without the cargo feature `mpi` refuses `solver.type = "petsc"`
+/// at `check`, with the command that builds a hasse that has it.
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn petsc_without_the_mpi_feature_is_refused_with_the_build_command() {
+    let out = hasse(&[
+        "check",
+        "cases/poisson-square.toml",
+        "--set",
+        "solver.type=\"petsc\"",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("`solver.type`"), "{stderr}");
+    assert!(
+        stderr.contains("cargo build --release --features mpi"),
+        "{stderr}"
+    );
+}

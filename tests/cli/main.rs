@@ -25,6 +25,8 @@ mod cli_input;
 mod cli_output;
 mod cli_physics;
 mod darcy_reports;
+#[cfg(feature = "mpi")]
+mod distributed;
 mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;

@@ -111,6 +111,10 @@ pub enum SolverKind {
     Amg,
     /// [`crate::multigrid::automatic`] decides.
     Auto,
+    /// PETSc over MPI (`mpirun -np N hasse run …`; the cargo feature
+    /// `mpi`): CG + GAMG by default, MUMPS when a factorisation is asked
+    /// for, and `[solver.petsc] options` on top.
+    Petsc,
 }
 
 /// Linear solver settings (`[solver]`).
@@ -140,6 +144,9 @@ pub struct SolverSpec {
     /// Fill-reducing ordering of the direct factorisation
     /// (`solver.ordering`).
     pub ordering: Ordering,
+    /// `[solver.petsc] options`: PETSc's own command-line options
+    /// (`"-ksp_type cg -pc_type hypre"`), applied after hasse's defaults.
+    pub petsc_options: String,
 }
 
 impl Default for SolverSpec {
@@ -152,6 +159,7 @@ impl Default for SolverSpec {
             residual_limit: 1e-6,
             cell_prolongation: CellProlongation::Smoothed,
             ordering: Ordering::Automatic,
+            petsc_options: String::new(),
         }
     }
 }

@@ -46,7 +46,7 @@ fn with_solver(case: &Case, problem: Diffusion, complex: &Complex) -> Result<Dif
         _ => None,
     };
     let choice = match case.solver.kind {
-        SolverKind::Direct => return Ok(problem),
+        SolverKind::Direct | SolverKind::Petsc => return Ok(problem),
         SolverKind::Multigrid => match grid {
             Some(h) => SolverChoice::Multigrid(h),
             None => {
@@ -86,9 +86,15 @@ pub(super) fn solve_diffusion(
         coefficient: "conductivity",
         boundary: &spec.boundary,
     };
-    let solution = problem
-        .solve(complex)
-        .map_err(|e| diffusion_error(case, &keys, e))?;
+    let (solution, petsc) = if case.solver.kind == crate::frontend::case::SolverKind::Petsc {
+        let (solution, note) = super::petsc::solve(case, &problem, complex)?;
+        (solution, Some(note))
+    } else {
+        let solution = problem
+            .solve(complex)
+            .map_err(|e| diffusion_error(case, &keys, e))?;
+        (solution, None)
+    };
     let total = started.elapsed().as_secs_f64();
     let report = &solution.report;
     // With CG the "numeric" phase builds the preconditioner, not a factor.
@@ -115,7 +121,7 @@ pub(super) fn solve_diffusion(
             solution.neumann_imbalance
         ));
     }
-    if solution.iterations.is_some() {
+    if solution.iterations.is_some() || petsc.is_some() {
         // CG stops at solver.tolerance: only the failure limit applies.
         if report.relative_residual.is_nan()
             || report.relative_residual > case.solver.residual_limit
@@ -142,6 +148,9 @@ pub(super) fn solve_diffusion(
         )],
         None => Vec::new(),
     };
+    if let Some(note) = &petsc {
+        notes.push(("petsc".to_string(), note.clone()));
+    }
     if solution.condition_bound > 1e12 {
         warnings.push(format!("the system's condition number is at least {:.1e} (largest / smallest diagonal entry): expect to lose about {:.0} of 16 digits; check coefficients and cell sizes that span many orders of magnitude", solution.condition_bound, solution.condition_bound.log10()));
     }
@@ -280,9 +289,7 @@ pub(super) fn solve_diffusion(
         errors,
         flux_error,
         relative_residual: Some(report.relative_residual),
-        factorization: solution
-            .iterations
-            .is_none()
+        factorization: (solution.iterations.is_none() && petsc.is_none())
             .then_some(report.factorization),
         ordering: report.ordering,
         timings,

@@ -54,6 +54,7 @@ mod error;
 mod gradient;
 mod heat;
 mod maxwell;
+mod petsc;
 mod probes;
 mod quantities;
 pub mod refine;

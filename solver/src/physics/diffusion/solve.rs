@@ -394,6 +394,109 @@ impl Diffusion {
         })
     }
 
+    /// The [`Solution`] made of values for every unknown solved elsewhere
+    /// (by PETSc across ranks, say): the system is assembled here to give
+    /// the fluxes, exactly as [`Diffusion::solve`] gives them, and the
+    /// relative residual ‖b − M u‖ / ‖b‖ of the values on the free
+    /// unknowns, an independent check of the other solver. Fixed unknowns
+    /// take their Dirichlet values whatever `values` holds.
+    pub fn solution_from_values(
+        &self,
+        complex: &Complex,
+        mut values: Vec<f64>,
+        solve_seconds: f64,
+    ) -> Result<Solution, DiffusionError> {
+        let Assembled {
+            location,
+            canonical,
+            matrix,
+            rhs,
+            fixed,
+            pure_neumann,
+            flux_rows,
+            ghost_values,
+            neumann_flux,
+            cell_points,
+            assembly_seconds,
+            ..
+        } = self.assemble(complex)?;
+        if values.len() != rhs.len() {
+            return Err(DiffusionError::Unsupported {
+                method: self.method.name(),
+                what: "values whose count differs from the number of unknowns",
+            });
+        }
+        for (u, g) in values.iter_mut().zip(&fixed) {
+            if let Some(g) = g {
+                *u = *g;
+            }
+        }
+        // r = b − M u on the free rows; the reduced right-hand side is
+        // b − M_fixed g there.
+        let mut product = vec![0.0; rhs.len()];
+        let mut lifted = vec![0.0; rhs.len()];
+        for column in 0..matrix.ncols() {
+            let range = matrix.col_range(column);
+            for (&row, &m) in matrix.row_idx()[range.clone()]
+                .iter()
+                .zip(&matrix.val()[range])
+            {
+                product[row] += m * values[column];
+                if fixed[column].is_some() {
+                    lifted[row] += m * values[column];
+                }
+            }
+        }
+        let (mut residual, mut reduced) = (0.0f64, 0.0f64);
+        let mut free = 0;
+        for u in 0..rhs.len() {
+            if fixed[u].is_none() {
+                free += 1;
+                residual += (rhs[u] - product[u]).powi(2);
+                reduced += (rhs[u] - lifted[u]).powi(2);
+            }
+        }
+        let relative_residual = if reduced > 0.0 {
+            (residual / reduced).sqrt()
+        } else {
+            residual.sqrt()
+        };
+        let flux_all = canonical.flux(&values);
+        let mut flux = flux_all[..flux_rows].to_vec();
+        if location == Location::CellCentred {
+            let lifted = canonical.metric().apply(&ghost_values);
+            for ((q, l), g) in flux.iter_mut().zip(lifted).zip(&neumann_flux) {
+                *q += g - l;
+            }
+        }
+        let condition_bound = diagonal_condition_bound(&matrix, &fixed);
+        Ok(Solution {
+            method: self.method,
+            location,
+            values,
+            flux,
+            report: SolveReport {
+                factorization: self.factorization,
+                ordering: None,
+                unknowns: free,
+                nonzeros: matrix.compute_nnz(),
+                symbolic_seconds: 0.0,
+                numeric_seconds: 0.0,
+                solve_seconds,
+                relative_residual,
+                factor_entries: None,
+                factor_flops: None,
+            },
+            iterations: None,
+            assembly_seconds,
+            analysed_during_assembly: false,
+            pure_neumann,
+            neumann_imbalance: 0.0,
+            cell_points,
+            condition_bound,
+        })
+    }
+
     /// A pure-Neumann system made solvable: a connected complex is
     /// required, the data's imbalance Σb must be within the tolerance and is
     /// removed in proportion to each unknown's weight, and unknown 0 is

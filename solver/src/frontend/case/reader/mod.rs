@@ -105,7 +105,9 @@ pub(super) const SOLVER_KEYS: &[&str] = &[
     "residual_limit",
     "prolongation",
     "ordering",
+    "petsc",
 ];
+pub(super) const PETSC_KEYS: &[&str] = &["options"];
 pub(super) const OUTPUT_KEYS: &[&str] = &[
     "directory",
     "name",
@@ -189,6 +191,17 @@ impl Reader {
                     problem_kind(root)
                 ),
                 Some("remove [refine], or run `hasse converge` for a study".into()),
+            );
+        }
+        if refine.is_some() && solver.kind == SolverKind::Petsc {
+            // One MPI run solves one system: MPI and PETSc start once per
+            // process.
+            let span = root.get_key_value("refine").and_then(|(k, _)| k.span());
+            reader.error(
+                span,
+                "refine",
+                "[refine] re-solves on refined meshes, which the petsc path does not do yet (one distributed solve per run)",
+                Some("remove [refine], or use another solver.type".into()),
             );
         }
 

@@ -136,13 +136,25 @@ impl Reader {
                 "multigrid" => SolverKind::Multigrid,
                 "amg" => SolverKind::Amg,
                 "auto" => SolverKind::Auto,
+                "petsc" => {
+                    if !cfg!(feature = "mpi") {
+                        let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                        self.error(
+                            span,
+                            "solver.type",
+                            "\"petsc\" needs a hasse built with the cargo feature `mpi`, and this one was built without it",
+                            Some("install MPI and PETSc with `scripts/setup --mpi`, build with `cargo build --release --features mpi`, and run with `mpirun -np N target/release/hasse run CASE`".into()),
+                        );
+                    }
+                    SolverKind::Petsc
+                }
                 other => {
                     let span = self.entry(table, "solver", "type").and_then(|e| e.span());
                     self.error(
                         span,
                         "solver.type",
                         format!("unknown solver type \"{other}\""),
-                        Some("\"direct\" (faer LLᵀ/LDLᵀ/LU), \"multigrid\" (CG with a V-cycle on the generator's grid levels), \"amg\" (CG with smoothed aggregation, any mesh) or \"auto\"".into()),
+                        Some("\"direct\" (faer LLᵀ/LDLᵀ/LU), \"multigrid\" (CG with a V-cycle on the generator's grid levels), \"amg\" (CG with smoothed aggregation, any mesh), \"auto\", or \"petsc\" (PETSc over MPI)".into()),
                     );
                     SolverKind::Direct
                 }
@@ -154,6 +166,20 @@ impl Reader {
                     "solver.type",
                     format!("the iterative solvers serve diffusion problems; this case is kind = \"{}\"", problem_kind(root)),
                     Some("remove solver.type (direct)".into()),
+                );
+            }
+        }
+        if let Some((petsc, entry)) = self.subtable(table, "solver", "petsc") {
+            self.check_keys(petsc, "solver.petsc", PETSC_KEYS);
+            if let Some(options) = self.string_at(petsc, "solver.petsc", "options") {
+                spec.petsc_options = options;
+            }
+            if spec.kind != SolverKind::Petsc {
+                self.error(
+                    entry.span(),
+                    "solver.petsc",
+                    "PETSc options apply only to solver.type = \"petsc\"",
+                    Some("set solver.type = \"petsc\" or remove [solver.petsc]".into()),
                 );
             }
         }
