@@ -108,6 +108,15 @@ pub enum ExprError {
         /// Why it cannot be one.
         reason: String,
     },
+    /// A coefficient of a nonlinear problem whose derivative with respect
+    /// to u cannot be formed.
+    #[error("cannot differentiate `{text}` with respect to u: {reason}")]
+    NotDifferentiable {
+        /// The expression as written.
+        text: String,
+        /// exmex's reason.
+        reason: String,
+    },
     /// A constant whose value is NaN or infinite.
     #[error("constant `{name}` is not finite ({value})")]
     NonFiniteConstant {
@@ -226,6 +235,8 @@ fn suggestion_text(suggestion: &Option<String>) -> String {
 enum Slot {
     Coordinate(usize),
     Time,
+    /// The solution u of a nonlinear problem.
+    Solution,
     Constant(f64),
     Definition(Arc<Expression>),
 }
@@ -254,6 +265,8 @@ pub struct Expression {
     /// True when the value depends on neither position nor time.
     constant: bool,
     uses_time: bool,
+    /// True when the value depends on the solution `u`.
+    uses_solution: bool,
     /// Set for a value per region ([`Expression::per_region`]).
     regions: Option<Arc<Regions>>,
 }
@@ -285,6 +298,62 @@ impl Expression {
         self.uses_time
     }
 
+    /// True when the expression depends on the solution `u` (only a
+    /// scope made by [`Scope::with_solution`] lets it).
+    pub fn uses_solution(&self) -> bool {
+        self.uses_solution
+    }
+
+    /// The value at `point`, time `t` and solution value `u`.
+    ///
+    /// ```
+    /// use hasse_solver::frontend::case::expr::Scope;
+    /// let k = Scope::new().with_solution().parse("1 + x * u^2").unwrap();
+    /// assert!(k.uses_solution() && !k.is_constant());
+    /// assert_eq!(k.eval_with(&[2.0], 0.0, 3.0), 19.0);
+    /// // ∂k/∂u = 2 x u, by exmex's symbolic differentiation.
+    /// let dk = k.derivative_u().unwrap();
+    /// assert_eq!(dk.eval_with(&[2.0], 0.0, 3.0), 12.0);
+    /// // Without `u`, the derivative is 0.
+    /// assert_eq!(Scope::new().parse("x").unwrap().derivative_u().unwrap().eval_with(&[2.0], 0.0, 3.0), 0.0);
+    /// ```
+    pub fn eval_with(&self, point: &[f64], t: f64, u: f64) -> f64 {
+        self.evaluate(point, t, u)
+    }
+
+    /// ∂/∂u of the expression, symbolically (exmex's partial derivative);
+    /// an error for operators exmex cannot differentiate (comparisons,
+    /// `if`, `&&`, `||`, rounding).
+    pub fn derivative_u(&self) -> Result<Expression, ExprError> {
+        let index = self
+            .slots
+            .iter()
+            .position(|slot| matches!(slot, Slot::Solution));
+        let Some(index) = index else {
+            return Scope::new().parse("0");
+        };
+        let not_differentiable = |reason: String| ExprError::NotDifferentiable {
+            text: self.text.clone(),
+            reason,
+        };
+        if self.regions.is_some() {
+            return Err(not_differentiable("it is given per region".into()));
+        }
+        let flat = (*self.flat)
+            .clone()
+            .partial(index)
+            .map_err(|e| not_differentiable(e.msg().to_string()))?;
+        Ok(Expression {
+            text: format!("∂({})/∂u", self.text),
+            flat: Box::new(flat),
+            slots: self.slots.clone(),
+            constant: false,
+            uses_time: self.uses_time,
+            uses_solution: true,
+            regions: None,
+        })
+    }
+
     /// An expression per region; `text` is how the case wrote it.
     ///
     /// ```
@@ -313,6 +382,12 @@ impl Expression {
             slots: Vec::new(),
             constant: false,
             uses_time,
+            uses_solution: regions
+                .pieces
+                .iter()
+                .map(|(_, e)| e)
+                .chain(&regions.default)
+                .any(Expression::uses_solution),
             regions: Some(Arc::new(regions)),
         }
     }
@@ -328,6 +403,10 @@ impl Expression {
     /// Division by zero and the like give non-finite values, not errors:
     /// callers check the values they evaluate and say where it happened.
     pub fn eval(&self, point: &[f64], t: f64) -> f64 {
+        self.evaluate(point, t, f64::NAN)
+    }
+
+    fn evaluate(&self, point: &[f64], t: f64, u: f64) -> f64 {
         if self.regions.is_some() {
             return f64::NAN;
         }
@@ -345,6 +424,7 @@ impl Expression {
             *value = match slot {
                 Slot::Coordinate(i) => point.get(*i).copied().unwrap_or(0.0),
                 Slot::Time => t,
+                Slot::Solution => u,
                 Slot::Constant(c) => *c,
                 Slot::Definition(e) => e.eval(point, t),
             };
@@ -376,6 +456,9 @@ impl Expression {
 pub struct Scope {
     constants: Vec<(String, f64)>,
     definitions: Vec<(String, Arc<Expression>)>,
+    /// Whether `u` names the solution (coefficients of a nonlinear
+    /// problem), unless a constant or definition of the case is called u.
+    solution: bool,
 }
 
 /// Names exmex already gives a meaning to; a user name equal to one of
@@ -393,9 +476,22 @@ impl Scope {
         Self::default()
     }
 
+    /// The same scope in which `u` names the solution (the conductivity
+    /// and reaction of a diffusion problem), unless the case defines a
+    /// constant or definition `u` itself.
+    pub fn with_solution(&self) -> Scope {
+        Scope {
+            solution: true,
+            ..self.clone()
+        }
+    }
+
     /// Every name an expression may use, for suggestions and messages.
     pub fn names(&self) -> Vec<String> {
         let mut names: Vec<String> = COORDINATES.iter().map(|s| s.to_string()).collect();
+        if self.solution {
+            names.push("u".into());
+        }
         names.push("pi".into());
         names.extend(self.constants.iter().map(|(n, _)| n.clone()));
         names.extend(self.definitions.iter().map(|(n, _)| n.clone()));
@@ -462,6 +558,11 @@ impl Scope {
         let mut slots = Vec::with_capacity(flat.var_names().len());
         let mut constant = true;
         let mut uses_time = false;
+        let mut uses_solution = false;
+        let defined = |name: &str| {
+            self.constants.iter().any(|(n, _)| n == name)
+                || self.definitions.iter().any(|(n, _)| n == name)
+        };
         for name in flat.var_names() {
             let slot = if let Some(i) = ["x", "y", "z"].iter().position(|c| c == name) {
                 constant = false;
@@ -472,6 +573,10 @@ impl Scope {
                 Slot::Time
             } else if name == "pi" {
                 Slot::Constant(std::f64::consts::PI)
+            } else if name == "u" && self.solution && !defined(name) {
+                constant = false;
+                uses_solution = true;
+                Slot::Solution
             } else if let Some((_, v)) = self.constants.iter().find(|(n, _)| n == name) {
                 Slot::Constant(*v)
             } else if let Some((_, e)) = self.definitions.iter().find(|(n, _)| n == name) {
@@ -493,6 +598,7 @@ impl Scope {
             slots,
             constant,
             uses_time,
+            uses_solution,
             regions: None,
         })
     }
