@@ -69,6 +69,7 @@ fn observed(method: Method, mesh: fn(usize) -> Result<Complex>) -> Result<(f64, 
         h.push(1.0 / n as f64);
         e.push(errors(&complex, &solved.solution, &exact, None).l2);
     }
+    eprintln!("{} L² errors {e:?}, order {}", method.name(), order(&h, &e));
     Ok((order(&h, &e), e))
 }
 
@@ -130,6 +131,7 @@ fn fv_cube_second_order() -> Result {
         e.push(errors(&complex, &solved.solution, &exact, None).l2);
     }
     let p = order(&h, &e);
+    eprintln!("fv cube L² errors {e:?}, order {p}");
     assert!((p - 2.0).abs() < 0.15, "order {p}, errors {e:?}");
     Ok(())
 }
@@ -244,6 +246,7 @@ fn bratu_closed_form() -> Result {
         e.push(max);
     }
     let p = order(&h, &e);
+    eprintln!("Bratu λ = 1 nodal max errors {e:?}, order {p}");
     assert!((p - 2.0).abs() < 0.15, "order {p}, errors {e:?}");
     // The solution's maximum u(½) = 2 ln cosh(θ/4) ≈ 0.1405 at λ = 1.
     assert!(e[2] < 1e-4 * exact(0.5));

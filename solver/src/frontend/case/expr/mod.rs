@@ -29,7 +29,12 @@
 //! assert_eq!((square.eval(&[0.5, 0.5], 0.0), square.eval(&[0.5, 1.5], 0.0)), (1.0, 0.0));
 //! ```
 
+mod messages;
 pub mod ops;
+mod solution;
+
+pub use messages::{quote, QUOTE_WIDTH};
+use messages::{syntax_text, unknown_text};
 
 use exmex::prelude::*;
 use exmex::MatchLiteral;
@@ -127,109 +132,6 @@ pub enum ExprError {
     },
 }
 
-/// Expressions longer than this many characters are quoted in messages
-/// by an excerpt of this width around the fault, not whole.
-pub const QUOTE_WIDTH: usize = 80;
-
-/// An expression as messages quote it: whole and in backquotes when it is
-/// short; otherwise by its length, and (the second part, for the end of
-/// the message) at most [`QUOTE_WIDTH`] characters around character `at`
-/// (the start when the fault has no one place) on a line of their own with
-/// a caret under that character on the next.
-///
-/// ```
-/// use hasse_solver::frontend::case::expr::quote;
-/// assert_eq!(quote("sin(x", Some(3)), ("`sin(x`".to_string(), String::new()));
-/// let long = format!("{}(", "x + ".repeat(50_000));
-/// let (head, tail) = quote(&long, Some(200_000));
-/// assert_eq!(head, "the expression of 200001 characters");
-/// let lines: Vec<&str> = tail.lines().collect();
-/// assert_eq!(lines[0], ", at character 200001:");
-/// // `…` and 80 characters, the last of them the fault, and the caret
-/// // under it.
-/// assert_eq!(lines[1], format!("    …{}(", &"x + ".repeat(20)[1..]));
-/// assert_eq!(lines[2], format!("    {}^", " ".repeat(80)));
-/// ```
-pub fn quote(text: &str, at: Option<usize>) -> (String, String) {
-    let chars: Vec<char> = text.chars().collect();
-    if chars.len() <= QUOTE_WIDTH {
-        return (format!("`{text}`"), String::new());
-    }
-    let at = at.unwrap_or(0).min(chars.len() - 1);
-    let start = at
-        .saturating_sub(QUOTE_WIDTH / 2)
-        .min(chars.len() - QUOTE_WIDTH);
-    let end = start + QUOTE_WIDTH;
-    let before = if start > 0 { "…" } else { "" };
-    let after = if end < chars.len() { "…" } else { "" };
-    let excerpt: String = chars[start..end].iter().collect();
-    let caret = before.chars().count() + (at - start);
-    (
-        format!("the expression of {} characters", chars.len()),
-        format!(
-            ", at character {}:\n    {before}{excerpt}{after}\n    {}^",
-            at + 1,
-            " ".repeat(caret)
-        ),
-    )
-}
-
-/// The message of a syntax error: what is wrong, then where.
-fn syntax_text(text: &str, message: &str) -> String {
-    let (head, tail) = quote(text, syntax_position(text));
-    format!("cannot parse {head}: {message}{tail}")
-}
-
-/// The message of an unknown name: which, with the closest known one,
-/// then where.
-fn unknown_text(text: &str, name: &str, suggestion: &Option<String>) -> String {
-    let (head, tail) = quote(text, word_position(text, name));
-    format!(
-        "unknown variable `{name}` in {head}{}{tail}",
-        suggestion_text(suggestion)
-    )
-}
-
-/// Where (in characters) a syntax error shows first: a `)` that closes
-/// nothing, the first `(` never closed, or a character that is not part
-/// of an expression; `None` when the fault is not one place.
-fn syntax_position(text: &str) -> Option<usize> {
-    let mut open = Vec::new();
-    for (i, c) in text.chars().enumerate() {
-        match c {
-            '(' => open.push(i),
-            ')' if open.is_empty() => return Some(i),
-            ')' => {
-                open.pop();
-            }
-            _ => {}
-        }
-    }
-    if let Some(&first) = open.first() {
-        return Some(first);
-    }
-    text.chars()
-        .position(|c| !(c.is_alphanumeric() || c.is_whitespace() || "+-*/^(),._<>=!&|".contains(c)))
-}
-
-/// Where (in characters) `name` first stands as a whole word in `text`.
-fn word_position(text: &str, name: &str) -> Option<usize> {
-    let word = |c: char| c.is_alphanumeric() || c == '_';
-    text.match_indices(name)
-        .find(|&(i, _)| {
-            !text[..i].chars().next_back().is_some_and(word)
-                && !text[i + name.len()..].chars().next().is_some_and(word)
-        })
-        .map(|(i, _)| text[..i].chars().count())
-}
-
-fn suggestion_text(suggestion: &Option<String>) -> String {
-    match suggestion {
-        Some(s) => format!(" (did you mean `{s}`?)"),
-        None => String::new(),
-    }
-}
-
 /// Where the value of one exmex variable comes from.
 #[derive(Clone, Debug)]
 enum Slot {
@@ -302,56 +204,6 @@ impl Expression {
     /// scope made by [`Scope::with_solution`] lets it).
     pub fn uses_solution(&self) -> bool {
         self.uses_solution
-    }
-
-    /// The value at `point`, time `t` and solution value `u`.
-    ///
-    /// ```
-    /// use hasse_solver::frontend::case::expr::Scope;
-    /// let k = Scope::new().with_solution().parse("1 + x * u^2").unwrap();
-    /// assert!(k.uses_solution() && !k.is_constant());
-    /// assert_eq!(k.eval_with(&[2.0], 0.0, 3.0), 19.0);
-    /// // ∂k/∂u = 2 x u, by exmex's symbolic differentiation.
-    /// let dk = k.derivative_u().unwrap();
-    /// assert_eq!(dk.eval_with(&[2.0], 0.0, 3.0), 12.0);
-    /// // Without `u`, the derivative is 0.
-    /// assert_eq!(Scope::new().parse("x").unwrap().derivative_u().unwrap().eval_with(&[2.0], 0.0, 3.0), 0.0);
-    /// ```
-    pub fn eval_with(&self, point: &[f64], t: f64, u: f64) -> f64 {
-        self.evaluate(point, t, u)
-    }
-
-    /// ∂/∂u of the expression, symbolically (exmex's partial derivative);
-    /// an error for operators exmex cannot differentiate (comparisons,
-    /// `if`, `&&`, `||`, rounding).
-    pub fn derivative_u(&self) -> Result<Expression, ExprError> {
-        let index = self
-            .slots
-            .iter()
-            .position(|slot| matches!(slot, Slot::Solution));
-        let Some(index) = index else {
-            return Scope::new().parse("0");
-        };
-        let not_differentiable = |reason: String| ExprError::NotDifferentiable {
-            text: self.text.clone(),
-            reason,
-        };
-        if self.regions.is_some() {
-            return Err(not_differentiable("it is given per region".into()));
-        }
-        let flat = (*self.flat)
-            .clone()
-            .partial(index)
-            .map_err(|e| not_differentiable(e.msg().to_string()))?;
-        Ok(Expression {
-            text: format!("∂({})/∂u", self.text),
-            flat: Box::new(flat),
-            slots: self.slots.clone(),
-            constant: false,
-            uses_time: self.uses_time,
-            uses_solution: true,
-            regions: None,
-        })
     }
 
     /// An expression per region; `text` is how the case wrote it.

@@ -279,7 +279,7 @@ impl Reader {
 
     /// What a nonlinear diffusion case cannot combine with, found from the
     /// input alone: the hybrid mimetic method, circumcentre cell points,
-    /// Robin conditions and `[refine]`.
+    /// Robin conditions, `[refine]`, quantities and probes.
     fn check_nonlinear(
         &mut self,
         root: &dyn TableLike,
@@ -311,6 +311,19 @@ impl Reader {
                     &format!("{}.type", b.key),
                     "Robin conditions are not supported with a u-dependent conductivity or a reaction",
                     Some("use dirichlet or neumann".into()),
+                );
+            }
+        }
+        let output = root.get("output").and_then(Item::as_table_like);
+        for name in ["quantity", "probe"] {
+            if let Some((key, _)) = output.and_then(|o| o.get_key_value(name)) {
+                self.error(
+                    key.span(),
+                    &format!("output.{name}"),
+                    format!("output.{name} is not evaluated for a nonlinear problem"),
+                    Some(format!(
+                        "remove [[output.{name}]]; the field u is in the output"
+                    )),
                 );
             }
         }
