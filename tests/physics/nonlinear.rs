@@ -10,6 +10,7 @@ use hasse_solver::metric::Method;
 use hasse_solver::physics::diffusion::errors;
 use hasse_solver::physics::nonlinear::{
     Coefficient, Iteration, NonlinearDiffusion, NonlinearError, NonlinearSolution, Stall,
+    TimeStepping,
 };
 use hasse_solver::physics::{BoundaryKind, ScalarFn};
 use std::f64::consts::PI;
@@ -321,5 +322,72 @@ fn bratu_fv_closed_form() -> Result {
         .fold(0.0, f64::max);
     // Second order with an O(1) constant: h² = 2.5·10⁻⁵, u'' ≤ λ e^{u_max}.
     assert!(max < 1e-4, "max error {max}");
+    Ok(())
+}
+
+/// In time, with insulated ends and a uniform start u(0) = 1, every cell
+/// follows u' = −u³ (the flux vanishes), whose solution is u(t) =
+/// 1/√(1 + 2t). The θ-scheme's error at t = 1 falls at first order for
+/// backward Euler (θ = 1) and second order for Crank–Nicolson (θ = ½),
+/// within DESIGN.md's ±0.15; the whole run makes one symbolic analysis.
+#[test]
+fn transient_theta_scheme_orders() -> Result {
+    let mesh = generate::interval(4, 0.0, 1.0)?;
+    let problem =
+        NonlinearDiffusion::new(Method::Fv, conductivity(), Arc::new(|_| 0.0)).with_reaction(
+            Coefficient::new(Arc::new(|u, _| u * u * u), Arc::new(|u, _| 3.0 * u * u)),
+        );
+    let exact = 1.0 / 3.0f64.sqrt();
+    for (theta, expected) in [(1.0, 1.0), (0.5, 2.0)] {
+        let (mut h, mut e) = (Vec::new(), Vec::new());
+        for steps in [20, 40, 80] {
+            let stepping = TimeStepping {
+                dt: 1.0 / steps as f64,
+                steps,
+                theta,
+            };
+            let run = problem.solve_transient(&mesh, &|_| 1.0, &stepping)?;
+            assert_eq!(run.symbolic_analyses, 1);
+            let (t, u) = run.levels.last().ok_or("no levels")?;
+            assert!((t - 1.0).abs() < 1e-12);
+            h.push(stepping.dt);
+            e.push(u.iter().map(|v| (v - exact).abs()).fold(0.0, f64::max));
+        }
+        let p = order(&h, &e);
+        eprintln!("θ = {theta}: errors at t = 1 {e:?}, order {p}");
+        assert!(
+            (p - expected).abs() < 0.15,
+            "θ = {theta}: order {p}, errors {e:?}"
+        );
+    }
+    Ok(())
+}
+
+/// The transient problem tends to the steady one: on the square problem
+/// the linearised operator's smallest eigenvalue is at least 2π² (k ≥ 1,
+/// r' = 3u² ≥ 0, the Dirichlet Laplacian's first eigenvalue on the unit
+/// square), so each backward-Euler step of Δt = 0.5 contracts the
+/// difference by at least 1/(1 + π²) ≈ 0.09; after 20 steps it is below
+/// 10⁻²⁰ of the start, and u must equal the steady Newton solution to the
+/// iteration's tolerance.
+#[test]
+fn transient_reaches_the_steady_solution() -> Result {
+    let (mut problem, _) = square(Method::Fe);
+    problem.options.tolerance = 1e-12;
+    let mesh = triangles(8)?;
+    let steady = problem.solve(&mesh)?;
+    let stepping = TimeStepping {
+        dt: 0.5,
+        steps: 20,
+        theta: 1.0,
+    };
+    let run = problem.solve_transient(&mesh, &|_| 0.0, &stepping)?;
+    let (_, u) = run.levels.last().ok_or("no levels")?;
+    let difference = u
+        .iter()
+        .zip(&steady.solution.values)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(difference < 1e-9, "max difference {difference}");
     Ok(())
 }

@@ -118,13 +118,15 @@ fn nonlinear_error(case: &Case, spec: &DiffusionSpec, error: NonlinearError) -> 
         NonlinearError::Unsupported { .. } => {
             RunError::input_at(case, "problem.method", error.to_string(), None).because(error)
         }
-        NonlinearError::NotConverged { .. } => RunError::solve(
+        NonlinearError::NotConverged { .. } | NonlinearError::AtTimeStep { .. } => RunError::solve(
             case,
             error.to_string(),
             Some("raise [solver.nonlinear] max_iterations, or check that a solution exists (a positive conductivity, a reaction that does not drive u away)".into()),
         )
         .because(error),
-        NonlinearError::Canonical(_) => RunError::solve(case, error.to_string(), None).because(error),
+        NonlinearError::Canonical(_) | NonlinearError::Stepping { .. } => {
+            RunError::solve(case, error.to_string(), None).because(error)
+        }
     }
 }
 

@@ -34,8 +34,17 @@
 //! the second block (the coefficient frozen at the last iterate, the
 //! reaction still linearised), which leaves a symmetric matrix and linear
 //! convergence.
+//!
+//! In time ([`NonlinearDiffusion::solve_transient`]), each step of the
+//! θ-scheme V (u − u⁰)/Δt + θ F(u) + (1 − θ) F(u⁰) = 0 (F the residual
+//! above) is solved the same way: its Jacobian V/Δt + θ J scales the first
+//! blocks of Ω_J and adds V/Δt to the third, on the same pattern and the
+//! same analysis for every step.
 
 mod newton;
+mod transient;
+
+pub use transient::{NonlinearTransient, TimeStepping};
 
 use crate::la::direct::SolveError;
 use crate::la::fixed::FixedSplit;
@@ -191,6 +200,26 @@ pub enum NonlinearError {
         method: &'static str,
         /// Why not.
         reason: String,
+    },
+    /// Time stepping that is not Δt > 0, θ ∈ (0, 1], at least one step.
+    #[error("time stepping needs Δt > 0, θ in (0, 1] and at least one step; got Δt = {dt}, θ = {theta}, {steps} steps")]
+    Stepping {
+        /// Δt.
+        dt: f64,
+        /// Steps.
+        steps: usize,
+        /// θ.
+        theta: f64,
+    },
+    /// A time step did not converge.
+    #[error("time step {step} (t = {time}): {error}")]
+    AtTimeStep {
+        /// 1, 2, …
+        step: usize,
+        /// The time the step ends at.
+        time: f64,
+        /// Why it failed.
+        error: Box<NonlinearError>,
     },
     /// The iteration did not converge; the residual norms ‖R(u_k)‖ so far.
     #[error("{iteration} did not converge: {stall}; residual history {}", history_text(.history))]

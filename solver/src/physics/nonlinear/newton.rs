@@ -4,9 +4,9 @@
 use super::{
     Iteration, NonlinearDiffusion, NonlinearError, NonlinearSolution, Stall, Step, System,
 };
-use crate::la::direct::{self, DirectSolver, Factorization};
+use crate::la::direct::{self, DirectSolver, Factorization, SolveReport};
 use crate::la::ordering::Ordering;
-use crate::operator::BlockMetric;
+use crate::operator::{BlockMetric, Canonical};
 use crate::physics::diffusion::Solution;
 
 /// Armijo constant of the line search: a step of length α is accepted
@@ -28,6 +28,23 @@ struct Evaluation {
     face_values: Vec<f64>,
     /// Ω(u)(A u − w): the flux.
     flux: Vec<f64>,
+    /// F(u) = Aᵀ q + V r − b on every unknown (the steady residual,
+    /// before a time step adds its terms).
+    forcing: Vec<f64>,
+}
+
+/// One step of the θ-scheme V (u − u⁰)/Δt + θ F(u) + (1 − θ) F(u⁰) = 0:
+/// its residual is the steady one with these terms added, and its
+/// Jacobian V/Δt + θ J_F has the steady Jacobian's pattern.
+pub(super) struct TimeStep<'a> {
+    /// 1/Δt.
+    pub(super) rate: f64,
+    /// θ ∈ (0, 1].
+    pub(super) theta: f64,
+    /// u⁰ on every unknown.
+    pub(super) previous: &'a [f64],
+    /// F(u⁰) on every unknown.
+    pub(super) previous_forcing: &'a [f64],
 }
 
 impl Evaluation {
@@ -44,7 +61,12 @@ fn point(points: &[f64], i: usize, d: usize) -> &[f64] {
     &points[i * d..(i + 1) * d]
 }
 
-fn evaluate(problem: &NonlinearDiffusion, system: &System, u: &[f64]) -> Evaluation {
+fn evaluate(
+    problem: &NonlinearDiffusion,
+    system: &System,
+    u: &[f64],
+    step: Option<&TimeStep>,
+) -> Evaluation {
     let d = system.dimension;
     let a = &*system.incidence;
     let k = &problem.conductivity.value;
@@ -92,6 +114,15 @@ fn evaluate(problem: &NonlinearDiffusion, system: &System, u: &[f64]) -> Evaluat
             *s += r.abs();
         }
     }
+    let forcing = full.clone();
+    if let Some(step) = step {
+        for (j, (f, s)) in full.iter_mut().zip(scale.iter_mut()).enumerate() {
+            let stored = system.volumes[j] * (u[j] - step.previous[j]) * step.rate;
+            let old = (1.0 - step.theta) * step.previous_forcing[j];
+            *f = step.theta * *f + old + stored;
+            *s = step.theta * *s + old.abs() + stored.abs();
+        }
+    }
     let residual = system.split.restrict(&full);
     let norm = residual.iter().map(|r| r * r).sum::<f64>().sqrt();
     let scale = system
@@ -112,6 +143,7 @@ fn evaluate(problem: &NonlinearDiffusion, system: &System, u: &[f64]) -> Evaluat
         difference,
         face_values,
         flux,
+        forcing,
     }
 }
 
@@ -121,14 +153,17 @@ fn jacobian_weights(
     system: &System,
     u: &[f64],
     at: &Evaluation,
+    step: Option<&TimeStep>,
 ) -> Vec<f64> {
+    let theta = step.map_or(1.0, |s| s.theta);
     let d = system.dimension;
     let rows = system.weights.len();
     let free = system.split.free();
     let mut weights = Vec::with_capacity(2 * rows + free.len());
     for r in 0..rows {
         let x = point(&system.row_points, r, d);
-        weights.push(system.weights[r] * (problem.conductivity.value)(at.face_values[r], x));
+        weights
+            .push(theta * system.weights[r] * (problem.conductivity.value)(at.face_values[r], x));
     }
     for r in 0..rows {
         let w = match problem.options.iteration {
@@ -140,7 +175,7 @@ fn jacobian_weights(
                     * at.difference[r]
             }
         };
-        weights.push(w);
+        weights.push(theta * w);
     }
     for &i in free {
         let w = match &problem.reaction {
@@ -149,31 +184,75 @@ fn jacobian_weights(
             }
             None => 0.0,
         };
-        weights.push(w);
+        let stored = step.map_or(0.0, |s| system.volumes[i] * s.rate);
+        weights.push(theta * w + stored);
     }
     weights
 }
 
-pub(super) fn solve(
+/// What the iterations of a run share: the Jacobian operator (whose
+/// pattern never changes) and the one LU analysis made for it.
+pub(super) struct Workspace {
+    jacobian: Canonical,
+    analysis: Option<DirectSolver>,
+    /// Symbolic analyses made so far (one per run).
+    pub(super) analyses: usize,
+}
+
+impl Workspace {
+    pub(super) fn new(system: &System) -> Self {
+        Self {
+            jacobian: system.jacobian.clone(),
+            analysis: None,
+            analyses: 0,
+        }
+    }
+}
+
+/// A converged iteration.
+pub(super) struct Converged {
+    /// u on every unknown.
+    pub(super) u: Vec<f64>,
+    /// F(u) on every unknown.
+    pub(super) forcing: Vec<f64>,
+    /// The flux Ω(u)(A u − w).
+    pub(super) flux: Vec<f64>,
+    pub(super) history: Vec<f64>,
+    pub(super) steps: Vec<Step>,
+    /// The last linear solve, if one was needed.
+    pub(super) report: Option<SolveReport>,
+}
+
+/// u on every unknown: `guess` on the free ones (zero where it has no
+/// entry), the Dirichlet values on the fixed ones.
+pub(super) fn lifted(system: &System, guess: Option<&[f64]>) -> Vec<f64> {
+    let unknowns = system.incidence.cols();
+    let guess: Vec<f64> = (0..unknowns)
+        .map(|i| guess.and_then(|g| g.get(i)).copied().unwrap_or(0.0))
+        .collect();
+    system
+        .split
+        .lift(&system.split.restrict(&guess), &system.fixed)
+}
+
+/// F(u) on every unknown (the steady residual).
+pub(super) fn forcing(problem: &NonlinearDiffusion, system: &System, u: &[f64]) -> Vec<f64> {
+    evaluate(problem, system, u, None).forcing
+}
+
+/// Newton's (or Picard's) iteration from `u`, for the steady problem or
+/// one time step.
+pub(super) fn iterate(
     problem: &NonlinearDiffusion,
     system: &System,
-) -> Result<NonlinearSolution, NonlinearError> {
+    work: &mut Workspace,
+    mut u: Vec<f64>,
+    time_step: Option<&TimeStep>,
+) -> Result<Converged, NonlinearError> {
     let options = &problem.options;
     let iteration = options.iteration;
-    let unknowns = system.incidence.cols();
-    // The initial guess on the free unknowns, the Dirichlet values on the
-    // fixed ones.
-    let guess: Vec<f64> = match &options.initial {
-        Some(initial) => (0..unknowns)
-            .map(|i| initial.get(i).copied().unwrap_or(0.0))
-            .collect(),
-        None => vec![0.0; unknowns],
-    };
     let free = system.split.free().to_vec();
-    let mut u = system
-        .split
-        .lift(&system.split.restrict(&guess), &system.fixed);
-    let mut at = evaluate(problem, system, &u);
+    let mut at = evaluate(problem, system, &u, time_step);
     let mut history = vec![at.norm];
     let mut steps = vec![Step {
         iteration: 0,
@@ -196,9 +275,6 @@ pub(super) fn solve(
     if !at.norm.is_finite() {
         return Err(stop(Stall::NonFinite, &history));
     }
-    let mut jacobian = system.jacobian.clone();
-    let mut analysis: Option<DirectSolver> = None;
-    let mut analyses = 0;
     let mut report = None;
     let mut k = 0;
     while at.relative() > options.tolerance {
@@ -206,16 +282,17 @@ pub(super) fn solve(
             return Err(stop(Stall::MaxIterations(k), &history));
         }
         k += 1;
-        jacobian.set_metric(BlockMetric::from_weights(jacobian_weights(
-            problem, system, &u, &at,
-        )))?;
-        let matrix = jacobian.assemble();
+        work.jacobian
+            .set_metric(BlockMetric::from_weights(jacobian_weights(
+                problem, system, &u, &at, time_step,
+            )))?;
+        let matrix = work.jacobian.assemble();
         // The pattern never changes: analyse once (LU, since the
         // derivative of the face weights makes J unsymmetric).
-        let solver = match analysis.take() {
+        let solver = match work.analysis.take() {
             Some(solver) => solver,
             None => {
-                analyses += 1;
+                work.analyses += 1;
                 DirectSolver::analyse_pattern(
                     matrix.symbolic(),
                     Factorization::Lu,
@@ -226,7 +303,7 @@ pub(super) fn solve(
         };
         let minus: Vec<f64> = at.residual.iter().map(|r| -r).collect();
         let solved = direct::solve_analysed(&solver, &matrix, &minus);
-        analysis = Some(solver);
+        work.analysis = Some(solver);
         let (delta, solved) = solved.map_err(|e| stop(Stall::Solve(e), &history))?;
         report = Some(solved);
         // Backtracking: halve α until ‖R‖ decreases enough.
@@ -237,7 +314,7 @@ pub(super) fn solve(
             for (&i, dx) in free.iter().zip(&delta) {
                 trial[i] += alpha * dx;
             }
-            let next = evaluate(problem, system, &trial);
+            let next = evaluate(problem, system, &trial, time_step);
             if next.norm <= (1.0 - SUFFICIENT_DECREASE * alpha) * at.norm {
                 accepted = Some((trial, next));
                 break;
@@ -260,10 +337,28 @@ pub(super) fn solve(
         u = trial;
         at = next;
     }
-    let report = report.unwrap_or(crate::la::direct::SolveReport {
+    Ok(Converged {
+        u,
+        forcing: at.forcing,
+        flux: at.flux,
+        history,
+        steps,
+        report,
+    })
+}
+
+/// The solution in the layout of the linear diffusion's.
+pub(super) fn solution(
+    problem: &NonlinearDiffusion,
+    system: &System,
+    u: Vec<f64>,
+    flux: Vec<f64>,
+    report: Option<SolveReport>,
+) -> Solution {
+    let report = report.unwrap_or(SolveReport {
         factorization: Factorization::Lu,
         ordering: None,
-        unknowns: free.len(),
+        unknowns: system.split.free().len(),
         nonzeros: 0,
         symbolic_seconds: 0.0,
         numeric_seconds: 0.0,
@@ -272,11 +367,11 @@ pub(super) fn solve(
         factor_entries: None,
         factor_flops: None,
     });
-    let solution = Solution {
+    Solution {
         method: problem.method,
         location: system.location,
         values: u,
-        flux: at.flux,
+        flux,
         report,
         assembly_seconds: system.assembly_seconds,
         analysed_during_assembly: false,
@@ -285,12 +380,27 @@ pub(super) fn solve(
         cell_points: None,
         iterations: None,
         condition_bound: f64::NAN,
-    };
+    }
+}
+
+pub(super) fn solve(
+    problem: &NonlinearDiffusion,
+    system: &System,
+) -> Result<NonlinearSolution, NonlinearError> {
+    let mut work = Workspace::new(system);
+    let u = lifted(system, problem.options.initial.as_deref());
+    let converged = iterate(problem, system, &mut work, u, None)?;
     Ok(NonlinearSolution {
-        solution,
-        iteration,
-        history,
-        steps,
-        symbolic_analyses: analyses,
+        solution: solution(
+            problem,
+            system,
+            converged.u,
+            converged.flux,
+            converged.report,
+        ),
+        iteration: problem.options.iteration,
+        history: converged.history,
+        steps: converged.steps,
+        symbolic_analyses: work.analyses,
     })
 }
