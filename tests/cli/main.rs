@@ -31,6 +31,7 @@ mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
 mod method_warnings;
+mod nonlinear;
 mod probes;
 mod quantities;
 mod regions;

@@ -17,5 +17,6 @@ mod darcy;
 mod diffusion;
 mod elasticity;
 mod maxwell;
+mod nonlinear;
 mod refinement;
 mod transient;

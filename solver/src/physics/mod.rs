@@ -11,6 +11,7 @@ pub mod elasticity;
 pub mod gradient;
 pub mod heat;
 pub mod maxwell;
+pub mod nonlinear;
 pub mod probe;
 pub mod regions;
 

@@ -48,6 +48,7 @@ use crate::la::direct::Factorization;
 use crate::la::ordering::Ordering;
 use crate::metric::Method;
 use crate::multigrid::CellProlongation;
+use crate::physics::nonlinear::Iteration;
 use diagnostic::Collector;
 use expr::{Expression, Scope};
 use hasse_complex::Complex;
@@ -147,6 +148,42 @@ pub struct SolverSpec {
     /// `[solver.petsc] options`: PETSc's own command-line options
     /// (`"-ksp_type cg -pc_type hypre"`), applied after hasse's defaults.
     pub petsc_options: String,
+    /// Newton/Picard settings of a nonlinear problem (`[solver.nonlinear]`).
+    pub nonlinear: NonlinearSolverSpec,
+}
+
+/// `[solver.nonlinear]`: how a nonlinear diffusion problem iterates.
+///
+/// ```
+/// use hasse_solver::frontend::case::Case;
+/// use hasse_solver::physics::nonlinear::Iteration;
+/// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [2, 2]\n[problem]\nmethod = \"fv\"\nreaction = \"u^3\"\n[solver.nonlinear]\nmethod = \"picard\"\nmax_iterations = 80\nmonitor = true\n";
+/// let nonlinear = Case::from_text("n.toml", text, &[]).unwrap().solver.nonlinear;
+/// assert_eq!((nonlinear.iteration, nonlinear.max_iterations, nonlinear.monitor), (Iteration::Picard, 80, true));
+/// assert_eq!(nonlinear.tolerance, 1e-10);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct NonlinearSolverSpec {
+    /// `method`: "newton" (default) or "picard".
+    pub iteration: Iteration,
+    /// `tolerance`: the residual relative to the size of its terms
+    /// (default 1e-10).
+    pub tolerance: f64,
+    /// `max_iterations` (default 50).
+    pub max_iterations: usize,
+    /// `monitor`: one line per iteration on stderr (default false).
+    pub monitor: bool,
+}
+
+impl Default for NonlinearSolverSpec {
+    fn default() -> Self {
+        Self {
+            iteration: Iteration::Newton,
+            tolerance: 1e-10,
+            max_iterations: 50,
+            monitor: false,
+        }
+    }
 }
 
 impl Default for SolverSpec {
@@ -160,6 +197,7 @@ impl Default for SolverSpec {
             cell_prolongation: CellProlongation::Smoothed,
             ordering: Ordering::Automatic,
             petsc_options: String::new(),
+            nonlinear: NonlinearSolverSpec::default(),
         }
     }
 }

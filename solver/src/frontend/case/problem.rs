@@ -201,6 +201,26 @@ pub struct DiffusionSpec {
     /// projected away (`problem.neumann_tolerance`, default 1e-2;
     /// `problem.neumann = "project"` makes it infinite).
     pub neumann_tolerance: f64,
+    /// r(u, x) of −∇·(k∇u) + r = f (`problem.reaction`); with it, or with
+    /// a conductivity that uses `u`, the problem is nonlinear.
+    pub reaction: Option<Expression>,
+}
+
+impl DiffusionSpec {
+    /// Whether the problem is solved by Newton's method: the conductivity
+    /// uses the solution `u`, or there is a reaction term.
+    ///
+    /// ```
+    /// use hasse_solver::frontend::case::{Case, Problem};
+    /// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [2, 2]\n[problem]\nmethod = \"fv\"\nconductivity = \"1 + u^2\"\n";
+    /// let case = Case::from_text("n.toml", text, &[]).unwrap();
+    /// let Problem::Diffusion(spec) = &case.problem else { panic!() };
+    /// assert!(spec.is_nonlinear());
+    /// ```
+    pub fn is_nonlinear(&self) -> bool {
+        self.reaction.is_some()
+            || matches!(&self.conductivity, Coefficient::Scalar(k) if k.uses_solution())
+    }
 }
 
 /// g = Ω δ f: a cell field's "normal gradient" as a face cochain

@@ -22,6 +22,7 @@ use crate::physics::elasticity::ElasticityError;
 use crate::physics::gradient::GradientError;
 use crate::physics::heat::HeatError;
 use crate::physics::maxwell::MaxwellError;
+use crate::physics::nonlinear::NonlinearError;
 use crate::physics::{Datum, TagError};
 use crate::refine::RefineError;
 use std::fmt;
@@ -45,6 +46,8 @@ pub enum Failure {
     Gradient(GradientError),
     /// A refinement study.
     Refine(RefineError),
+    /// Nonlinear diffusion (Newton or Picard).
+    Nonlinear(NonlinearError),
 }
 
 impl Failure {
@@ -58,6 +61,7 @@ impl Failure {
             Failure::Coupled(e) => e,
             Failure::Gradient(e) => e,
             Failure::Refine(e) => e,
+            Failure::Nonlinear(e) => e,
         }
     }
 }
@@ -80,7 +84,8 @@ failure_from!(
     ElasticityError => Elasticity,
     CoupledError => Coupled,
     GradientError => Gradient,
-    RefineError => Refine
+    RefineError => Refine,
+    NonlinearError => Nonlinear
 );
 
 /// Why a run failed after the case was read: bad input found while

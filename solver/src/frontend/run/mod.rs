@@ -55,6 +55,7 @@ mod gradient;
 mod heat;
 mod maxwell;
 mod petsc;
+mod nonlinear;
 mod probes;
 mod quantities;
 pub mod refine;
@@ -142,6 +143,9 @@ pub fn solve(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     match &case.problem {
+        Problem::Diffusion(spec) if spec.is_nonlinear() => {
+            nonlinear::solve(case, spec, complex, phase)
+        }
         Problem::Diffusion(spec) => solve_diffusion(case, spec, complex, phase),
         Problem::Gradient(spec) => gradient::solve(case, spec, complex, phase),
         Problem::Heat(spec) => heat::solve(case, spec, complex, phase),
@@ -169,6 +173,7 @@ pub fn solve(
 /// ```
 pub fn check_data(case: &Case, complex: &Complex) -> Result<(), RunError> {
     match &case.problem {
+        Problem::Diffusion(spec) if spec.is_nonlinear() => nonlinear::check(case, spec, complex),
         Problem::Diffusion(spec) => diffusion::check(case, spec, complex),
         Problem::Gradient(spec) => gradient::check(case, spec, complex),
         Problem::Heat(spec) => heat::check(case, spec, complex),

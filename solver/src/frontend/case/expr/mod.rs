@@ -29,7 +29,12 @@
 //! assert_eq!((square.eval(&[0.5, 0.5], 0.0), square.eval(&[0.5, 1.5], 0.0)), (1.0, 0.0));
 //! ```
 
+mod messages;
 pub mod ops;
+mod solution;
+
+pub use messages::{quote, QUOTE_WIDTH};
+use messages::{syntax_text, unknown_text};
 
 use exmex::prelude::*;
 use exmex::MatchLiteral;
@@ -108,6 +113,15 @@ pub enum ExprError {
         /// Why it cannot be one.
         reason: String,
     },
+    /// A coefficient of a nonlinear problem whose derivative with respect
+    /// to u cannot be formed.
+    #[error("cannot differentiate `{text}` with respect to u: {reason}")]
+    NotDifferentiable {
+        /// The expression as written.
+        text: String,
+        /// exmex's reason.
+        reason: String,
+    },
     /// A constant whose value is NaN or infinite.
     #[error("constant `{name}` is not finite ({value})")]
     NonFiniteConstant {
@@ -118,114 +132,13 @@ pub enum ExprError {
     },
 }
 
-/// Expressions longer than this many characters are quoted in messages
-/// by an excerpt of this width around the fault, not whole.
-pub const QUOTE_WIDTH: usize = 80;
-
-/// An expression as messages quote it: whole and in backquotes when it is
-/// short; otherwise by its length, and (the second part, for the end of
-/// the message) at most [`QUOTE_WIDTH`] characters around character `at`
-/// (the start when the fault has no one place) on a line of their own with
-/// a caret under that character on the next.
-///
-/// ```
-/// use hasse_solver::frontend::case::expr::quote;
-/// assert_eq!(quote("sin(x", Some(3)), ("`sin(x`".to_string(), String::new()));
-/// let long = format!("{}(", "x + ".repeat(50_000));
-/// let (head, tail) = quote(&long, Some(200_000));
-/// assert_eq!(head, "the expression of 200001 characters");
-/// let lines: Vec<&str> = tail.lines().collect();
-/// assert_eq!(lines[0], ", at character 200001:");
-/// // `…` and 80 characters, the last of them the fault, and the caret
-/// // under it.
-/// assert_eq!(lines[1], format!("    …{}(", &"x + ".repeat(20)[1..]));
-/// assert_eq!(lines[2], format!("    {}^", " ".repeat(80)));
-/// ```
-pub fn quote(text: &str, at: Option<usize>) -> (String, String) {
-    let chars: Vec<char> = text.chars().collect();
-    if chars.len() <= QUOTE_WIDTH {
-        return (format!("`{text}`"), String::new());
-    }
-    let at = at.unwrap_or(0).min(chars.len() - 1);
-    let start = at
-        .saturating_sub(QUOTE_WIDTH / 2)
-        .min(chars.len() - QUOTE_WIDTH);
-    let end = start + QUOTE_WIDTH;
-    let before = if start > 0 { "…" } else { "" };
-    let after = if end < chars.len() { "…" } else { "" };
-    let excerpt: String = chars[start..end].iter().collect();
-    let caret = before.chars().count() + (at - start);
-    (
-        format!("the expression of {} characters", chars.len()),
-        format!(
-            ", at character {}:\n    {before}{excerpt}{after}\n    {}^",
-            at + 1,
-            " ".repeat(caret)
-        ),
-    )
-}
-
-/// The message of a syntax error: what is wrong, then where.
-fn syntax_text(text: &str, message: &str) -> String {
-    let (head, tail) = quote(text, syntax_position(text));
-    format!("cannot parse {head}: {message}{tail}")
-}
-
-/// The message of an unknown name: which, with the closest known one,
-/// then where.
-fn unknown_text(text: &str, name: &str, suggestion: &Option<String>) -> String {
-    let (head, tail) = quote(text, word_position(text, name));
-    format!(
-        "unknown variable `{name}` in {head}{}{tail}",
-        suggestion_text(suggestion)
-    )
-}
-
-/// Where (in characters) a syntax error shows first: a `)` that closes
-/// nothing, the first `(` never closed, or a character that is not part
-/// of an expression; `None` when the fault is not one place.
-fn syntax_position(text: &str) -> Option<usize> {
-    let mut open = Vec::new();
-    for (i, c) in text.chars().enumerate() {
-        match c {
-            '(' => open.push(i),
-            ')' if open.is_empty() => return Some(i),
-            ')' => {
-                open.pop();
-            }
-            _ => {}
-        }
-    }
-    if let Some(&first) = open.first() {
-        return Some(first);
-    }
-    text.chars()
-        .position(|c| !(c.is_alphanumeric() || c.is_whitespace() || "+-*/^(),._<>=!&|".contains(c)))
-}
-
-/// Where (in characters) `name` first stands as a whole word in `text`.
-fn word_position(text: &str, name: &str) -> Option<usize> {
-    let word = |c: char| c.is_alphanumeric() || c == '_';
-    text.match_indices(name)
-        .find(|&(i, _)| {
-            !text[..i].chars().next_back().is_some_and(word)
-                && !text[i + name.len()..].chars().next().is_some_and(word)
-        })
-        .map(|(i, _)| text[..i].chars().count())
-}
-
-fn suggestion_text(suggestion: &Option<String>) -> String {
-    match suggestion {
-        Some(s) => format!(" (did you mean `{s}`?)"),
-        None => String::new(),
-    }
-}
-
 /// Where the value of one exmex variable comes from.
 #[derive(Clone, Debug)]
 enum Slot {
     Coordinate(usize),
     Time,
+    /// The solution u of a nonlinear problem.
+    Solution,
     Constant(f64),
     Definition(Arc<Expression>),
 }
@@ -254,6 +167,8 @@ pub struct Expression {
     /// True when the value depends on neither position nor time.
     constant: bool,
     uses_time: bool,
+    /// True when the value depends on the solution `u`.
+    uses_solution: bool,
     /// Set for a value per region ([`Expression::per_region`]).
     regions: Option<Arc<Regions>>,
 }
@@ -285,6 +200,12 @@ impl Expression {
         self.uses_time
     }
 
+    /// True when the expression depends on the solution `u` (only a
+    /// scope made by [`Scope::with_solution`] lets it).
+    pub fn uses_solution(&self) -> bool {
+        self.uses_solution
+    }
+
     /// An expression per region; `text` is how the case wrote it.
     ///
     /// ```
@@ -313,6 +234,12 @@ impl Expression {
             slots: Vec::new(),
             constant: false,
             uses_time,
+            uses_solution: regions
+                .pieces
+                .iter()
+                .map(|(_, e)| e)
+                .chain(&regions.default)
+                .any(Expression::uses_solution),
             regions: Some(Arc::new(regions)),
         }
     }
@@ -328,6 +255,10 @@ impl Expression {
     /// Division by zero and the like give non-finite values, not errors:
     /// callers check the values they evaluate and say where it happened.
     pub fn eval(&self, point: &[f64], t: f64) -> f64 {
+        self.evaluate(point, t, f64::NAN)
+    }
+
+    fn evaluate(&self, point: &[f64], t: f64, u: f64) -> f64 {
         if self.regions.is_some() {
             return f64::NAN;
         }
@@ -345,6 +276,7 @@ impl Expression {
             *value = match slot {
                 Slot::Coordinate(i) => point.get(*i).copied().unwrap_or(0.0),
                 Slot::Time => t,
+                Slot::Solution => u,
                 Slot::Constant(c) => *c,
                 Slot::Definition(e) => e.eval(point, t),
             };
@@ -376,6 +308,9 @@ impl Expression {
 pub struct Scope {
     constants: Vec<(String, f64)>,
     definitions: Vec<(String, Arc<Expression>)>,
+    /// Whether `u` names the solution (coefficients of a nonlinear
+    /// problem), unless a constant or definition of the case is called u.
+    solution: bool,
 }
 
 /// Names exmex already gives a meaning to; a user name equal to one of
@@ -393,9 +328,22 @@ impl Scope {
         Self::default()
     }
 
+    /// The same scope in which `u` names the solution (the conductivity
+    /// and reaction of a diffusion problem), unless the case defines a
+    /// constant or definition `u` itself.
+    pub fn with_solution(&self) -> Scope {
+        Scope {
+            solution: true,
+            ..self.clone()
+        }
+    }
+
     /// Every name an expression may use, for suggestions and messages.
     pub fn names(&self) -> Vec<String> {
         let mut names: Vec<String> = COORDINATES.iter().map(|s| s.to_string()).collect();
+        if self.solution {
+            names.push("u".into());
+        }
         names.push("pi".into());
         names.extend(self.constants.iter().map(|(n, _)| n.clone()));
         names.extend(self.definitions.iter().map(|(n, _)| n.clone()));
@@ -462,6 +410,11 @@ impl Scope {
         let mut slots = Vec::with_capacity(flat.var_names().len());
         let mut constant = true;
         let mut uses_time = false;
+        let mut uses_solution = false;
+        let defined = |name: &str| {
+            self.constants.iter().any(|(n, _)| n == name)
+                || self.definitions.iter().any(|(n, _)| n == name)
+        };
         for name in flat.var_names() {
             let slot = if let Some(i) = ["x", "y", "z"].iter().position(|c| c == name) {
                 constant = false;
@@ -472,6 +425,10 @@ impl Scope {
                 Slot::Time
             } else if name == "pi" {
                 Slot::Constant(std::f64::consts::PI)
+            } else if name == "u" && self.solution && !defined(name) {
+                constant = false;
+                uses_solution = true;
+                Slot::Solution
             } else if let Some((_, v)) = self.constants.iter().find(|(n, _)| n == name) {
                 Slot::Constant(*v)
             } else if let Some((_, e)) = self.definitions.iter().find(|(n, _)| n == name) {
@@ -493,6 +450,7 @@ impl Scope {
             slots,
             constant,
             uses_time,
+            uses_solution,
             regions: None,
         })
     }

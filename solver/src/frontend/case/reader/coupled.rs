@@ -155,6 +155,7 @@ impl Reader {
                             // Not read: the coupled block solve does not
                             // project Neumann data.
                             neumann_tolerance: 1e-2,
+                            reaction: None,
                         },
                         exact,
                     }),

@@ -58,6 +58,7 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "cell_points",
     "neumann",
     "neumann_tolerance",
+    "reaction",
     "initial",
     "permeability",
     "mass",
@@ -83,6 +84,7 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
             "cell_points",
             "neumann",
             "neumann_tolerance",
+            "reaction",
         ],
     ),
     ("gradient", &["field", "metric"]),
@@ -106,8 +108,11 @@ pub(super) const SOLVER_KEYS: &[&str] = &[
     "prolongation",
     "ordering",
     "petsc",
+    "nonlinear",
 ];
 pub(super) const PETSC_KEYS: &[&str] = &["options"];
+/// Keys of `[solver.nonlinear]`.
+pub(super) const NONLINEAR_KEYS: &[&str] = &["method", "tolerance", "max_iterations", "monitor"];
 pub(super) const OUTPUT_KEYS: &[&str] = &[
     "directory",
     "name",
@@ -620,10 +625,15 @@ pub(super) const REGIONAL_KEYS: &str = "values per region are accepted by the co
 
 pub(super) fn expression_help(e: &ExprError, scope: &Scope) -> String {
     match e {
+        ExprError::UnknownVariable { name, .. } if name == "u" => format!(
+            "the solution u may appear only in the conductivity and reaction of a diffusion problem (which makes it nonlinear); here expressions may use {}",
+            scope.names().join(", ")
+        ),
         ExprError::UnknownVariable { .. } => format!(
             "expressions may use {}; add other names under [constants] or [definitions]",
             scope.names().join(", ")
         ),
+        ExprError::NotDifferentiable { .. } => "Newton's method needs ∂/∂u: write the u-dependence with + - * / ^ and functions (sin, exp, ln, sqrt, …), without comparisons or if(…)".into(),
         ExprError::Syntax { .. } => "operators: + - * / ^; functions: sin cos tan exp ln sqrt abs min max atan2 ...; write powers as x^2".into(),
         ExprError::ReservedName { .. } => "choose another name".into(),
         ExprError::NonFiniteConstant { .. } => "give a finite number".into(),

@@ -126,7 +126,18 @@ impl Reader {
         match kind.as_str() {
             "diffusion" => {
                 let method = self.method(table, problem_entry.span());
-                let conductivity = self.coefficient(table, "conductivity", scope);
+                // The conductivity and the reaction may use the solution u.
+                let with_u = scope.with_solution();
+                let conductivity = self
+                    .coefficient(table, "conductivity", &with_u)
+                    .and_then(|k| self.nonlinear_conductivity(table, k));
+                let reaction = match self.entry(table, "problem", "reaction") {
+                    Some(_) => self
+                        .expression_at(table, "problem", "reaction", &with_u)
+                        .and_then(|r| self.differentiable(table, "reaction", r))
+                        .map(Some),
+                    None => Some(None),
+                };
                 let source = match self.entry(table, "problem", "source") {
                     Some(_) => self.expression_or_regions_at(table, "problem", "source", scope),
                     None => scope.parse("0").ok(),
@@ -151,14 +162,19 @@ impl Reader {
                     self.error(span, "problem.cell_points", "only the two-point flux (method = \"fv\") places its unknowns at other cell points", None);
                 }
                 let neumann_tolerance = self.neumann_tolerance(table);
-                Some(Problem::Diffusion(DiffusionSpec {
+                let spec = DiffusionSpec {
                     method: method?,
                     conductivity: conductivity?,
                     source: source?,
                     boundary,
                     circumcentres,
                     neumann_tolerance,
-                }))
+                    reaction: reaction?,
+                };
+                if spec.is_nonlinear() {
+                    self.check_nonlinear(root, table, &spec);
+                }
+                Some(Problem::Diffusion(spec))
             }
             "heat" => self.heat(root, table, problem_entry.span(), scope),
             "darcy" => self.darcy(root, table, problem_entry.span(), scope),
@@ -202,6 +218,122 @@ impl Reader {
                 );
                 None
             }
+        }
+    }
+
+    /// A conductivity that uses u must be one scalar expression whose
+    /// derivative exmex can form.
+    fn nonlinear_conductivity(
+        &mut self,
+        table: &dyn TableLike,
+        k: Coefficient,
+    ) -> Option<Coefficient> {
+        let span = || {
+            table
+                .get_key_value("conductivity")
+                .and_then(|(_, item)| item.span())
+        };
+        match k {
+            Coefficient::Tensor(rows) if rows.iter().flatten().any(|e| e.uses_solution()) => {
+                self.error(
+                    span(),
+                    "problem.conductivity",
+                    "a conductivity that depends on u must be a scalar",
+                    Some("write k(u, x) as one expression, e.g. \"1 + u^2\"".into()),
+                );
+                None
+            }
+            Coefficient::Scalar(e) if e.uses_solution() && e.regions().is_some() => {
+                self.error(
+                    span(),
+                    "problem.conductivity",
+                    "a conductivity that depends on u cannot be given per region",
+                    Some("write one expression; select regions by position with if(…) outside the u-dependence".into()),
+                );
+                None
+            }
+            Coefficient::Scalar(e) if e.uses_solution() => self
+                .differentiable(table, "conductivity", e)
+                .map(Coefficient::Scalar),
+            other => Some(other),
+        }
+    }
+
+    /// `e` (at `problem.<key>`) if its derivative with respect to u exists.
+    fn differentiable(
+        &mut self,
+        table: &dyn TableLike,
+        key: &str,
+        e: Expression,
+    ) -> Option<Expression> {
+        match e.derivative_u() {
+            Ok(_) => Some(e),
+            Err(error) => {
+                let span = table.get_key_value(key).and_then(|(_, item)| item.span());
+                let help = expression_help(&error, &Scope::new());
+                self.error(span, &join("problem", key), error.to_string(), Some(help));
+                None
+            }
+        }
+    }
+
+    /// What a nonlinear diffusion case cannot combine with, found from the
+    /// input alone: the hybrid mimetic method, circumcentre cell points,
+    /// Robin conditions, `[refine]`, quantities and probes.
+    fn check_nonlinear(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        spec: &DiffusionSpec,
+    ) {
+        let span_of =
+            |t: &dyn TableLike, key: &str| t.get_key_value(key).and_then(|(_, i)| i.span());
+        if spec.method == Method::FvMimetic {
+            self.error(
+                span_of(table, "method"),
+                "problem.method",
+                "a nonlinear problem (conductivity with u, or a reaction) needs a diagonal Ω; fv-mimetic couples the faces of a cell",
+                Some("use fv, fd, fe (simplices) or dec".into()),
+            );
+        }
+        if spec.circumcentres {
+            self.error(
+                span_of(table, "cell_points"),
+                "problem.cell_points",
+                "a nonlinear problem keeps the cell values at the centroids",
+                Some("remove problem.cell_points".into()),
+            );
+        }
+        for b in &spec.boundary {
+            if matches!(b.kind, BoundaryKindSpec::Robin { .. }) {
+                self.error(
+                    b.tag_span.clone(),
+                    &format!("{}.type", b.key),
+                    "Robin conditions are not supported with a u-dependent conductivity or a reaction",
+                    Some("use dirichlet or neumann".into()),
+                );
+            }
+        }
+        let output = root.get("output").and_then(Item::as_table_like);
+        for name in ["quantity", "probe"] {
+            if let Some((key, _)) = output.and_then(|o| o.get_key_value(name)) {
+                self.error(
+                    key.span(),
+                    &format!("output.{name}"),
+                    format!("output.{name} is not evaluated for a nonlinear problem"),
+                    Some(format!(
+                        "remove [[output.{name}]]; the field u is in the output"
+                    )),
+                );
+            }
+        }
+        if let Some((key, _)) = root.get_key_value("refine") {
+            self.error(
+                key.span(),
+                "refine",
+                "refinement studies re-solve linear problems; this case is nonlinear",
+                Some("remove [refine], or run the meshes one by one".into()),
+            );
         }
     }
 

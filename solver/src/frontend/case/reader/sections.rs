@@ -1,6 +1,8 @@
 //! The `[exact]`, `[solver]`, `[refine]` and `[output]` tables.
 
 use super::*;
+use crate::frontend::case::NonlinearSolverSpec;
+use crate::physics::nonlinear::Iteration;
 
 impl Reader {
     pub(super) fn exact(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<ExactSpec> {
@@ -311,6 +313,65 @@ impl Reader {
                         None,
                     );
                 }
+            }
+        }
+        if let Some((nonlinear, _)) = self.subtable(table, "solver", "nonlinear") {
+            spec.nonlinear = self.nonlinear_solver(nonlinear);
+        }
+        spec
+    }
+
+    /// `[solver.nonlinear]`: method, tolerance, max_iterations, monitor.
+    fn nonlinear_solver(&mut self, table: &dyn TableLike) -> NonlinearSolverSpec {
+        const PREFIX: &str = "solver.nonlinear";
+        self.check_keys(table, PREFIX, NONLINEAR_KEYS);
+        let mut spec = NonlinearSolverSpec::default();
+        if let Some(name) = self.string_at(table, PREFIX, "method") {
+            match name.as_str() {
+                "newton" => spec.iteration = Iteration::Newton,
+                "picard" => spec.iteration = Iteration::Picard,
+                other => {
+                    let span = self.entry(table, PREFIX, "method").and_then(|e| e.span());
+                    self.error(
+                        span,
+                        "solver.nonlinear.method",
+                        format!("unknown nonlinear method \"{other}\""),
+                        Some("use \"newton\" (default: quadratic convergence) or \"picard\" (the coefficient frozen at the last iterate: linear convergence)".into()),
+                    );
+                }
+            }
+        }
+        if let Some(t) = self.number_at(table, PREFIX, "tolerance") {
+            if t > 0.0 && t < 1.0 {
+                spec.tolerance = t;
+            } else {
+                let span = self
+                    .entry(table, PREFIX, "tolerance")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "solver.nonlinear.tolerance",
+                    format!("a relative residual in (0, 1), found {t}"),
+                    None,
+                );
+            }
+        }
+        if let Some(entry) = self.entry(table, PREFIX, "max_iterations") {
+            match entry.item.as_integer() {
+                Some(n) if n >= 1 => spec.max_iterations = n as usize,
+                Some(n) => self.error(
+                    entry.span(),
+                    &entry.name,
+                    format!("at least 1 iteration, found {n}"),
+                    None,
+                ),
+                None => self.type_error(&entry, "an integer"),
+            }
+        }
+        if let Some(entry) = self.entry(table, PREFIX, "monitor") {
+            match entry.item.as_bool() {
+                Some(b) => spec.monitor = b,
+                None => self.type_error(&entry, "true or false"),
             }
         }
         spec
