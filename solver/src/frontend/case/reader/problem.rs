@@ -314,6 +314,22 @@ impl Reader {
                 );
             }
         }
+        // Newton's steps are solved by one LU analysis reused over the
+        // steps; the iterative and distributed solvers are not wired in.
+        if let Some((solver, kind)) = root
+            .get("solver")
+            .and_then(Item::as_table_like)
+            .and_then(|t| t.get_key_value("type"))
+        {
+            if kind.as_str().is_some_and(|k| k != "direct") {
+                self.error(
+                    kind.span().or_else(|| solver.span()),
+                    "solver.type",
+                    "a nonlinear problem solves its Newton steps with a direct LU factorisation; other solver types are not available for it",
+                    Some("remove solver.type (or set it to \"direct\")".into()),
+                );
+            }
+        }
         let output = root.get("output").and_then(Item::as_table_like);
         for name in ["quantity", "probe"] {
             if let Some((key, _)) = output.and_then(|o| o.get_key_value(name)) {
