@@ -28,6 +28,7 @@ mod darcy_reports;
 mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
+mod lar_files;
 mod method_warnings;
 mod probes;
 mod quantities;
