@@ -161,20 +161,60 @@ pub(crate) fn polyhedron_faces(
         .collect()
 }
 
+/// The cycle through all of `cell`'s vertices made by the given edges that
+/// join two of them, if they make exactly one.
+fn edge_cycle(cell: &[usize], edges: &[Vec<usize>]) -> Option<Vec<usize>> {
+    let mut around: std::collections::HashMap<usize, Vec<usize>> =
+        cell.iter().map(|&v| (v, Vec::new())).collect();
+    for e in edges {
+        if let [a, b] = e[..] {
+            if around.contains_key(&a) && around.contains_key(&b) {
+                around.get_mut(&a)?.push(b);
+                around.get_mut(&b)?.push(a);
+            }
+        }
+    }
+    if around.values().any(|n| n.len() != 2) {
+        return None;
+    }
+    let mut order = vec![cell[0]];
+    let mut previous = cell[0];
+    let mut at = around[&cell[0]][0];
+    while at != cell[0] {
+        order.push(at);
+        let next = around[&at].iter().copied().find(|&n| n != previous)?;
+        (previous, at) = (at, next);
+        if order.len() > cell.len() {
+            return None;
+        }
+    }
+    (order.len() == cell.len()).then_some(order)
+}
+
 /// The cells of one dimension `p` (1, 2 or 3), each an unordered vertex
 /// set, as [`TopCells`]: simplices when they have p + 1 vertices, convex
-/// polygons and polyhedra otherwise. The error names the cell.
+/// polygons and polyhedra otherwise. A 2-cell that is not convex is
+/// ordered by the cycle of the given `edges` through its vertices, when
+/// they make one (the complex then orients it by that cycle). The error
+/// names the cell.
 pub(crate) fn top_cells(
     vertices: &Vertices,
     p: usize,
     cells: &[Vec<usize>],
+    edges: Option<&[Vec<usize>]>,
 ) -> Result<TopCells, (usize, OrderError)> {
     let mut out = TopCells::default();
     for (i, cell) in cells.iter().enumerate() {
         if cell.len() == p + 1 {
             out.push_simplex(cell);
         } else if p == 2 {
-            out.push_polygon(&polygon_cycle(vertices, cell).map_err(|e| (i, e))?);
+            let cycle = match polygon_cycle(vertices, cell) {
+                Err(OrderError::NotConvex { vertex }) => edges
+                    .and_then(|edges| edge_cycle(cell, edges))
+                    .ok_or((i, OrderError::NotConvex { vertex }))?,
+                other => other.map_err(|e| (i, e))?,
+            };
+            out.push_polygon(&cycle);
         } else {
             out.push_polyhedron(&polyhedron_faces(vertices, cell).map_err(|e| (i, e))?);
         }

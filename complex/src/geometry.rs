@@ -416,16 +416,47 @@ impl<'a> Mesh<'a> {
         let apex = origin + sum * (0.5 / edges.len() as f64);
         let mut area = 0.0;
         let mut moment = Vector3::zeros();
+        let mut reflex = false;
+        let normal = unit(&self.vector_area(f));
+        let signs = column(self.complex.boundary_csc(2), f).1;
         for (k, &e) in edges.iter().enumerate() {
             let (a, b) = if small { ends[k] } else { self.ends(e) };
             let a = a - apex;
             let b = b - apex;
-            let t = 0.5 * a.cross(&b).norm();
+            let c = a.cross(&b);
+            let t = 0.5 * c.norm();
+            // A triangle of the fan turned against the cell: the apex is
+            // outside the kernel of a non-convex polygon.
+            reflex |= f64::from(signs[k]) * c.dot(&normal) < -1e-12 * c.norm();
             area += t;
             // Triangle centroid relative to the apex: (a + b) / 3.
             moment += (a + b) * (t / 3.0);
         }
+        if reflex {
+            return self.signed_polygon(f, &apex, &normal);
+        }
         (area, centred(&apex, &moment, area))
+    }
+
+    /// The fan of [`Self::polygon`] with signed triangles (by the cell's
+    /// orientation), exact for any simple polygon, convex or not.
+    fn signed_polygon(
+        &self,
+        f: usize,
+        apex: &Vector3<f64>,
+        normal: &Vector3<f64>,
+    ) -> (f64, Vector3<f64>) {
+        let (edges, signs) = column(self.complex.boundary_csc(2), f);
+        let mut area = 0.0;
+        let mut moment = Vector3::zeros();
+        for (&e, &r) in edges.iter().zip(signs) {
+            let (a, b) = self.ends(e);
+            let (a, b) = (a - apex, b - apex);
+            let t = 0.5 * f64::from(r) * a.cross(&b).dot(normal);
+            area += t;
+            moment += (a + b) * (t / 3.0);
+        }
+        (area, centred(apex, &moment, area))
     }
 
     /// Signed tetrahedra (o, a_f, v₀, v₁) over the oriented fan of every

@@ -14,7 +14,10 @@
 //! exactly those facets, and then keep the file's numbering. Vertex lists
 //! may come in any order: a top cell with p + 1 vertices is a simplex, any
 //! other 2-cell a convex polygon and any other 3-cell a convex polyhedron,
-//! both ordered from the vertex positions. A 1-complex is a file with `V`
+//! both ordered from the vertex positions. A non-convex 2-cell (a simple
+//! polygon) cannot be ordered from its vertices alone: it is read when
+//! `EV` is given and its edges there form one cycle through its vertices.
+//! A 1-complex is a file with `V`
 //! and `EV` only.
 //!
 //! Written back by [`to_lar_json`] with every dimension listed and vertex
@@ -126,7 +129,7 @@ pub enum LarError {
         cell: usize,
         vertex: usize,
     },
-    #[error("\"{key}\"[{cell}] is not convex: vertex {vertex} lies inside the convex hull of the others (cells given by unordered vertex lists must be convex)")]
+    #[error("\"{key}\"[{cell}] is not convex: vertex {vertex} lies inside the convex hull of the others (a cell given by its unordered vertex list must be convex, or, for a 2-cell, have its boundary cycle among the edges of a given EV)")]
     NotConvex {
         key: &'static str,
         cell: usize,
@@ -239,11 +242,13 @@ impl LarInput {
             }
             seen.insert(sorted(vertices), cell);
         }
-        let cells = top_cells(&self.vertices, n, top).map_err(|(cell, e)| match e {
-            OrderError::Degenerate => LarError::Degenerate { key, cell },
-            OrderError::NotPlanar { vertex } => LarError::NotPlanar { key, cell, vertex },
-            OrderError::NotConvex { vertex } => LarError::NotConvex { key, cell, vertex },
-        })?;
+        let cells = top_cells(&self.vertices, n, top, self.cells[0].as_deref()).map_err(
+            |(cell, e)| match e {
+                OrderError::Degenerate => LarError::Degenerate { key, cell },
+                OrderError::NotPlanar { vertex } => LarError::NotPlanar { key, cell, vertex },
+                OrderError::NotConvex { vertex } => LarError::NotConvex { key, cell, vertex },
+            },
+        )?;
         // The facets of every level, as the complex will number them; each
         // given level is compared with them.
         let mut extracted: Vec<Vec<Vec<usize>>> = vec![Vec::new(); n];

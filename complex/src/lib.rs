@@ -28,6 +28,7 @@ pub mod homology;
 pub mod json;
 pub mod lar;
 pub mod lar_json;
+mod nonconvex;
 pub mod product;
 pub mod refine;
 pub mod relations;

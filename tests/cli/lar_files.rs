@@ -148,3 +148,53 @@ fn a_bad_lar_file_is_refused_with_its_key_and_cell() -> TestResult {
     assert!(text(&out).contains("mesh.file"), "{}", text(&out));
     Ok(())
 }
+
+#[test]
+fn non_convex_cells_are_solved_by_fe_and_refused_by_the_other_methods() -> TestResult {
+    // An L-shaped hexagon and the square filling its notch; vertex 3 at
+    // (1, 1) is the one interior vertex, a reflex corner of the L.
+    let dir = scratch("lar-non-convex")?;
+    std::fs::write(
+        dir.join("notch.lar.json"),
+        r#"{"V": [[0,0],[2,0],[2,1],[1.2,0.9],[1,2],[0,2],[2,2]],
+            "FV": [[0,1,2,3,4,5],[3,2,6,4]],
+            "EV": [[0,1],[1,2],[2,3],[3,4],[4,5],[0,5],[2,6],[4,6]]}"#,
+    )?;
+    std::fs::write(
+        dir.join("notch.toml"),
+        "[mesh]\nfile = \"notch.lar.json\"\n\n[problem]\nmethod = \"fe\"\nsource = 0\n\n[[boundary]]\ntag = \"boundary\"\ntype = \"dirichlet\"\nvalue = \"1 + 2*x - y\"\n\n[exact]\nsolution = \"1 + 2*x - y\"\ngradient = [\"2\", \"-1\"]\n",
+    )?;
+    let info = hasse_in(&dir, &["info", "notch.lar.json"])?;
+    assert!(
+        text(&info).contains("K0 = 7   K1 = 8   K2 = 2"),
+        "{}",
+        text(&info)
+    );
+    // The virtual element on the L reproduces the linear field exactly,
+    // the interior vertex included.
+    let out = hasse_in(&dir, &["run", "notch.toml", "-o", "notch"])?;
+    let shown = text(&out);
+    assert!(out.status.success(), "{shown}");
+    assert!(shown.contains("unknowns   7"), "{shown}");
+    let sampled = shown
+        .lines()
+        .find(|l| l.starts_with("sampled"))
+        .ok_or("no sampled line")?;
+    let max: f64 = sampled
+        .split_whitespace()
+        .nth(2)
+        .ok_or("no value")?
+        .parse()?;
+    assert!(max < 1e-12, "{sampled}");
+    for method in ["fv", "fv-mimetic", "dec-barycentric"] {
+        let set = format!("problem.method={method}");
+        let out = hasse_in(&dir, &["run", "notch.toml", "--set", &set])?;
+        assert_eq!(out.status.code(), Some(2), "{method}: {}", text(&out));
+        assert!(
+            text(&out).contains("needs convex cells") && text(&out).contains("top cell 0"),
+            "{method}: {}",
+            text(&out)
+        );
+    }
+    Ok(())
+}

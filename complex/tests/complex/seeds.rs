@@ -135,12 +135,47 @@ fn lar_operator_identities_on_fig_2d() -> TestResult {
 }
 
 #[test]
-fn lar_fig_2d_non_convex_faces_are_refused_by_name_when_given_unordered() -> TestResult {
-    // Unordered vertex lists are read as convex cells: a non-convex
-    // hexagon of Fig. 2d is refused with its key, index and an inner vertex.
-    let err = lar_json::from_str(FIG_2D)
+fn lar_fig_2d_oriented_the_non_convex_hexagons_by_their_boundary_cycles() -> TestResult {
+    // Seed 004, Fig. 2d as an oriented complex: each hexagon ordered by
+    // the cycle of its edges in EV, signed by walking it (digest:
+    // "f0 traverses 3→5 and 6→0, so f1 must traverse 5→3 and 0→6").
+    let k = lar_json::from_str(FIG_2D)?;
+    assert_eq!(k.cell_counts(), vec![8, 10, 2]);
+    // The file's edge numbering e0 … e9 is kept.
+    let lar = fig_2d()?;
+    assert_eq!(k.lar(), &lar);
+    let dd = k.boundary(1) * k.boundary(2);
+    assert!(dd.data().iter().all(|&x| x == 0), "∂1∂2 = 0");
+    // Unsigned, ∂2 is the printed [∂2].
+    assert_eq!(
+        k.boundary(2).map(|&x| x.unsigned_abs()),
+        lar.unoriented_boundary(2)?
+    );
+    let d2 = dense(k.boundary(2));
+    // e5 = [3, 5] and e2 = [0, 6] (an edge runs from its lower vertex).
+    assert_eq!((d2[5][0], d2[2][0]), (1, -1), "f0: 3→5 and 6→0");
+    assert_eq!((d2[5][1], d2[2][1]), (-1, 1), "f1: 5→3 and 0→6");
+    // An annulus: χ = 0, β = (1, 1, 0); area 4² − 2² split 6 + 6.
+    assert_eq!(k.euler_characteristic(), 0);
+    assert_eq!(k.betti_numbers(), vec![1, 1, 0]);
+    assert_eq!(k.measure(2), &[6.0, 6.0]);
+    // Centroids by the signed fan (the vertex average lies outside f0's
+    // kernel): (25/9, 11/9) and (11/9, 25/9).
+    let c = k.centroid(2);
+    for (x, expected) in c
+        .iter()
+        .zip([25.0 / 9.0, 11.0 / 9.0, 11.0 / 9.0, 25.0 / 9.0])
+    {
+        assert!((x - expected).abs() < 1e-12, "{c:?}");
+    }
+    assert_eq!(k.non_convex_cells(), vec![0, 1]);
+    // Without EV the hexagons cannot be recovered from their vertex sets:
+    // refused with the key, the index and a vertex inside the hull.
+    let without_edges = r#"{"V": [[0, 0], [4, 0], [0, 4], [4, 4], [1, 3], [3, 3], [1, 1], [3, 1]],
+        "FV": [[0, 1, 3, 5, 6, 7], [0, 2, 3, 4, 5, 6]]}"#;
+    let err = lar_json::from_str(without_edges)
         .err()
-        .ok_or("Fig. 2d was accepted")?;
+        .ok_or("accepted without EV")?;
     assert!(
         matches!(err, LarError::NotConvex { key: "FV", cell: 0, vertex } if [5, 6, 7].contains(&vertex)),
         "{err}"

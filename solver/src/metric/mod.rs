@@ -14,6 +14,13 @@
 //! per cell or one scalar λ per cell (K = λ·I, stored as 8 bytes a cell
 //! instead of 72).
 //!
+//! Non-convex cells (simple polygons, e.g. read from a LAR file): only
+//! FE takes them, through the virtual element, which is exact on linear
+//! fields on any simple polygon (and stable on star-shaped ones). The
+//! others locate unknowns or half-resistances at cell centroids and need
+//! the centroid inside every face's half-plane: they refuse the first
+//! non-convex top cell by id ([`require_convex`]).
+//!
 //! [`BlockMetric`]: crate::operator::BlockMetric
 
 #![warn(missing_docs)]
@@ -29,7 +36,23 @@ mod method;
 pub use coefficient::{check_tensors, isotropic, CellTensors, Tensor};
 pub use method::{Location, Method, UnknownMethod};
 
-use hasse_complex::ComplexError;
+use hasse_complex::{Complex, ComplexError};
+
+/// Refuse a mesh with a non-convex top cell for a method whose formula
+/// needs convex cells, naming the first such cell.
+pub(crate) fn require_convex(complex: &Complex, method: &'static str) -> Result<(), MetricError> {
+    if complex.dim() != 2 {
+        return Ok(());
+    }
+    match complex.non_convex_cells().first() {
+        Some(&cell) => Err(MetricError::UnsupportedCell {
+            method,
+            needs: "convex cells (fe takes non-convex polygons, by its virtual elements)",
+            cell,
+        }),
+        None => Ok(()),
+    }
+}
 
 /// Why a metric could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
