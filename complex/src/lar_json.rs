@@ -51,6 +51,12 @@ pub const CELL_KEYS: [&str; 3] = ["EV", "FV", "CV"];
 /// and, where there is one, the cell (0-based position in its list).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum LarError {
+    #[error("not valid JSON: {message}")]
+    Syntax {
+        line: usize,
+        column: usize,
+        message: String,
+    },
     #[error("the top level must be an object {{\"V\": [...], \"FV\": [...], ...}}")]
     NotAnObject,
     #[error("unknown key \"{0}\": the keys are V, EV, FV and CV")]
@@ -462,8 +468,11 @@ fn parse_cells(
 
 /// The checked content of LAR text (see [`LarInput`]).
 pub fn parse_str(text: &str) -> Result<LarInput, LarError> {
-    // The text was checked as JSON by the callers that report positions.
-    let value: Value = serde_json::from_str(text).map_err(|_| LarError::NotAnObject)?;
+    let value: Value = serde_json::from_str(text).map_err(|e| LarError::Syntax {
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
     parse_value(&value)
 }
 

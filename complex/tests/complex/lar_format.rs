@@ -161,7 +161,8 @@ fn bad_input_is_refused_with_the_key_the_cell_and_the_problem() -> TestResult {
     );
     // Non-finite numbers cannot be written in JSON; a huge one overflows.
     let huge = r#"{"V": [[0, 0], [1e999, 0], [0, 1]], "FV": [[0, 1, 2]]}"#;
-    assert!(lar_json::parse_str(huge).is_err());
+    let err = lar_json::parse_str(huge).err().ok_or("accepted 1e999")?;
+    assert!(matches!(err, LarError::Syntax { line: 1, .. }), "{err}");
     Ok(())
 }
 
