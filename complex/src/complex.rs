@@ -118,6 +118,7 @@ impl Complex {
             })
             .collect::<Result<_>>()?;
         drop(top_frames);
+        crate::nonconvex::orient_by_cycles(&lar, &mut boundaries)?;
         check_closed(&lar, &boundaries)?;
         let top_orientation = orient_top_cells(&lar, &boundaries[n - 1], ambient)?;
         let top = &mut boundaries[n - 1];
@@ -590,14 +591,17 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<frame::Pack
                 .ok_or_else(|| degenerate(p, j, cell))?;
             let sign = facet_frame
                 .as_ref()
-                .and_then(|f| frame::induced_sign(&cell_frame, f, cell_frame.diameter))
-                .ok_or_else(|| {
-                    ComplexError::Invalid(format!(
-                        "{}-cell {i} (vertices {facet:?}) does not bound {p}-cell {j} (vertices {cell:?}) from outside: the cell is not convex or is degenerate",
-                        p - 1
-                    ))
-                })?;
-            out.push(sign);
+                .and_then(|f| frame::induced_sign(&cell_frame, f, cell_frame.diameter));
+            // A polygon's undecided sign (0) is settled by its boundary
+            // cycle (`nonconvex`); other cells must be convex.
+            out.push(match sign {
+                Some(sign) => sign,
+                None if p == 2 => 0,
+                None => return Err(ComplexError::Invalid(format!(
+                    "{}-cell {i} (vertices {facet:?}) does not bound {p}-cell {j} (vertices {cell:?}) from outside: the cell is not convex or is degenerate",
+                    p - 1
+                ))),
+            });
         }
         Ok(())
     };
@@ -661,37 +665,17 @@ fn orient_top_cells(lar: &Lar, top: &CsMat<i8>, ambient: Vec<i8>) -> Result<Vec<
                 }
             }
         }
-        if closed && n == 2 && d == 3 && enclosed_volume(lar, &by_cell, &flags, &component) < 0.0 {
+        if closed
+            && n == 2
+            && d == 3
+            && crate::nonconvex::enclosed_volume(lar, &by_cell, &flags, &component) < 0.0
+        {
             for &c in &component {
                 flags[c] = -flags[c];
             }
         }
     }
     Ok(flags)
-}
-
-/// Signed volume enclosed by a closed oriented surface component:
-/// (1/6) Σ_cells Σ_{oriented boundary edges a→b} det[x_c, x_a, x_b].
-fn enclosed_volume(lar: &Lar, by_cell: &CsMat<i8>, flags: &[i8], component: &[usize]) -> f64 {
-    let vertices = lar.vertices();
-    let mut volume = 0.0;
-    for &c in component {
-        let centre =
-            frame::frame(vertices, lar.cell_vertices(2, c), 0).map_or([0.0; 3], |f| f.centre);
-        let Some(col) = by_cell.outer_view(c) else {
-            continue;
-        };
-        for (edge, &s) in col.iter() {
-            let ends = lar.cell_vertices(1, edge);
-            let (a, b) = (
-                frame::point(vertices, ends[0]),
-                frame::point(vertices, ends[1]),
-            );
-            let m = [centre, a, b];
-            volume += f64::from(flags[c] * s) * frame::det(3, &m) / 6.0;
-        }
-    }
-    volume
 }
 
 /// ∂_{p−1} ∂_p = 0, column by column. The signs of a simplex's facets are

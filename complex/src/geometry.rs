@@ -398,7 +398,7 @@ impl<'a> Mesh<'a> {
     /// Fan of triangles (apex, v₀, v₁) over the edges of a 2-cell, apex the
     /// vertex average (every vertex of the cycle ends two edges).
     fn polygon(&self, f: usize) -> (f64, Vector3<f64>) {
-        let (edges, _) = column(self.complex.boundary_csc(2), f);
+        let (edges, signs) = column(self.complex.boundary_csc(2), f);
         let Some(&first) = edges.first() else {
             return (0.0, Vector3::zeros());
         };
@@ -416,16 +416,63 @@ impl<'a> Mesh<'a> {
         let apex = origin + sum * (0.5 / edges.len() as f64);
         let mut area = 0.0;
         let mut moment = Vector3::zeros();
+        // The fan's triangles with the cell's signs: their sum is twice
+        // the vector area; kept for the convexity check below.
+        let mut turned = [Vector3::zeros(); SMALL_POLYGON];
+        let mut oriented = Vector3::zeros();
         for (k, &e) in edges.iter().enumerate() {
             let (a, b) = if small { ends[k] } else { self.ends(e) };
             let a = a - apex;
             let b = b - apex;
-            let t = 0.5 * a.cross(&b).norm();
+            let c = a.cross(&b);
+            let t = 0.5 * c.norm();
+            if small {
+                turned[k] = c * f64::from(signs[k]);
+            }
+            oriented += c * f64::from(signs[k]);
             area += t;
             // Triangle centroid relative to the apex: (a + b) / 3.
             moment += (a + b) * (t / 3.0);
         }
+        // A triangle of the fan turned against the cell: the apex is
+        // outside the kernel of a non-convex polygon (never a triangle).
+        if edges.len() > 3 {
+            let normal = unit(&oriented);
+            let against = |c: &Vector3<f64>| c.dot(&normal) < -1e-12 * c.norm();
+            let reflex = if small {
+                turned[..edges.len()].iter().any(against)
+            } else {
+                edges.iter().zip(signs).any(|(&e, &r)| {
+                    let (a, b) = self.ends(e);
+                    against(&((a - apex).cross(&(b - apex)) * f64::from(r)))
+                })
+            };
+            if reflex {
+                return self.signed_polygon(f, &apex, &normal);
+            }
+        }
         (area, centred(&apex, &moment, area))
+    }
+
+    /// The fan of [`Self::polygon`] with signed triangles (by the cell's
+    /// orientation), exact for any simple polygon, convex or not.
+    fn signed_polygon(
+        &self,
+        f: usize,
+        apex: &Vector3<f64>,
+        normal: &Vector3<f64>,
+    ) -> (f64, Vector3<f64>) {
+        let (edges, signs) = column(self.complex.boundary_csc(2), f);
+        let mut area = 0.0;
+        let mut moment = Vector3::zeros();
+        for (&e, &r) in edges.iter().zip(signs) {
+            let (a, b) = self.ends(e);
+            let (a, b) = (a - apex, b - apex);
+            let t = 0.5 * f64::from(r) * a.cross(&b).dot(normal);
+            area += t;
+            moment += (a + b) * (t / 3.0);
+        }
+        (area, centred(apex, &moment, area))
     }
 
     /// Signed tetrahedra (o, a_f, v₀, v₁) over the oriented fan of every

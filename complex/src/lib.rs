@@ -15,6 +15,7 @@
 
 pub mod cells;
 pub mod complex;
+mod convex_order;
 pub mod dual;
 pub mod error;
 pub mod euler;
@@ -26,7 +27,11 @@ pub mod gmsh;
 pub mod homology;
 pub mod json;
 pub mod lar;
+pub mod lar_json;
+mod nonconvex;
+pub mod product;
 pub mod refine;
+pub mod relations;
 pub mod split;
 pub mod tags;
 

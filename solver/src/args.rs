@@ -110,11 +110,12 @@ pub(crate) enum Command {
     /// Betti numbers, boundary regions (tags) and cell quality.
     ///
     /// MESH may be a case file (.toml, its `[mesh]` table is used), a Gmsh
-    /// file (.msh, version 4) or a hasse complex file (.json).
+    /// file (.msh, version 4), a LAR file (.lar.json: the LAR paper's `V`,
+    /// `EV`, `FV`, `CV`) or a hasse complex file (.json).
     ///
     /// Example: hasse info cases/torus.toml
     Info {
-        /// Case file, Gmsh .msh v4 file or hasse .json complex.
+        /// Case file, Gmsh .msh v4 file, LAR .lar.json or hasse .json complex.
         mesh: PathBuf,
         /// Compute Betti numbers even for large meshes.
         #[arg(long)]
@@ -123,6 +124,32 @@ pub(crate) enum Command {
         /// and the peak memory of the process.
         #[arg(long)]
         timing: bool,
+    },
+    /// Write a mesh in another format: the LAR paper's representation
+    /// (--lar, a JSON object with the vertices `V` and the cells `EV`,
+    /// `FV`, `CV` as vertex lists; tags are not part of it) or hasse's
+    /// exact JSON complex (--json, with tags and orientations).
+    ///
+    /// MESH is read as by `info`: a case file (.toml, its `[mesh]` table),
+    /// a Gmsh file (.msh), a LAR file (.lar.json) or a hasse complex
+    /// (.json). Each file is written under a temporary name and renamed
+    /// into place. Exit code 0 on success, 1 when a file cannot be
+    /// written, 2 for bad input.
+    ///
+    /// Examples:
+    ///   hasse export cases/l-shape.toml --lar l-shape.lar.json
+    ///   hasse export cases/lar-fig2a.lar.json --json fig2a.json
+    #[command(verbatim_doc_comment)]
+    #[command(group(clap::ArgGroup::new("format").required(true).multiple(true).args(["lar", "json"])))]
+    Export {
+        /// Case file, Gmsh .msh v4 file, LAR .lar.json or hasse .json complex.
+        mesh: PathBuf,
+        /// Write the LAR representation here (the name must end in .lar.json).
+        #[arg(long, value_name = "OUT.lar.json")]
+        lar: Option<PathBuf>,
+        /// Write the hasse JSON complex here.
+        #[arg(long, value_name = "OUT.json")]
+        json: Option<PathBuf>,
     },
     /// Convergence study: solve CASE on N successively refined meshes (or
     /// time steps) and report the errors against its exact solution and

@@ -29,10 +29,9 @@ fn load_timed(path: &Path, timing: bool) -> Result<hasse_complex::Complex, mesh_
 }
 
 fn load(path: &Path) -> Result<hasse_complex::Complex, mesh_spec::MeshError> {
-    let mut complex = match path.extension().and_then(|e| e.to_str()) {
-        Some("msh") => hasse_complex::gmsh::read_msh(path)?,
-        Some("json") => hasse_complex::json::read_json(path)?,
-        _ => return mesh_spec::read_case_mesh(path)?.build(path),
+    let mut complex = match mesh_spec::read_mesh_file(path) {
+        Some(read) => read?,
+        None => return mesh_spec::read_case_mesh(path)?.build(path),
     };
     // As a case file's mesh would have it.
     mesh_spec::tag_boundary(&mut complex);
@@ -101,6 +100,7 @@ fn main() -> ExitCode {
             &set,
             quiet,
         ),
+        Command::Export { mesh, lar, json } => export(&mesh, lar.as_deref(), json.as_deref()),
         Command::Info {
             mesh,
             betti,
@@ -125,6 +125,41 @@ fn main() -> ExitCode {
             }
         },
     }
+}
+
+/// `hasse export`: the mesh of MESH written as LAR and/or hasse JSON.
+fn export(mesh: &Path, lar: Option<&Path>, json: Option<&Path>) -> ExitCode {
+    if let Some(out) = lar.filter(|out| !hasse_complex::lar_json::is_lar_path(out)) {
+        eprintln!(
+            "error: --lar {}: the name must end in .lar.json, which is how hasse recognises a LAR file when it reads one",
+            out.display()
+        );
+        return ExitCode::from(EXIT_BAD_INPUT);
+    }
+    let complex = match load(mesh) {
+        Ok(complex) => complex,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let files = [
+        (lar, hasse_complex::lar_json::to_lar_json(&complex), "LAR"),
+        (json, hasse_complex::json::to_json(&complex), "hasse JSON"),
+    ];
+    for (out, text, kind) in files {
+        let Some(out) = out else { continue };
+        if let Err(e) = output::write_text_file(out, &text) {
+            eprintln!("error: writing {}: {e}", out.display());
+            return ExitCode::from(EXIT_SOLVE_FAILED);
+        }
+        println!(
+            "wrote      {} ({kind}, cells per dimension {:?})",
+            out.display(),
+            complex.cell_counts()
+        );
+    }
+    ExitCode::SUCCESS
 }
 
 fn read_case(path: &Path, set: &[String]) -> Result<Case, ExitCode> {

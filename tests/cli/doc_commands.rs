@@ -107,7 +107,7 @@ fn command_in(line: &str) -> Option<String> {
     let at = line.find("hasse ")?;
     let command = line[at..].trim();
     let sub = command.split_whitespace().nth(1)?;
-    ["run", "check", "refine", "info", "converge"]
+    ["run", "check", "refine", "info", "converge", "export"]
         .contains(&sub)
         .then(|| command.to_string())
 }
@@ -154,7 +154,7 @@ fn documented() -> Vec<(String, String)> {
         }
     }
     let bin = env!("CARGO_BIN_EXE_hasse");
-    for sub in ["", "run", "refine", "check", "info", "converge"] {
+    for sub in ["", "run", "refine", "check", "info", "converge", "export"] {
         let mut args: Vec<&str> = Vec::new();
         if !sub.is_empty() {
             args.push(sub);

@@ -30,6 +30,7 @@ mod distributed;
 mod doc_commands;
 mod fuzz_regressions;
 mod interrupted_output;
+mod lar_files;
 mod method_warnings;
 mod nonlinear;
 mod probes;

@@ -11,4 +11,6 @@
 mod generators;
 mod geometry;
 mod io;
+mod lar_format;
+mod seeds;
 mod split;

@@ -1,5 +1,6 @@
 //! The `[mesh]` table of a case file: a generator with its parameters, or
-//! a mesh file (Gmsh .msh v4 or hasse JSON) relative to the case file.
+//! a mesh file (Gmsh .msh v4, hasse JSON or a LAR file `.lar.json`)
+//! relative to the case file.
 //!
 //! ```toml
 //! [mesh]
@@ -38,13 +39,19 @@
 //! [mesh]
 //! file = "l-shape.msh"
 //! ```
+//! or a complex in the LAR paper's representation (`V`, `EV`, `FV`, `CV`;
+//! see `hasse_complex::lar_json`):
+//! ```toml
+//! [mesh]
+//! file = "lar-fig2a.lar.json"
+//! ```
 //!
 //! Every mesh with a boundary, generated or read (also a Gmsh file without
 //! physical groups), has a `boundary` tag on the (n−1)-cells of its
 //! boundary; a physical group named `boundary` takes precedence. Closed
 //! surfaces (torus, sphere) have none.
 
-use hasse_complex::{generate, gmsh, json, Complex};
+use hasse_complex::{generate, gmsh, json, lar_json, Complex};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -92,6 +99,22 @@ pub enum MeshError {
     /// A hasse JSON complex could not be read.
     #[error(transparent)]
     Json(#[from] json::JsonError),
+    /// A LAR file (`.lar.json`) could not be read.
+    #[error(transparent)]
+    Lar(#[from] lar_json::LarFileError),
+}
+
+/// Read a mesh file by its name: `.msh` (Gmsh v4), `.lar.json` (LAR) or
+/// `.json` (hasse complex); `None` for any other name.
+pub fn read_mesh_file(path: &Path) -> Option<Result<Complex, MeshError>> {
+    if lar_json::is_lar_path(path) {
+        return Some(lar_json::read_lar_json(path).map_err(MeshError::from));
+    }
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("msh") => Some(gmsh::read_msh(path).map_err(MeshError::from)),
+        Some("json") => Some(json::read_json(path).map_err(MeshError::from)),
+        _ => None,
+    }
 }
 
 /// The `[mesh]` table (its keys are explained in the module
@@ -269,14 +292,13 @@ impl MeshSpec {
             (None, Some(file)) => {
                 let base = case_path.parent().unwrap_or(Path::new("."));
                 let full = base.join(file);
-                let read = match full.extension().and_then(|e| e.to_str()) {
-                    Some("msh") => gmsh::read_msh(&full).map_err(|e| key("file", e.to_string()))?,
-                    Some("json") => json::read_json(&full).map_err(|e| key("file", e.to_string()))?,
-                    _ => {
+                let read = match read_mesh_file(&full) {
+                    Some(read) => read.map_err(|e| key("file", e.to_string()))?,
+                    None => {
                         return Err(key(
                             "file",
                             format!(
-                                "{}: unknown mesh format; use a Gmsh .msh (v4) or a hasse .json file",
+                                "{}: unknown mesh format; use a Gmsh .msh (v4), a LAR .lar.json or a hasse .json file",
                                 full.display()
                             ),
                         ))

@@ -84,6 +84,7 @@ pub fn hodge_metric<'a>(
             });
         }
     }
+    super::require_convex(complex, "DEC with the barycentric dual")?;
     let centres = Centres::new(complex, kind)?;
     let lengths = complex.measure(1);
     let locals = (0..cells)

@@ -14,6 +14,13 @@
 //! per cell or one scalar λ per cell (K = λ·I, stored as 8 bytes a cell
 //! instead of 72).
 //!
+//! Non-convex cells (simple polygons, e.g. read from a LAR file): FE takes
+//! any, through the virtual element, which is exact on linear fields on
+//! any simple polygon (and stable on star-shaped ones). FV (two-point and
+//! mimetic) and barycentric DEC place unknowns or half-resistances at cell
+//! centroids: they take non-convex cells that are star-shaped about their
+//! centroid and refuse the first other one by id ([`require_convex`]).
+//!
 //! [`BlockMetric`]: crate::operator::BlockMetric
 
 #![warn(missing_docs)]
@@ -29,7 +36,45 @@ mod method;
 pub use coefficient::{check_tensors, isotropic, CellTensors, Tensor};
 pub use method::{Location, Method, UnknownMethod};
 
-use hasse_complex::ComplexError;
+use hasse_complex::{Complex, ComplexError};
+
+/// Refuse a mesh with a top cell that is not star-shaped about its
+/// centroid (a non-convex polygon whose centroid lies outside some edge's
+/// half-plane) for a method that places unknowns or half-resistances at
+/// centroids, naming the first such cell. Convex cells, and non-convex
+/// ones seen whole from their centroid (mildly distorted quads), pass.
+pub(crate) fn require_convex(complex: &Complex, method: &'static str) -> Result<(), MetricError> {
+    if complex.dim() != 2 || complex.embedding_dim() != 2 {
+        return Ok(());
+    }
+    let by_cell = complex.boundary_csc(2);
+    let centroids = complex.centroid(2);
+    let lar = complex.lar();
+    let outside = |cell: usize| {
+        let c = &centroids[2 * cell..2 * cell + 2];
+        let Some(column) = by_cell.outer_view(cell) else {
+            return false;
+        };
+        let scale = complex.measure(2)[cell];
+        column.iter().any(|(e, &r)| {
+            let ends = lar.cell_vertices(1, e);
+            let (mut a, mut b) = (lar.vertices().point(ends[0]), lar.vertices().point(ends[1]));
+            if r < 0 {
+                (a, b) = (b, a);
+            }
+            // The centroid must be left of every edge of the ccw boundary.
+            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) <= 1e-12 * scale
+        })
+    };
+    match complex.non_convex_cells().into_iter().find(|&cell| outside(cell)) {
+        Some(cell) => Err(MetricError::UnsupportedCell {
+            method,
+            needs: "cells star-shaped about their centroid (fe takes any simple polygon, by its virtual elements)",
+            cell,
+        }),
+        None => Ok(()),
+    }
+}
 
 /// Why a metric could not be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -99,6 +99,13 @@ pub(crate) use levels::{Level, Levels, MeshAt};
 
 use hasse_complex::Complex;
 
+/// Write a text file under a temporary name in its directory and rename
+/// it into place: `path` holds the old file or the complete new one, never
+/// a part (used by `hasse export`).
+pub fn write_text_file(path: &Path, text: &str) -> Result<(), OutputError> {
+    atomic::write_atomically(path, |temporary| atomic::write_text(temporary, text))
+}
+
 use std::collections::HashSet;
 
 use std::path::{Path, PathBuf};

@@ -15,14 +15,22 @@ pub(super) fn polygon_moments(
     let vertices = top.complex.cell_vertices(2, c);
     let mut moments = vec![Vector3::zeros(); x.len()];
     let mut area = 0.0;
-    for e in top.edges_of(c) {
+    // Outward normals from the cell's oriented boundary (∂₂'s signs and
+    // the sense of the walk), not from the vertex average, which lies
+    // behind some edges of a non-convex polygon.
+    let (edges, signs) = top.facets_of(2, c);
+    let mut walk = 0.0;
+    for (&e, &r) in edges.iter().zip(signs) {
+        let (a, b) = top.local_ends(e, vertices, c)?;
+        let (p, q) = (x[a] - centre, x[b] - centre);
+        walk += f64::from(r) * (p[0] * q[1] - p[1] * q[0]);
+    }
+    let sense = if walk < 0.0 { -1.0 } else { 1.0 };
+    for (&e, &r) in edges.iter().zip(signs) {
         let (a, b) = top.local_ends(e, vertices, c)?;
         let t = x[b] - x[a];
         let mid = Vector3::new(0.5 * (x[a][0] + x[b][0]), 0.5 * (x[a][1] + x[b][1]), 0.0);
-        let mut normal = Vector3::new(t[1], -t[0], 0.0);
-        if normal.dot(&(mid - centre)) < 0.0 {
-            normal = -normal;
-        }
+        let normal = Vector3::new(t[1], -t[0], 0.0) * (f64::from(r) * sense);
         for i in [a, b] {
             moments[i] += normal * 0.5;
         }

@@ -268,6 +268,7 @@ pub fn mimetic_hybrid<'a>(
     let tensors = tensors.into();
     const METHOD: &str = "mimetic finite differences";
     let n = check_volume(complex, METHOD)?;
+    crate::metric::require_convex(complex, METHOD)?;
     let cells = complex.cell_count(n);
     let tensors = tensors.checked(cells, complex.embedding_dim())?;
     let faces = complex.try_boundary(n)?.rows();

@@ -172,6 +172,7 @@ pub fn two_point<'a>(
     let tensors = tensors.into();
     const METHOD: &str = "two-point flux (TPFA)";
     let n = check_dimension(complex, METHOD)?;
+    super::require_convex(complex, METHOD)?;
     let tensors = tensors.checked(complex.cell_count(n), complex.embedding_dim())?;
     let boundary = complex.try_boundary(n)?;
     let faces = boundary.rows();
@@ -264,6 +265,7 @@ pub fn two_point_at<'a>(
     let tensors = tensors.into();
     const METHOD: &str = "two-point flux (TPFA) at given cell points";
     let n = check_dimension(complex, METHOD)?;
+    super::require_convex(complex, METHOD)?;
     let d = complex.embedding_dim();
     let cells = complex.cell_count(n);
     let tensors = tensors.checked(cells, d)?;
@@ -377,6 +379,7 @@ pub fn non_orthogonality(
 ) -> Result<Option<FaceAngle>, MetricError> {
     const METHOD: &str = "two-point flux (TPFA)";
     let n = check_dimension(complex, METHOD)?;
+    super::require_convex(complex, METHOD)?;
     let d = complex.embedding_dim();
     let cells = complex.cell_count(n);
     let given = points.is_some();
