@@ -590,7 +590,12 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<frame::Pack
                 .ok_or_else(|| degenerate(p, j, cell))?;
             let sign = facet_frame
                 .as_ref()
-                .and_then(|f| frame::induced_sign(&cell_frame, f, cell_frame.diameter))
+                .and_then(|f| {
+                    // On a flat torus the facet is seen from the cell's image.
+                    let mut f = *f;
+                    f.centre = vertices.nearest(&f.centre, &cell_frame.centre);
+                    frame::induced_sign(&cell_frame, &f, cell_frame.diameter)
+                })
                 .ok_or_else(|| {
                     ComplexError::Invalid(format!(
                         "{}-cell {i} (vertices {facet:?}) does not bound {p}-cell {j} (vertices {cell:?}) from outside: the cell is not convex or is degenerate",
