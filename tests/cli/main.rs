@@ -27,6 +27,7 @@ mod cli_physics;
 mod darcy_reports;
 mod doc_commands;
 mod fuzz_regressions;
+mod hodge;
 mod interrupted_output;
 mod method_warnings;
 mod probes;

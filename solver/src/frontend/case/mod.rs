@@ -345,6 +345,7 @@ impl Case {
         self.check_regional_data(&complex, &mut collector);
         self.check_quantities(&complex, &mut collector);
         self.check_probes(&complex, &mut collector);
+        self.check_hodge(&complex, &mut collector);
         {
             let n = complex.dim();
             let available: Vec<String> = complex
@@ -435,6 +436,7 @@ impl Case {
             Problem::Gradient(_)
             | Problem::Darcy(_)
             | Problem::Maxwell(_)
+            | Problem::Hodge(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => None,
         }
