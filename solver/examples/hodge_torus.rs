@@ -43,13 +43,13 @@ fn report(name: &str, complex: &Complex, star: Star) -> Result<(), Box<dyn Error
         if star.is_diagonal() {
             let delta = forms.codifferential(1)?;
             let mut div = vec![0.0; delta.nrows()];
-            for e in 0..delta.ncols() {
+            for (e, &he) in h.iter().enumerate() {
                 let range = delta.col_range(e);
                 for (&v, &x) in delta.row_idx()[range.clone()]
                     .iter()
                     .zip(&delta.val()[range])
                 {
-                    div[v] += x * h[e];
+                    div[v] += x * he;
                 }
             }
             let worst = div.iter().fold(0.0f64, |m, x| m.max(x.abs()));
