@@ -89,3 +89,24 @@ fn check_refuses_a_degree_out_of_range() -> Result {
     assert!(stderr.contains("did you mean \"essential\"?"), "{stderr}");
     Ok(())
 }
+
+/// Other kinds are refused on the flat torus, whose wrapped cells only
+/// the forms layer measures unwrapped, at the generator's line.
+#[test]
+fn other_kinds_are_refused_on_the_flat_torus() -> Result {
+    let dir = std::env::temp_dir().join(format!("hasse-cli-hodge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir)?;
+    let file = dir.join("flat-diffusion.toml");
+    let text = "[mesh]\ngenerator = \"torus-flat\"\nn = [4, 4]\n[problem]\nmethod = \"fe\"\nsource = \"0\"\n";
+    std::fs::write(&file, text)?;
+    let shown = file.to_string_lossy().into_owned();
+    let out = hasse(&["check", &shown]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!("{shown}:2:13: `mesh.generator`: a periodic mesh")),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir)?;
+    Ok(())
+}

@@ -13,6 +13,21 @@ impl Case {
     /// the circumcentric and Whitney stars need simplices.
     pub(super) fn check_hodge(&self, complex: &Complex, collector: &mut Collector) {
         let super::Problem::Hodge(spec) = &self.problem else {
+            // Only the stars and Whitney forms read a cell's geometry from
+            // its unwrapped points; every other kind's metrics, loads and
+            // error norms read vertex coordinates directly, and would see
+            // the cells that wrap around stretched across the domain.
+            if complex.vertices().period().is_some() {
+                collector.error(
+                    self.mesh_spans.get("generator").cloned(),
+                    "mesh.generator",
+                    format!(
+                        "a periodic mesh (the flat torus) is measured unwrapped only by the Hodge Laplacian's stars; kind = \"{}\" would read the wrapped cells' coordinates directly",
+                        self.problem.kind()
+                    ),
+                    Some("use kind = \"hodge-laplacian\" on generator = \"torus-flat\"".into()),
+                );
+            }
             return;
         };
         let n = complex.dim();
