@@ -26,6 +26,7 @@ pub mod gmsh;
 pub mod homology;
 pub mod json;
 pub mod lar;
+mod period;
 pub mod refine;
 pub mod split;
 pub mod tags;

@@ -34,12 +34,14 @@
 
 pub mod diagnostic;
 pub mod expr;
+mod hodge_spec;
 mod mesh_checks;
 mod problem;
 mod quantity;
 mod reader;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
+pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
 pub use quantity::{ProbeSpec, QuantityKind, QuantitySpec};
 
