@@ -27,6 +27,10 @@ use sprs::CsMat;
 pub struct Vertices {
     dim: usize,
     coords: Vec<f64>,
+    /// Periods of a flat torus, per axis (0: not periodic); `None` for
+    /// the ordinary, non-periodic embedding. See [`Vertices::with_period`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) period: Option<[f64; 3]>,
 }
 
 impl Vertices {
@@ -52,7 +56,11 @@ impl Vertices {
                 value: coords[i],
             });
         }
-        Ok(Self { dim, coords })
+        Ok(Self {
+            dim,
+            coords,
+            period: None,
+        })
     }
 
     /// Points from fixed-size arrays.

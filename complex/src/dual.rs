@@ -193,7 +193,11 @@ impl FlagWalker<'_> {
         let n = self.complex.dim();
         chain[k - self.p] = self.centre(k, cell);
         if k == n {
-            return sign * simplex_volume(&chain[..=n - self.p]);
+            // On a flat torus the centres of a flag are seen from the
+            // first one's image (they all lie in or near one top cell).
+            let points = &mut chain[..=n - self.p];
+            crate::frame::unwrap_cell(self.complex.vertices(), points);
+            return sign * simplex_volume(points);
         }
         let (cofaces, _) = row(self.complex.boundary(k + 1), cell);
         let mut total = 0.0;
@@ -220,25 +224,22 @@ impl FlagWalker<'_> {
         let Some(&opposite) = upper.iter().find(|v| lower.binary_search(v).is_err()) else {
             return 1.0;
         };
-        let origin = Vector3::from(complex.point3(lower[0]));
+        let vertices = complex.vertices();
+        let first = complex.point3(lower[0]);
+        let origin = Vector3::from(first);
+        let at = |x: Point| Vector3::from(vertices.nearest(&x, &first));
         let mut basis = [Vector3::zeros(); 2];
         let mut found = 0;
         for &v in &lower[1..] {
-            let w = reject(Vector3::from(complex.point3(v)) - origin, &basis[..found]);
+            let w = reject(at(complex.point3(v)) - origin, &basis[..found]);
             let len = w.norm();
             if len > 0.0 && found < 2 {
                 basis[found] = Vector3::new(w[0] / len, w[1] / len, w[2] / len);
                 found += 1;
             }
         }
-        let inward = reject(
-            Vector3::from(complex.point3(opposite)) - origin,
-            &basis[..found],
-        );
-        let centre = reject(
-            Vector3::from(self.centre(k + 1, tau)) - origin,
-            &basis[..found],
-        );
+        let inward = reject(at(complex.point3(opposite)) - origin, &basis[..found]);
+        let centre = reject(at(self.centre(k + 1, tau)) - origin, &basis[..found]);
         // The centre is on σ when its distance from σ's span is at rounding level.
         if centre.norm() <= 1e-12 * inward.norm() {
             return 0.0;

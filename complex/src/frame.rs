@@ -27,6 +27,19 @@ pub(crate) fn point(vertices: &Vertices, i: usize) -> Point {
     x
 }
 
+/// On a flat torus, move every point of a cell to its image nearest the
+/// first one, so that the cell is measured with unwrapped coordinates.
+pub(crate) fn unwrap_cell(vertices: &Vertices, points: &mut [Point]) {
+    if vertices.period().is_none() {
+        return;
+    }
+    if let Some((first, rest)) = points.split_first_mut() {
+        for x in rest {
+            *x = vertices.nearest(x, first);
+        }
+    }
+}
+
 /// An orthonormal basis of the span of a p-cell, oriented like the cell,
 /// and the average of its vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,9 +128,12 @@ pub(crate) fn frame(vertices: &Vertices, cell: &[usize], p: usize) -> Option<Fra
         for (slot, &v) in stack.iter_mut().zip(cell) {
             *slot = point(vertices, v);
         }
+        unwrap_cell(vertices, &mut stack[..cell.len()]);
         &stack[..cell.len()]
     } else {
-        heap = cell.iter().map(|&v| point(vertices, v)).collect();
+        let mut points: Vec<Point> = cell.iter().map(|&v| point(vertices, v)).collect();
+        unwrap_cell(vertices, &mut points);
+        heap = points;
         &heap
     };
     let origin = Vector3::from(points[0]);

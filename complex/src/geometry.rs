@@ -230,9 +230,10 @@ impl Complex {
                     let cell = self.cell_vertices(n, c);
                     let mut largest: f64 = 0.0;
                     for (k, &a) in cell.iter().enumerate() {
-                        let x = Vector3::from(frame::point(vertices, a));
+                        let x = frame::point(vertices, a);
                         for &b in &cell[k + 1..] {
-                            let r = Vector3::from(frame::point(vertices, b)) - x;
+                            let y = vertices.nearest(&frame::point(vertices, b), &x);
+                            let r = Vector3::from(y) - Vector3::from(x);
                             largest = largest.max(r.norm_squared());
                         }
                     }
@@ -266,6 +267,32 @@ impl Complex {
         CellGeometry { measure, centroid }
     }
 
+    /// The points of p-cell `i`'s vertices (in the order of
+    /// [`Complex::cell_vertices`]), padded to three coordinates; on a flat
+    /// torus each is the image nearest the first vertex, so the cell is
+    /// seen unwrapped. Per-cell metrics (Whitney stars, elements) read
+    /// their geometry here.
+    ///
+    /// ```
+    /// use hasse_complex::generate::torus_flat;
+    /// let k = torus_flat(3, 3, [0.0, 3.0], [0.0, 3.0], false).unwrap();
+    /// // Every square is unit, also those that wrap around.
+    /// assert!(k.measure(2).iter().all(|a| (a - 1.0).abs() < 1e-14));
+    /// for c in 0..k.cell_count(2) {
+    ///     let p = k.cell_points(2, c);
+    ///     assert!(p.iter().all(|x| (x[0] - p[0][0]).abs() <= 1.0 && (x[1] - p[0][1]).abs() <= 1.0));
+    /// }
+    /// ```
+    pub fn cell_points(&self, p: usize, i: usize) -> Vec<[f64; 3]> {
+        let mut points: Vec<Point> = self
+            .cell_vertices(p, i)
+            .iter()
+            .map(|&v| self.point3(v))
+            .collect();
+        frame::unwrap_cell(self.vertices(), &mut points);
+        points
+    }
+
     /// Vertex `i` padded to three coordinates.
     pub(crate) fn point3(&self, i: usize) -> Point {
         frame::point(self.vertices(), i)
@@ -296,7 +323,9 @@ impl Complex {
             let (cells, signs) = row(top, f);
             let mut sum = Vector3::zeros();
             for (&c, &s) in cells.iter().zip(signs) {
-                let away = xf - Vector3::from(padded(&top_centres[c * d..(c + 1) * d]));
+                let centre = padded(&top_centres[c * d..(c + 1) * d]);
+                let centre = self.vertices().nearest(&centre, &xf.into());
+                let away = xf - Vector3::from(centre);
                 let nu = match n {
                     1 => away,
                     2 => away - face_direction * away.dot(&face_direction),
@@ -339,6 +368,8 @@ impl Complex {
 struct Mesh<'a> {
     coords: &'a [f64],
     d: usize,
+    /// The vertices when they are periodic (a flat torus), for unwrapping.
+    periodic: Option<&'a crate::cells::Vertices>,
     /// The vertex pairs of the edges, flat (row i of M₁ is entries 2i, 2i+1).
     edges: Cow<'a, [usize]>,
     complex: &'a Complex,
@@ -353,6 +384,7 @@ impl<'a> Mesh<'a> {
         Self {
             coords: complex.vertices().as_slice(),
             d: complex.embedding_dim(),
+            periodic: complex.vertices().period().map(|_| complex.vertices()),
             edges: edge_pairs(complex.lar()),
             complex,
         }
@@ -381,13 +413,33 @@ impl<'a> Mesh<'a> {
         (measure, centroid.into())
     }
 
-    /// The two end points of edge `e` (tail = lower vertex id, head = higher).
+    /// The two end points of edge `e` (tail = lower vertex id, head = higher);
+    /// on a flat torus the head is the image nearest the tail.
     #[inline(always)]
     fn ends(&self, e: usize) -> (Vector3<f64>, Vector3<f64>) {
-        (
-            self.point(self.edges[2 * e]),
-            self.point(self.edges[2 * e + 1]),
-        )
+        let tail = self.point(self.edges[2 * e]);
+        let head = self.point(self.edges[2 * e + 1]);
+        (tail, self.near(head, &tail))
+    }
+
+    /// The image of `x` nearest `reference` (x itself off a flat torus).
+    #[inline(always)]
+    fn near(&self, x: Vector3<f64>, reference: &Vector3<f64>) -> Vector3<f64> {
+        match self.periodic {
+            Some(vertices) => Vector3::from(vertices.nearest(&x.into(), &(*reference).into())),
+            None => x,
+        }
+    }
+
+    /// Both ends of edge `e` as images near `reference`.
+    #[inline(always)]
+    fn ends_near(&self, e: usize, reference: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+        let (a, b) = self.ends(e);
+        if self.periodic.is_none() {
+            return (a, b);
+        }
+        let a2 = self.near(a, reference);
+        (a2, b + (a2 - a))
     }
 
     fn segment(&self, e: usize) -> (f64, Vector3<f64>) {
@@ -407,7 +459,7 @@ impl<'a> Mesh<'a> {
         let mut ends = [(Vector3::zeros(), Vector3::zeros()); SMALL_POLYGON];
         let mut sum = Vector3::zeros();
         for (k, &e) in edges.iter().enumerate() {
-            let (a, b) = self.ends(e);
+            let (a, b) = self.ends_near(e, &origin);
             if small {
                 ends[k] = (a, b);
             }
@@ -421,7 +473,11 @@ impl<'a> Mesh<'a> {
         let mut turned = [Vector3::zeros(); SMALL_POLYGON];
         let mut oriented = Vector3::zeros();
         for (k, &e) in edges.iter().enumerate() {
-            let (a, b) = if small { ends[k] } else { self.ends(e) };
+            let (a, b) = if small {
+                ends[k]
+            } else {
+                self.ends_near(e, &origin)
+            };
             let a = a - apex;
             let b = b - apex;
             let c = a.cross(&b);
@@ -499,7 +555,7 @@ impl<'a> Mesh<'a> {
             let mut normal = Vector3::zeros();
             let mut tensor = [Vector3::zeros(); 3];
             for (&e, &r) in edges.iter().zip(edge_signs) {
-                let (a, b) = self.ends(e);
+                let (a, b) = self.ends_near(e, &origin);
                 let a = a - origin;
                 let b = b - origin;
                 let ab = a + b;
@@ -536,7 +592,7 @@ impl<'a> Mesh<'a> {
         let origin = self.ends(first).0;
         let mut area = Vector3::zeros();
         for (&e, &r) in edges.iter().zip(signs) {
-            let (a, b) = self.ends(e);
+            let (a, b) = self.ends_near(e, &origin);
             let a = a - origin;
             let b = b - origin;
             area += a.cross(&b) * (0.5 * f64::from(r));
@@ -575,7 +631,10 @@ fn circumcentre_of(complex: &Complex, cell: &[usize]) -> Option<Point> {
     let mut edges = [Vector3::zeros(); 3];
     let p = cell.len() - 1;
     for (k, &v) in cell[1..].iter().enumerate() {
-        edges[k] = Vector3::from(complex.point3(v)) - origin;
+        let x = complex
+            .vertices()
+            .nearest(&complex.point3(v), &origin.into());
+        edges[k] = Vector3::from(x) - origin;
     }
     // Unused rows/columns are padded with the identity and a zero right-hand side.
     let mut gram = Matrix3::<f64>::identity();

@@ -30,6 +30,7 @@ pub mod lar;
 pub mod lar_json;
 mod nonconvex;
 pub mod product;
+mod period;
 pub mod refine;
 pub mod relations;
 pub mod split;

@@ -48,7 +48,8 @@
 //!   coefficients.
 //! - [`physics`]: each problem as canonical operators plus its data:
 //!   diffusion, transient heat, mixed Darcy, Maxwell cavities, linear
-//!   elasticity, coupled fields, normal gradients.
+//!   elasticity, coupled fields, normal gradients, and the k-form layer
+//!   [`physics::forms`] (d, ⋆, δ and the Hodge Laplacian Δ_k).
 //! - [`refine`] (re-solving on SPLIT-refined meshes) and [`study`]
 //!   (convergence orders and their tables).
 //! - [`distributed`]: the partitioned complex (owned top cells and their

@@ -242,6 +242,13 @@ fn describe_problem(case: &Case) -> String {
         ),
         Problem::Darcy(d) => format!("darcy, flux mass {:?}", d.mass),
         Problem::Maxwell(m) => format!("maxwell, {} modes, dual {:?}", m.modes, m.dual),
+        Problem::Hodge(h) => format!(
+            "hodge-laplacian, degree {}, {} modes, {}, {} boundary",
+            h.degree,
+            h.modes,
+            h.method.name(),
+            h.boundary.name()
+        ),
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
         Problem::Coupled(c) => format!(
             "coupled fields {} ({}) and {} ({})",

@@ -328,6 +328,14 @@ const CATALOGUE: &[Bad] = &[
         line: Some(11),
         says: &["⋆1 of 1-cell 2 is 0e0 ≤ 0", "`mass = \"whitney\"`", "`method = \"dec-barycentric\"`"],
     },
+    // A Hodge Laplacian's degree above the mesh's dimension.
+    Bad {
+        set: &[],
+        file: "hodge-degree",
+        exit: 2,
+        line: Some(11),
+        says: &["`problem.degree`: degree 3 is out of range: the mesh is 2-dimensional, so 0 ≤ degree ≤ 2"],
+    },
     // (f) A negative constant permeability.
     Bad {
         set: &[],

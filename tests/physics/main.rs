@@ -16,6 +16,7 @@ mod coupled;
 mod darcy;
 mod diffusion;
 mod elasticity;
+mod forms;
 mod maxwell;
 mod nonlinear;
 mod refinement;

@@ -20,6 +20,7 @@
 //! | [`annulus`] | quads | `inner`, `outer`, `boundary` |
 //! | [`torus`], [`sphere`] | closed quad / triangle surfaces in R^3 | none (no boundary) |
 //! | [`hollow_box`] | hexes | `outer`, `cavity`, `boundary` |
+//! | [`torus_flat`], [`torus_flat_box`] | quads or triangles of a periodic rectangle, cubes or Kuhn tetrahedra of a periodic box (flat metric) | none (no boundary) |
 //!
 //! ```
 //! use hasse_complex::generate;
@@ -33,12 +34,14 @@
 
 mod delaunay;
 mod grid;
+mod periodic;
 mod perturb;
 mod surfaces;
 mod voronoi;
 
 pub use delaunay::{delaunay, delaunay_rectangle};
 pub use grid::{box3, graded_axis, grid, hollow_box, interval, kuhn, rectangle, uniform_axis};
+pub use periodic::{torus_flat, torus_flat_box};
 pub use perturb::perturb;
 pub use surfaces::{annulus, sphere, torus};
 pub use voronoi::{voronoi, voronoi_with_sites};

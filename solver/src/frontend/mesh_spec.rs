@@ -4,7 +4,7 @@
 //!
 //! ```toml
 //! [mesh]
-//! generator = "rectangle"   # interval | rectangle | box | annulus | torus | sphere | hollow-box | voronoi | delaunay
+//! generator = "rectangle"   # interval | rectangle | box | annulus | torus | torus-flat | sphere | hollow-box | voronoi | delaunay
 //! n = [32, 32]              # cells per axis
 //! x = [0.0, 1.0]            # extent per axis (default [0, 1])
 //! y = [0.0, 1.0]
@@ -341,9 +341,10 @@ impl MeshSpec {
             // square: 1 vertex, 3 edges, 2 triangles), 6 tetrahedra per cube
             // (1 + 7 + 12 + 6 = 26 cells).
             ("rectangle", [a, b]) if simplex => (2.0 * a * b, 3.0, 2, "n"),
-            ("rectangle" | "annulus" | "torus", [a, b]) => (a * b, 4.0, 2, "n"),
-            ("box", [a, b, c]) if simplex => (6.0 * a * b * c, 26.0 / 6.0, 3, "n"),
-            ("box", [a, b, c]) => (a * b * c, 8.0, 3, "n"),
+            ("torus-flat", [a, b]) if simplex => (2.0 * a * b, 3.0, 2, "n"),
+            ("rectangle" | "annulus" | "torus" | "torus-flat", [a, b]) => (a * b, 4.0, 2, "n"),
+            ("box" | "torus-flat", [a, b, c]) if simplex => (6.0 * a * b * c, 26.0 / 6.0, 3, "n"),
+            ("box" | "torus-flat", [a, b, c]) => (a * b * c, 8.0, 3, "n"),
             ("voronoi", [a]) => (*a, 6.0, 2, "n"),
             // About 2 triangles per point, 1 + 3 + 2 cells per point.
             ("delaunay", [a]) => (2.0 * a, 3.0, 2, "n"),
@@ -472,6 +473,26 @@ impl MeshSpec {
                 )
                 .map_err(Generated::Complex)
             }
+            "torus-flat" => {
+                // The rectangle x × y with opposite sides identified; the
+                // flat metric comes from each cell's unwrapped points.
+                // n = [nx, ny] or [nx, ny, nz] (the periodic box).
+                let wanted = match self.n.as_deref() {
+                    Some([_, _, _]) => 3,
+                    _ => 2,
+                };
+                let n = self.counts(wanted, key).map_err(Generated::Key)?;
+                let extent = |e: Option<[f64; 2]>| e.unwrap_or([0.0, 1.0]);
+                let built = match *n.as_slice() {
+                    [nx, ny, nz] => generate::torus_flat_box(
+                        [nx, ny, nz],
+                        [extent(self.x), extent(self.y), extent(self.z)],
+                        simplicial,
+                    ),
+                    _ => generate::torus_flat(n[0], n[1], extent(self.x), extent(self.y), simplicial),
+                };
+                built.map_err(|e| Generated::Key(key("n", e.to_string())))
+            }
             "sphere" => generate::sphere(
                 self.radius.unwrap_or(1.0),
                 self.subdivisions.unwrap_or(2),
@@ -516,7 +537,7 @@ impl MeshSpec {
             other => Err(Generated::Key(key(
                 "generator",
                 format!(
-                    "unknown generator \"{other}\"; known: interval, rectangle, box, annulus, torus, sphere, hollow-box, voronoi, delaunay"
+                    "unknown generator \"{other}\"; known: interval, rectangle, box, annulus, torus, torus-flat, sphere, hollow-box, voronoi, delaunay"
                 ),
             ))),
         }

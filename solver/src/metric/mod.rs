@@ -32,6 +32,7 @@ pub mod fe;
 pub mod fv;
 pub mod mass;
 mod method;
+pub mod whitney;
 
 pub use coefficient::{check_tensors, isotropic, CellTensors, Tensor};
 pub use method::{Location, Method, UnknownMethod};

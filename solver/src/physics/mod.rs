@@ -8,6 +8,7 @@ pub mod coupled;
 pub mod darcy;
 pub mod diffusion;
 pub mod elasticity;
+pub mod forms;
 pub mod gradient;
 pub mod heat;
 pub mod maxwell;

@@ -9,6 +9,59 @@ use crate::physics::regions::{top_cell_tags, RegionError, Regional};
 use hasse_complex::Complex;
 
 impl Case {
+    /// A Hodge Laplacian's degree must be at most the mesh's dimension, and
+    /// the circumcentric and Whitney stars need simplices.
+    pub(super) fn check_hodge(&self, complex: &Complex, collector: &mut Collector) {
+        let super::Problem::Hodge(spec) = &self.problem else {
+            // Only the stars and Whitney forms read a cell's geometry from
+            // its unwrapped points; every other kind's metrics, loads and
+            // error norms read vertex coordinates directly, and would see
+            // the cells that wrap around stretched across the domain.
+            if complex.vertices().period().is_some() {
+                collector.error(
+                    self.mesh_spans.get("generator").cloned(),
+                    "mesh.generator",
+                    format!(
+                        "a periodic mesh (the flat torus) is measured unwrapped only by the Hodge Laplacian's stars; kind = \"{}\" would read the wrapped cells' coordinates directly",
+                        self.problem.kind()
+                    ),
+                    Some("use kind = \"hodge-laplacian\" on generator = \"torus-flat\"".into()),
+                );
+            }
+            return;
+        };
+        let n = complex.dim();
+        if spec.degree > n {
+            collector.error(
+                spec.degree_span.clone(),
+                "problem.degree",
+                format!(
+                    "degree {} is out of range: the mesh is {n}-dimensional, so 0 ≤ degree ≤ {n}",
+                    spec.degree
+                ),
+                Some(format!(
+                    "k-forms live on k-cells; choose a degree from 0 to {n}"
+                )),
+            );
+        }
+        if spec.method != super::HodgeMethod::DecBarycentric {
+            if let Some(c) =
+                (0..complex.cell_count(n)).find(|&c| complex.cell_vertices(n, c).len() != n + 1)
+            {
+                collector.error(
+                    spec.method_span.clone(),
+                    "problem.method",
+                    format!(
+                        "method \"{}\" needs a simplicial mesh; top cell {c} has {} vertices",
+                        spec.method.name(),
+                        complex.cell_vertices(n, c).len()
+                    ),
+                    Some("use method = \"dec-barycentric\" on cells that are not simplices".into()),
+                );
+            }
+        }
+    }
+
     /// Tag the top cells whose centroid satisfies each `[regions]`
     /// condition (a nonzero value).
     pub(super) fn apply_regions(&self, complex: &mut Complex, collector: &mut Collector) {

@@ -34,12 +34,14 @@
 
 pub mod diagnostic;
 pub mod expr;
+mod hodge_spec;
 mod mesh_checks;
 mod problem;
 mod quantity;
 mod reader;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
+pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
 pub use quantity::{ProbeSpec, QuantityKind, QuantitySpec};
 
@@ -391,6 +393,7 @@ impl Case {
         self.check_regional_data(&complex, &mut collector);
         self.check_quantities(&complex, &mut collector);
         self.check_probes(&complex, &mut collector);
+        self.check_hodge(&complex, &mut collector);
         {
             let n = complex.dim();
             let available: Vec<String> = complex
@@ -481,6 +484,7 @@ impl Case {
             Problem::Gradient(_)
             | Problem::Darcy(_)
             | Problem::Maxwell(_)
+            | Problem::Hodge(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => None,
         }

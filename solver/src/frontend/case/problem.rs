@@ -3,6 +3,7 @@
 //! the file and before any mesh exists.
 
 use super::expr::Expression;
+use super::HodgeSpec;
 use crate::metric::Method;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -600,6 +601,8 @@ pub enum Problem {
     Darcy(DarcySpec),
     /// `kind = "maxwell"`.
     Maxwell(MaxwellSpec),
+    /// `kind = "hodge-laplacian"`.
+    Hodge(HodgeSpec),
     /// `kind = "elasticity"`.
     Elasticity(ElasticitySpec),
     /// `kind = "coupled"` (boxed: two diffusion specifications).
@@ -615,6 +618,7 @@ impl Problem {
             Problem::Heat(_) => "heat",
             Problem::Darcy(_) => "darcy",
             Problem::Maxwell(_) => "maxwell",
+            Problem::Hodge(_) => "hodge-laplacian",
             Problem::Elasticity(_) => "elasticity",
             Problem::Coupled(_) => "coupled",
         }
@@ -628,6 +632,7 @@ impl Problem {
             Problem::Darcy(d) => &d.boundary,
             Problem::Gradient(_)
             | Problem::Maxwell(_)
+            | Problem::Hodge(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => &[],
         }
@@ -664,6 +669,7 @@ impl Problem {
             Problem::Darcy(d) => Some(&d.permeability),
             Problem::Gradient(_)
             | Problem::Maxwell(_)
+            | Problem::Hodge(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => None,
         }
@@ -687,7 +693,10 @@ impl Problem {
                     )
                 })
                 .collect(),
-            Problem::Gradient(_) | Problem::Maxwell(_) | Problem::Elasticity(_) => Vec::new(),
+            Problem::Gradient(_)
+            | Problem::Maxwell(_)
+            | Problem::Hodge(_)
+            | Problem::Elasticity(_) => Vec::new(),
         }
     }
 
@@ -730,7 +739,7 @@ impl Problem {
                     all.push(("problem.poisson".into(), poisson));
                 }
             },
-            Problem::Gradient(_) | Problem::Darcy(_) | Problem::Maxwell(_) => {}
+            Problem::Gradient(_) | Problem::Darcy(_) | Problem::Maxwell(_) | Problem::Hodge(_) => {}
         }
         all.retain(|(_, e)| e.regions().is_some());
         all

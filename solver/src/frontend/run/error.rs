@@ -38,6 +38,8 @@ pub enum Failure {
     Darcy(DarcyError),
     /// A Maxwell cavity.
     Maxwell(MaxwellError),
+    /// A Hodge Laplacian.
+    Forms(crate::physics::forms::FormsError),
     /// Linear elasticity.
     Elasticity(ElasticityError),
     /// Two coupled fields.
@@ -57,6 +59,7 @@ impl Failure {
             Failure::Heat(e) => e,
             Failure::Darcy(e) => e,
             Failure::Maxwell(e) => e,
+            Failure::Forms(e) => e,
             Failure::Elasticity(e) => e,
             Failure::Coupled(e) => e,
             Failure::Gradient(e) => e,
@@ -77,6 +80,7 @@ macro_rules! failure_from {
 }
 
 failure_from!(
+    crate::physics::forms::FormsError => Forms,
     DiffusionError => Diffusion,
     HeatError => Heat,
     DarcyError => Darcy,

@@ -53,6 +53,7 @@ mod elasticity;
 mod error;
 mod gradient;
 mod heat;
+mod hodge;
 mod maxwell;
 mod petsc;
 mod nonlinear;
@@ -151,6 +152,7 @@ pub fn solve(
         Problem::Heat(spec) => heat::solve(case, spec, complex, phase),
         Problem::Darcy(spec) => darcy::solve(case, spec, complex, phase),
         Problem::Maxwell(spec) => maxwell::solve(case, spec, complex, phase),
+        Problem::Hodge(spec) => hodge::solve(case, spec, complex, phase),
         Problem::Elasticity(spec) => elasticity::solve(case, spec, complex, phase),
         Problem::Coupled(spec) => coupled::solve(case, spec, complex, phase),
     }
@@ -178,7 +180,7 @@ pub fn check_data(case: &Case, complex: &Complex) -> Result<(), RunError> {
         Problem::Gradient(spec) => gradient::check(case, spec, complex),
         Problem::Heat(spec) => heat::check(case, spec, complex),
         Problem::Darcy(spec) => darcy::check(case, spec, complex),
-        Problem::Maxwell(_) => Ok(()),
+        Problem::Maxwell(_) | Problem::Hodge(_) => Ok(()),
         Problem::Elasticity(spec) => elasticity::check(case, spec, complex),
         Problem::Coupled(spec) => coupled::check(case, spec, complex),
     }

@@ -21,6 +21,7 @@ use toml_edit::{ImDocument, Item, TableLike, Value};
 
 mod coupled;
 mod elasticity;
+mod hodge;
 mod kinds;
 mod overrides;
 mod problem;
@@ -63,6 +64,8 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "permeability",
     "mass",
     "modes",
+    "degree",
+    "boundary",
     "lambda",
     "mu",
     "young",
@@ -91,6 +94,10 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
     ("heat", &["method", "conductivity", "source", "initial"]),
     ("darcy", &["method", "permeability", "source"]),
     ("maxwell", &["method", "mass", "modes"]),
+    (
+        "hodge-laplacian",
+        &["method", "degree", "modes", "boundary"],
+    ),
     (
         "elasticity",
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],

@@ -179,6 +179,7 @@ impl Reader {
             "heat" => self.heat(root, table, problem_entry.span(), scope),
             "darcy" => self.darcy(root, table, problem_entry.span(), scope),
             "maxwell" => self.maxwell(root, table, problem_entry.span()),
+            "hodge-laplacian" => self.hodge(root, table, problem_entry.span()),
             "elasticity" => self.elasticity(root, table, problem_entry.span(), scope),
             "coupled" => self.coupled(root, table, problem_entry.span(), scope),
             "gradient" => {

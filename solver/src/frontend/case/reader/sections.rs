@@ -12,7 +12,7 @@ impl Reader {
         }
         let (table, entry) = self.subtable(root, "", "exact")?;
         self.check_keys(table, "exact", EXACT_KEYS);
-        let eigenproblem = problem_kind(root) == "maxwell";
+        let eigenproblem = matches!(problem_kind(root), "maxwell" | "hodge-laplacian");
         let elastic = problem_kind(root) == "elasticity";
         let solution = match self.entry(table, "exact", "solution") {
             Some(e) if elastic => {
@@ -85,7 +85,7 @@ impl Reader {
                 self.error(
                     e.key_span.clone(),
                     "exact.eigenvalues",
-                    "only an eigenproblem (kind = \"maxwell\") has eigenvalues",
+                    "only an eigenproblem (kind = \"maxwell\" or \"hodge-laplacian\") has eigenvalues",
                     None,
                 );
                 Vec::new()
