@@ -589,14 +589,12 @@ fn signed_boundary(lar: &Lar, p: usize) -> Result<(CsMat<i8>, Option<frame::Pack
                 .as_ref()
                 .and_then(|frames| frames.get(j))
                 .ok_or_else(|| degenerate(p, j, cell))?;
-            let sign = facet_frame
-                .as_ref()
-                .and_then(|f| {
-                    // On a flat torus the facet is seen from the cell's image.
-                    let mut f = *f;
-                    f.centre = vertices.nearest(&f.centre, &cell_frame.centre);
-                    frame::induced_sign(&cell_frame, &f, cell_frame.diameter)
-                });
+            let sign = facet_frame.as_ref().and_then(|f| {
+                // On a flat torus the facet is seen from the cell's image.
+                let mut f = *f;
+                f.centre = vertices.nearest(&f.centre, &cell_frame.centre);
+                frame::induced_sign(&cell_frame, &f, cell_frame.diameter)
+            });
             // A polygon's undecided sign (0) is settled by its boundary
             // cycle (`nonconvex`); other cells must be convex.
             out.push(match sign {
