@@ -304,6 +304,28 @@ pub(super) fn points_of(points: UnknownPoints<'_>, kept: impl Iterator<Item = us
         .collect()
 }
 
+/// The method's flux Ω A u on the flux rows of A; on cell-centred
+/// boundary faces with the ghost part of Dirichlet/Robin data, Ω(Au − w),
+/// and the data's own flux on Neumann faces.
+fn method_flux(
+    location: Location,
+    canonical: &Canonical,
+    values: &[f64],
+    flux_rows: usize,
+    ghost_values: &[f64],
+    neumann_flux: &[f64],
+) -> Vec<f64> {
+    let flux_all = canonical.flux(values);
+    let mut flux = flux_all[..flux_rows].to_vec();
+    if location == Location::CellCentred {
+        let lifted = canonical.metric().apply(ghost_values);
+        for ((q, l), g) in flux.iter_mut().zip(lifted).zip(neumann_flux) {
+            *q += g - l;
+        }
+    }
+    flux
+}
+
 impl Diffusion {
     /// Assemble and solve on `complex`.
     pub fn solve(&self, complex: &Complex) -> Result<Solution, DiffusionError> {
@@ -369,15 +391,14 @@ impl Diffusion {
                 *u -= mean;
             }
         }
-        let flux_all = canonical.flux(&values);
-        let mut flux = flux_all[..flux_rows].to_vec();
-        // The ghost part of boundary fluxes: Ω(Au − w) on Dirichlet/Robin faces.
-        if location == Location::CellCentred {
-            let lifted = canonical.metric().apply(&ghost_values);
-            for ((q, l), g) in flux.iter_mut().zip(lifted).zip(&neumann_flux) {
-                *q += g - l;
-            }
-        }
+        let flux = method_flux(
+            location,
+            &canonical,
+            &values,
+            flux_rows,
+            &ghost_values,
+            &neumann_flux,
+        );
         Ok(Solution {
             method: self.method,
             location,
@@ -461,14 +482,14 @@ impl Diffusion {
         } else {
             residual.sqrt()
         };
-        let flux_all = canonical.flux(&values);
-        let mut flux = flux_all[..flux_rows].to_vec();
-        if location == Location::CellCentred {
-            let lifted = canonical.metric().apply(&ghost_values);
-            for ((q, l), g) in flux.iter_mut().zip(lifted).zip(&neumann_flux) {
-                *q += g - l;
-            }
-        }
+        let flux = method_flux(
+            location,
+            &canonical,
+            &values,
+            flux_rows,
+            &ghost_values,
+            &neumann_flux,
+        );
         let condition_bound = diagonal_condition_bound(&matrix, &fixed);
         Ok(Solution {
             method: self.method,
