@@ -29,6 +29,7 @@ mod darcy_reports;
 mod distributed;
 mod doc_commands;
 mod fuzz_regressions;
+mod heat_solvers;
 mod hodge;
 mod interrupted_output;
 mod lar_files;

@@ -343,3 +343,140 @@ fn data_on_the_kept_operator_equal_a_full_assembly() {
         }
     }
 }
+
+/// Conjugate gradients preconditioned by multigrid, started from the
+/// previous level, reproduce the amplification factor of the θ-scheme as
+/// the factorisation does: the levels are R^k φ (see the module notes) up
+/// to the CG tolerance. With ‖b − Lx‖ ≤ 10⁻¹⁰‖b‖ and L = M/Δt + θK, whose
+/// condition number is below 1 + θΔtλ_max ≤ 1 + 8Δt/h² = 2.2 here (λ_max
+/// of the five-point and P1 stencils is under 8/h²; Q1's is smaller), the
+/// relative error of a level is at most 2.2·10⁻¹⁰ per step, 10⁻⁸ after ten.
+#[test]
+fn multigrid_stepping_gives_the_amplification_factor_of_each_step() {
+    use hasse_solver::multigrid::{Hierarchy, SolverChoice};
+    let (n, dt, steps) = (16, 1e-3, 10);
+    for case in cases(n) {
+        let grid = case.mesh.cell_count(2) == n * n;
+        let mut choices = vec![("amg", SolverChoice::Multigrid(Hierarchy::Algebraic))];
+        if grid {
+            choices.push((
+                "grid",
+                SolverChoice::Multigrid(Hierarchy::Grid { cells: vec![n, n] }),
+            ));
+        }
+        for (name, choice) in choices {
+            for theta in [1.0, 0.5] {
+                let heat = zero_boundary(Heat::new(case.method, unit(), dt).with_theta(theta))
+                    .with_solver(choice.clone(), 1e-10, &case.mesh);
+                let history = heat.run(&case.mesh, &*sine(), steps, 1).unwrap();
+                let iterations = history
+                    .iterations
+                    .expect("an iterative run counts iterations");
+                assert_eq!(iterations.solves, steps);
+                // Warm-started from the previous level, which is within
+                // O(Δt) of the answer, a handful of V-cycles suffice.
+                assert!(
+                    iterations.max <= 8,
+                    "{} {name} θ = {theta}: {} iterations",
+                    case.name,
+                    iterations.max
+                );
+                let r = (1.0 - (1.0 - theta) * dt * case.lambda) / (1.0 + theta * dt * case.lambda);
+                let phi = &history.fields[0];
+                for (k, field) in history.fields.iter().enumerate() {
+                    let diff: Vec<f64> = field
+                        .iter()
+                        .zip(phi)
+                        .map(|(u, p)| u - r.powi(k as i32) * p)
+                        .collect();
+                    let error = max_abs(&diff) / max_abs(phi);
+                    assert!(
+                        error < 1e-8,
+                        "{} {name} θ = {theta}, step {k}: relative error {error:e}",
+                        case.name
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Adaptive steps on the discrete eigenvector φ: the θ-scheme with steps
+/// h_k multiplies φ by Π R(λh_k) exactly, whatever steps the control
+/// chose, and its true local error per step is |R(λh) − e^{−λh}| relative
+/// to the level before (φ decays). For backward Euler the estimate
+/// ½|u − u_FE| is ½x²/(1+x) with x = λh, never below the true error
+/// 1/(1+x) − e^{−x} (equal to leading order x²/2, smaller beyond), so no
+/// accepted step exceeds the tolerance. For Crank–Nicolson the AB2
+/// difference estimates the true error x³/12 to leading order, with a
+/// relative correction O(x) ≤ 0.1 at the steps a tolerance of 10⁻⁵
+/// allows (x³/12 ≈ 10⁻⁵ gives x ≈ 0.05), so 1.5× the tolerance bounds it.
+#[test]
+fn adaptive_steps_keep_the_true_local_error_within_the_tolerance() {
+    use hasse_solver::physics::heat::Adaptive;
+    let (dt, end) = (1e-4, 0.1);
+    let steps = (end / dt) as usize;
+    for case in cases(12) {
+        for (theta, tolerance, bound) in [(1.0, 1e-3, 1.0), (1.0, 1e-4, 1.0), (0.5, 1e-5, 1.5)] {
+            let heat = zero_boundary(Heat::new(case.method, unit(), dt).with_theta(theta))
+                .with_adaptive(Adaptive { tolerance });
+            let history = heat.run(&case.mesh, &*sine(), steps, 0).unwrap();
+            let report = history.adaptive.expect("an adaptive run reports its steps");
+            let label = format!("{} θ = {theta}, tolerance {tolerance:e}", case.name);
+            assert_eq!(report.step_sizes.len(), history.steps, "{label}");
+            assert!(
+                history.steps < steps / 2,
+                "{label}: {} steps",
+                history.steps
+            );
+            let total: f64 = report.step_sizes.iter().sum();
+            assert_abs_diff_eq!(total, end, epsilon = 1e-12);
+            assert_abs_diff_eq!(*history.times.last().unwrap(), end, epsilon = 1e-12);
+            let amplification =
+                |h: f64| (1.0 - (1.0 - theta) * h * case.lambda) / (1.0 + theta * h * case.lambda);
+            for (k, &h) in report.step_sizes.iter().enumerate() {
+                let local = (amplification(h) - (-case.lambda * h).exp()).abs();
+                assert!(
+                    local <= bound * tolerance * (1.0 + 1e-9),
+                    "{label}: step {k} of {h:e} has local error {local:e}"
+                );
+            }
+            let product: f64 = report
+                .step_sizes
+                .iter()
+                .map(|&h| amplification(h))
+                .product();
+            let phi = &history.fields[0];
+            let last = history.fields.last().unwrap();
+            let diff: Vec<f64> = last.iter().zip(phi).map(|(u, p)| u - product * p).collect();
+            assert!(
+                max_abs(&diff) / max_abs(phi) < 1e-12,
+                "{label}: the levels are not Π R(λh_k) φ"
+            );
+        }
+    }
+}
+
+/// Backward Euler's local error grows like h² and Crank–Nicolson's like
+/// h³, so a tolerance 64× smaller asks for steps 8× (BE) or 4× (CN)
+/// smaller. The control's steps are Δt₀·2ʲ and its estimates scale by
+/// 4 (BE) or 8 (CN) per level to leading order, so 64× shifts the level
+/// by exactly 3 or 2 and the step counts by 8 or 4, up to the few steps
+/// the control takes to grow from Δt₀ and the last, shortened one.
+#[test]
+fn adaptive_step_counts_follow_the_scheme_order() {
+    use hasse_solver::physics::heat::Adaptive;
+    let case = cases(12).remove(0);
+    let count = |theta: f64, tolerance: f64| {
+        zero_boundary(Heat::new(case.method, unit(), 1e-5).with_theta(theta))
+            .with_adaptive(Adaptive { tolerance })
+            .run(&case.mesh, &*sine(), 20_000, 0)
+            .unwrap()
+            .steps as f64
+    };
+    let be = count(1.0, 1e-5) / count(1.0, 6.4e-4);
+    let cn = count(0.5, 1e-6) / count(0.5, 6.4e-5);
+    println!("step-count ratios at a 64× smaller tolerance: BE {be}, CN {cn}");
+    assert!((7.0..9.0).contains(&be), "backward Euler: ratio {be}");
+    assert!((3.5..4.5).contains(&cn), "Crank–Nicolson: ratio {cn}");
+}

@@ -251,6 +251,9 @@ pub struct TimeSpec {
     /// `end`, when the case gives it instead of `steps` (a restarted run
     /// then stops at it).
     pub end: Option<f64>,
+    /// `adaptive = { tolerance }`: adaptive step sizes from `dt` on, with
+    /// this relative local error per step; the run ends at t₀ + steps·dt.
+    pub adaptive: Option<f64>,
 }
 
 /// ∂u/∂t − ∇·(K∇u) = f(x, t) from u(x, t₀) = `initial` (`kind = "heat"`).
@@ -274,7 +277,7 @@ pub struct TimeSpec {
 /// let case = Case::from_text("h.toml", text, &[]).unwrap();
 /// let Problem::Heat(spec) = &case.problem else { panic!() };
 /// // `end` is turned into a whole number of steps.
-/// let time = TimeSpec { dt: 0.25, steps: 4, start: 0.0, theta: 0.5, save_every: 1, end: Some(1.0) };
+/// let time = TimeSpec { dt: 0.25, steps: 4, start: 0.0, theta: 0.5, save_every: 1, end: Some(1.0), adaptive: None };
 /// assert_eq!(spec.time, time);
 /// assert!(spec.source.uses_time() && !spec.initial.uses_time());
 /// ```

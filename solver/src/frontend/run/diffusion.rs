@@ -32,9 +32,13 @@ pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion 
     problem
 }
 
-/// The case's `solver.type`: multigrid-preconditioned CG instead of the
-/// direct factorisation when asked for (or chosen by the automatic rule).
-fn with_solver(case: &Case, problem: Diffusion, complex: &Complex) -> Result<Diffusion, RunError> {
+/// The case's `solver.type` as a [`crate::multigrid::SolverChoice`]:
+/// `None` for a direct solve (or PETSc's), else multigrid-preconditioned
+/// CG on the generator's grid levels or by smoothed aggregation, or the
+/// automatic rule. Diffusion and heat choose alike.
+pub(super) fn solver_choice(
+    case: &Case,
+) -> Result<Option<crate::multigrid::SolverChoice>, RunError> {
     use crate::frontend::case::SolverKind;
     use crate::multigrid::{Hierarchy, SolverChoice};
     // Grid levels exist for the rectangle and box generators: coarser grids
@@ -45,8 +49,8 @@ fn with_solver(case: &Case, problem: Diffusion, complex: &Complex) -> Result<Dif
         }
         _ => None,
     };
-    let choice = match case.solver.kind {
-        SolverKind::Direct | SolverKind::Petsc => return Ok(problem),
+    Ok(Some(match case.solver.kind {
+        SolverKind::Direct | SolverKind::Petsc => return Ok(None),
         SolverKind::Multigrid => match grid {
             Some(h) => SolverChoice::Multigrid(h),
             None => {
@@ -60,10 +64,18 @@ fn with_solver(case: &Case, problem: Diffusion, complex: &Complex) -> Result<Dif
         },
         SolverKind::Amg => SolverChoice::Multigrid(Hierarchy::Algebraic),
         SolverKind::Auto => SolverChoice::Auto(grid),
-    };
-    Ok(problem
-        .with_solver(choice, case.solver.tolerance, complex)
-        .with_cell_prolongation(case.solver.cell_prolongation))
+    }))
+}
+
+/// The case's `solver.type`: multigrid-preconditioned CG instead of the
+/// direct factorisation when asked for (or chosen by the automatic rule).
+fn with_solver(case: &Case, problem: Diffusion, complex: &Complex) -> Result<Diffusion, RunError> {
+    Ok(match solver_choice(case)? {
+        None => problem,
+        Some(choice) => problem
+            .with_solver(choice, case.solver.tolerance, complex)
+            .with_cell_prolongation(case.solver.cell_prolongation),
+    })
 }
 
 pub(super) fn solve_diffusion(

@@ -8,7 +8,8 @@ use crate::frontend::case::{BoundaryKindSpec, Case, HeatSpec};
 use crate::frontend::output::Cochain;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::physics::diffusion::Errors;
-use crate::physics::heat::{Heat, HeatBoundary, HeatError, HeatEvent, History, TimeFn};
+use crate::physics::diffusion::{Iterative, Preconditioning};
+use crate::physics::heat::{Adaptive, Heat, HeatBoundary, HeatError, HeatEvent, History, TimeFn};
 use crate::physics::regions::Regional;
 use hasse_complex::Complex;
 use std::sync::Arc;
@@ -79,6 +80,19 @@ fn run_error(case: &Case, spec: &HeatSpec, e: HeatError) -> RunError {
         HeatError::Unsupported { .. } => RunError::input_at(case, "problem.method", message, None),
         HeatError::Overflow { .. } => RunError::solve(case, message, None),
         HeatError::InitialField { .. } => RunError::input_at(case, "problem.initial.from", message, None),
+        HeatError::AdaptiveTolerance { .. } | HeatError::AdaptiveTheta { .. } => {
+            RunError::input_at(case, "time.adaptive", message, None)
+        }
+        HeatError::StepTooSmall { .. } => RunError::solve(
+            case,
+            message,
+            Some("raise time.adaptive.tolerance, or check that the data are continuous in time".into()),
+        ),
+        HeatError::Cg(_) | HeatError::Multigrid(_) => RunError::solve(
+            case,
+            format!("solving M/Δt + θK iteratively: {message}"),
+            Some("raise solver.tolerance, or use solver.type = \"direct\"".into()),
+        ),
         HeatError::Solve(_) | HeatError::Canonical(_) => RunError::solve(
             case,
             format!("factorising M/Δt + θK: {message}"),
@@ -116,7 +130,24 @@ pub(super) fn solve_streaming<'a>(
         time.steps = state.steps;
     }
     let time = &time;
-    phase("assembling and factorising");
+    if let Some(choice) = super::diffusion::solver_choice(case)? {
+        heat = heat.with_solver(choice, case.solver.tolerance, complex);
+        if let Some(Iterative {
+            preconditioner: Preconditioning::Multigrid { options, .. },
+            ..
+        }) = &mut heat.iterative
+        {
+            options.cell_prolongation = case.solver.cell_prolongation;
+        }
+    }
+    if let Some(tolerance) = time.adaptive {
+        heat = heat.with_adaptive(Adaptive { tolerance });
+    }
+    phase(if heat.iterative.is_some() {
+        "assembling and setting up multigrid"
+    } else {
+        "assembling and factorising"
+    });
     let started = Instant::now();
     let initial = |x: &[f64]| spec.initial.eval(x, time.start);
     let dim = if heat.at(time.start).location() == crate::metric::Location::Nodal {
@@ -184,7 +215,10 @@ pub(super) fn solve_streaming<'a>(
                     }
                     series.push((t, fields));
                 }
-                HeatEvent::Step(step) => {
+                HeatEvent::Step {
+                    number: step,
+                    time: t,
+                } => {
                     if step % report_every == 0 || step == time.steps {
                         let saved = stream
                             .as_deref()
@@ -192,11 +226,14 @@ pub(super) fn solve_streaming<'a>(
                             .filter(|p| !p.is_empty())
                             .map(|p| format!(", completed levels in {}", p.xdmf().display()))
                             .unwrap_or_default();
-                        phase(&format!(
-                            "time step {step}/{} (t = {:.6}){saved}",
-                            time.steps,
-                            time.start + step as f64 * time.dt
-                        ));
+                        // Adaptive runs take as many steps as the control
+                        // decides: only the time tells how far they are.
+                        let of = if time.adaptive.is_some() {
+                            String::new()
+                        } else {
+                            format!("/{}", time.steps)
+                        };
+                        phase(&format!("time step {step}{of} (t = {t:.6}){saved}"));
                     }
                 }
             },
@@ -240,12 +277,42 @@ pub(super) fn solve_streaming<'a>(
     };
     let quantities = super::quantities::heat_quantities(case, &history.times, &level_quantities);
     report.extend(quantities.report);
+    let steps = match &history.adaptive {
+        None => format!("{} steps of dt = {}", history.steps, time.dt),
+        Some(a) => {
+            let (lo, hi) = a
+                .step_sizes
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(lo, hi), &h| {
+                    (lo.min(h), hi.max(h))
+                });
+            format!(
+                "{} adaptive steps of dt = {lo:.3e} to {hi:.3e} ({} rejected, {} step sizes set up; tolerance {:e})",
+                history.steps,
+                a.rejected,
+                a.systems,
+                time.adaptive.unwrap_or_default()
+            )
+        }
+    };
+    let setup = match &history.iterations {
+        None => format!("{}: factorisation", history.solver),
+        Some(_) => format!("{}: setup", history.solver),
+    };
+    let iterations = history
+        .iterations
+        .map(|i| {
+            format!(
+                ", {:.1} CG iterations per step (at most {})",
+                i.mean(),
+                i.max
+            )
+        })
+        .unwrap_or_default();
     let mut notes = vec![(
         "time".to_string(),
         format!(
-            "{} steps of dt = {} from t = {} to {} ({scheme}), {} levels saved\none factorisation {:.3} s, {:.3} ms per step ({:.3} ms in solves)",
-            history.steps,
-            time.dt,
+            "{steps} from t = {} to {} ({scheme}), {} levels saved\n{setup} {:.3} s, {:.3} ms per step ({:.3} ms in solves){iterations}",
             time.start,
             history.times.last().copied().unwrap_or(time.start),
             history.times.len(),
@@ -261,7 +328,14 @@ pub(super) fn solve_streaming<'a>(
         report.insert("probes".into(), probes);
     }
     let mut timings = vec![
-        ("factorisation".to_string(), history.factorization_seconds),
+        (
+            if heat.iterative.is_some() {
+                "multigrid setup".to_string()
+            } else {
+                "factorisation".to_string()
+            },
+            history.factorization_seconds,
+        ),
         (
             "time stepping".to_string(),
             history.seconds_per_step * history.steps as f64,
@@ -283,7 +357,7 @@ pub(super) fn solve_streaming<'a>(
         errors,
         flux_error: None,
         relative_residual: None,
-        factorization: Some(heat.factorization),
+        factorization: heat.iterative.is_none().then_some(heat.factorization),
         ordering: history.ordering,
         timings,
         warnings: super::consistency::diffusion_warnings(
@@ -309,6 +383,17 @@ fn time_json(time: &crate::frontend::case::TimeSpec, history: &History) -> serde
         "factorization_seconds": history.factorization_seconds,
         "seconds_per_step": history.seconds_per_step,
         "solve_seconds_per_step": history.solve_seconds_per_step,
+        "solver": history.solver,
+        "iterations": history.iterations.map(|i| serde_json::json!({
+            "total": i.total, "max": i.max, "mean": i.mean(), "solves": i.solves,
+        })),
+        "adaptive": history.adaptive.as_ref().map(|a| serde_json::json!({
+            "tolerance": time.adaptive,
+            "step_sizes": a.step_sizes,
+            "estimates": a.estimates,
+            "rejected": a.rejected,
+            "step_sizes_set_up": a.systems,
+        })),
     })
 }
 

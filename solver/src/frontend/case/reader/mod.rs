@@ -29,6 +29,7 @@ mod quantities;
 mod sections;
 #[cfg(test)]
 mod tests;
+mod time;
 
 use kinds::{kind_help, problem_kind, Conditions};
 pub(in crate::frontend::case) use overrides::apply_overrides;

@@ -161,12 +161,23 @@ impl Reader {
                     SolverKind::Direct
                 }
             };
-            if spec.kind != SolverKind::Direct && problem_kind(root) != "diffusion" {
+            let kind = problem_kind(root);
+            let serves = match spec.kind {
+                SolverKind::Direct => true,
+                SolverKind::Petsc => kind == "diffusion",
+                _ => matches!(kind, "diffusion" | "heat"),
+            };
+            if !serves {
                 let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                let served = if spec.kind == SolverKind::Petsc {
+                    "PETSc serves steady diffusion problems"
+                } else {
+                    "the iterative solvers serve diffusion and heat problems"
+                };
                 self.error(
                     span,
                     "solver.type",
-                    format!("the iterative solvers serve diffusion problems; this case is kind = \"{}\"", problem_kind(root)),
+                    format!("{served}; this case is kind = \"{kind}\""),
                     Some("remove solver.type (direct)".into()),
                 );
             }

@@ -16,20 +16,24 @@
 //! every step and is factorised once. θ = 1 is backward Euler (first
 //! order, L-stable), θ = ½ Crank–Nicolson (second order, A-stable).
 
-use crate::la::direct::{DirectSolver, Factorization, SolveError};
-use crate::la::fixed::FixedSplit;
+mod stepping;
+mod system;
+#[cfg(test)]
+mod tests;
+
+use crate::la::direct::{Factorization, SolveError};
+use crate::la::iterative::{CgError, CgOptions};
 use crate::la::ordering::Ordering;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::Location;
 use crate::metric::Method;
-use crate::operator::{BlockMetric, Canonical, CanonicalError};
-use crate::physics::diffusion::{Diffusion, DiffusionError};
+use crate::multigrid::{self, MultigridError, MultigridOptions, SolverChoice};
+use crate::operator::CanonicalError;
+use crate::physics::diffusion::{Diffusion, DiffusionError, Iterative, Preconditioning};
 use crate::physics::regions::Regional;
 use crate::physics::{non_finite_text, point_text, BoundaryKind, Conductivity, Datum, ScalarFn};
 use hasse_complex::Complex;
-use sprs::CsMat;
 use std::sync::Arc;
-use std::time::Instant;
 
 /// A scalar function of position and time.
 pub type SpaceTimeFn = Arc<dyn Fn(&[f64], f64) -> f64 + Send + Sync>;
@@ -181,6 +185,120 @@ pub enum HeatError {
     /// The operator M/Δt + θK could not be formed.
     #[error(transparent)]
     Canonical(#[from] CanonicalError),
+    /// Conjugate gradients on M/Δt + θK failed (no convergence within the
+    /// iteration limit, or a matrix that is not positive definite).
+    #[error("conjugate gradients on M/Δt + θK: {0}")]
+    Cg(CgError),
+    /// The multigrid preconditioner of M/Δt + θK could not be built or
+    /// its iteration failed.
+    #[error(transparent)]
+    Multigrid(#[from] MultigridError),
+    /// [`Adaptive::tolerance`] is not a positive finite number.
+    #[error("the adaptive time-step tolerance must be positive and finite, found {tolerance}")]
+    AdaptiveTolerance {
+        /// The tolerance given.
+        tolerance: f64,
+    },
+    /// Adaptive steps need an implicit scheme whose error the estimate
+    /// knows: θ in [½, 1].
+    #[error("adaptive time steps need θ in [½, 1] (backward Euler to Crank–Nicolson), found θ = {theta}")]
+    AdaptiveTheta {
+        /// The θ given.
+        theta: f64,
+    },
+    /// The step size control halved the step 30 times below Δt₀ without
+    /// meeting the tolerance (data discontinuous in time, or a tolerance
+    /// near rounding).
+    #[error("at t = {time} the step Δt = {dt:e} still has an estimated local error {estimate:e} above the tolerance {tolerance:e}: the time-step control gives up (is the data discontinuous in time, or the tolerance near rounding?)")]
+    StepTooSmall {
+        /// Where the control gave up.
+        time: f64,
+        /// The smallest step tried.
+        dt: f64,
+        /// Its relative error estimate.
+        estimate: f64,
+        /// The tolerance asked for.
+        tolerance: f64,
+    },
+}
+
+/// Adaptive time steps for θ in [½, 1]: each step's local error is
+/// estimated from an explicit predictor of the same order (see the
+/// stepping module) and kept below `tolerance` relative to the size of
+/// the solution, max(‖uⁿ‖∞, ‖uⁿ⁺¹‖∞). Step sizes are Δt₀·2ʲ (Δt₀ the
+/// problem's `dt`): a rejected step is retried at half the size (or
+/// less), an accepted one whose error would stay within the tolerance at
+/// twice the size lets the next step double, and the last step is
+/// shortened to land on the end time t₀ + steps·Δt₀. Each size is
+/// factorised (or its multigrid built) once.
+///
+/// ```
+/// use hasse_complex::generate::interval;
+/// use hasse_solver::metric::Method;
+/// use hasse_solver::physics::heat::{Adaptive, Heat, HeatBoundary, TimeFn};
+/// use hasse_solver::physics::Conductivity;
+/// use std::sync::Arc;
+/// // Two modes decaying at rates π² and 64π²: once the fast one has died
+/// // out, the slow one lets the steps grow.
+/// let mesh = interval(64, 0.0, 1.0).unwrap();
+/// let heat = Heat::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), 1e-4)
+///     .with_theta(0.5)
+///     .with_boundary("boundary", HeatBoundary::Dirichlet(TimeFn::Steady(Arc::new(|_| 0.0))))
+///     .with_adaptive(Adaptive { tolerance: 1e-4 });
+/// let pi = std::f64::consts::PI;
+/// let initial = |x: &[f64]| (pi * x[0]).sin() + (8.0 * pi * x[0]).sin();
+/// let history = heat.run(&mesh, &initial, 2000, 0).unwrap();
+/// let report = history.adaptive.unwrap();
+/// assert!((history.times.last().unwrap() - 0.2).abs() < 1e-12);
+/// assert!(history.steps < 200); // far fewer than the 2000 steps of Δt₀
+/// let largest = report.step_sizes.iter().fold(0.0f64, |m, &h| m.max(h));
+/// assert!(largest >= 8.0 * report.step_sizes[0]);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// The relative local error allowed per step.
+    pub tolerance: f64,
+}
+
+/// What the step-size control of an adaptive run did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AdaptiveReport {
+    /// The size of every accepted step, in order.
+    pub step_sizes: Vec<f64>,
+    /// The relative local error estimate of every accepted step.
+    pub estimates: Vec<f64>,
+    /// Steps rejected and retried smaller.
+    pub rejected: usize,
+    /// Distinct step sizes, each factorised or set up once.
+    pub systems: usize,
+}
+
+/// Conjugate-gradient iterations of an iterative run.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepIterations {
+    /// Over all solves.
+    pub total: usize,
+    /// The most any one solve took.
+    pub max: usize,
+    /// Solves made (steps, plus retried adaptive steps).
+    pub solves: usize,
+}
+
+impl StepIterations {
+    fn add(&mut self, iterations: usize) {
+        self.total += iterations;
+        self.max = self.max.max(iterations);
+        self.solves += 1;
+    }
+
+    /// Mean iterations per solve.
+    pub fn mean(&self) -> f64 {
+        if self.solves == 0 {
+            0.0
+        } else {
+            self.total as f64 / self.solves as f64
+        }
+    }
 }
 
 /// The transient heat problem: method, conductivity, data and θ-scheme.
@@ -231,6 +349,11 @@ pub struct Heat {
     pub factorization: Factorization,
     /// Its fill-reducing ordering (default automatic).
     pub ordering: Ordering,
+    /// Conjugate gradients instead of a factorisation, started at every
+    /// step from the previous level (see [`Heat::with_solver`]).
+    pub iterative: Option<Iterative>,
+    /// Adaptive step sizes instead of the constant `dt`.
+    pub adaptive: Option<Adaptive>,
 }
 
 /// The computed time levels and how long they took.
@@ -244,8 +367,18 @@ pub struct History {
     pub times: Vec<f64>,
     /// The field at each saved time (all unknowns, fixed ones included).
     pub fields: Vec<Vec<f64>>,
-    /// Symbolic analysis plus numeric factorisation of M/Δt + θK, seconds.
+    /// Building the step solver: symbolic analysis plus numeric
+    /// factorisation of M/Δt + θK, or its multigrid setup (for every step
+    /// size of an adaptive run), seconds.
     pub factorization_seconds: f64,
+    /// How the steps were solved, e.g. "direct LLᵀ" or "CG with geometric
+    /// multigrid".
+    pub solver: String,
+    /// Conjugate-gradient iterations, when the steps were solved
+    /// iteratively.
+    pub iterations: Option<StepIterations>,
+    /// The step-size control's record, for an adaptive run.
+    pub adaptive: Option<AdaptiveReport>,
     /// The fill-reducing ordering the factorisation used (`None` for LU or
     /// when every unknown is fixed).
     pub ordering: Option<Ordering>,
@@ -254,7 +387,7 @@ pub struct History {
     pub seconds_per_step: f64,
     /// The part of `seconds_per_step` spent in the triangular solves.
     pub solve_seconds_per_step: f64,
-    /// Steps taken.
+    /// Steps taken (accepted steps, for an adaptive run).
     pub steps: usize,
 }
 
@@ -272,7 +405,7 @@ pub struct History {
 /// heat.run_observed(&mesh, &|_| 1.0, 2, 1, &mut |event| {
 ///     events.push(match event {
 ///         HeatEvent::Level { index, .. } => format!("level {index}"),
-///         HeatEvent::Step(n) => format!("step {n}"),
+///         HeatEvent::Step { number, .. } => format!("step {number}"),
 ///     })
 /// })
 /// .unwrap();
@@ -291,8 +424,13 @@ pub enum HeatEvent<'a> {
         /// u at t, every unknown.
         field: &'a [f64],
     },
-    /// Step number `n` (1-based) has been taken.
-    Step(usize),
+    /// A step has been taken (an accepted step, in an adaptive run).
+    Step {
+        /// Its number, 1-based.
+        number: usize,
+        /// The time it reached.
+        time: f64,
+    },
 }
 
 impl Heat {
@@ -311,7 +449,75 @@ impl Heat {
             start: 0.0,
             factorization: Factorization::Llt,
             ordering: Ordering::Automatic,
+            iterative: None,
+            adaptive: None,
         }
+    }
+
+    /// Choose how every step's system M/Δt + θK is solved, as
+    /// [`Diffusion::with_solver`] does for a steady problem:
+    /// [`SolverChoice::Direct`] factorises it once (per step size),
+    /// [`SolverChoice::Multigrid`] builds a multigrid preconditioner once
+    /// and runs conjugate gradients to `tolerance` at every step, started
+    /// from the previous level, [`SolverChoice::Auto`] applies
+    /// [`multigrid::automatic`] to this method's unknowns on `complex`.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::metric::Method;
+    /// use hasse_solver::multigrid::{Hierarchy, SolverChoice};
+    /// use hasse_solver::physics::heat::{Heat, HeatBoundary, TimeFn};
+    /// use hasse_solver::physics::Conductivity;
+    /// use std::sync::Arc;
+    /// let mesh = rectangle(32, 32, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let heat = |choice| {
+    ///     Heat::new(Method::Fv, Conductivity::Scalar(Arc::new(|_| 1.0)), 1e-3)
+    ///         .with_boundary("boundary", HeatBoundary::Dirichlet(TimeFn::Steady(Arc::new(|_| 0.0))))
+    ///         .with_solver(choice, 1e-10, &mesh)
+    ///         .run(&mesh, &|x| x[0] * (1.0 - x[0]), 10, 0)
+    ///         .unwrap()
+    /// };
+    /// let direct = heat(SolverChoice::Direct);
+    /// let multigrid = heat(SolverChoice::Multigrid(Hierarchy::Grid { cells: vec![32, 32] }));
+    /// // Warm-started from the previous level, a few iterations per step.
+    /// assert!(multigrid.iterations.unwrap().max <= 6);
+    /// for (a, b) in direct.fields[1].iter().zip(&multigrid.fields[1]) {
+    ///     assert!((a - b).abs() < 1e-9);
+    /// }
+    /// ```
+    pub fn with_solver(mut self, choice: SolverChoice, tolerance: f64, complex: &Complex) -> Self {
+        let choice = match choice {
+            SolverChoice::Auto(hierarchy) => {
+                let n = complex.dim();
+                let unknowns = match self.at(self.start).location() {
+                    Location::Nodal => complex.cell_count(0),
+                    _ => complex.cell_count(n),
+                };
+                multigrid::automatic(n, unknowns, hierarchy)
+            }
+            other => other,
+        };
+        self.iterative = match choice {
+            SolverChoice::Multigrid(hierarchy) => Some(Iterative {
+                options: CgOptions {
+                    tolerance,
+                    ..CgOptions::default()
+                },
+                initial: None,
+                preconditioner: Preconditioning::Multigrid {
+                    hierarchy,
+                    options: MultigridOptions::default(),
+                },
+            }),
+            _ => None,
+        };
+        self
+    }
+
+    /// Step with adaptive step sizes (see [`Adaptive`]).
+    pub fn with_adaptive(mut self, adaptive: Adaptive) -> Self {
+        self.adaptive = Some(adaptive);
+        self
     }
 
     /// Set the source f.
@@ -396,358 +602,5 @@ impl Heat {
             return Err(HeatError::StartTime { t0: self.start });
         }
         Ok(())
-    }
-
-    /// Take `steps` steps from u(·, t₀) = `initial`, keeping every
-    /// `save_every`-th level (t₀ and the last level are always kept; 0 keeps
-    /// only those two).
-    pub fn run(
-        &self,
-        complex: &Complex,
-        initial: &dyn Fn(&[f64]) -> f64,
-        steps: usize,
-        save_every: usize,
-    ) -> Result<History, HeatError> {
-        self.run_with_progress(complex, initial, steps, save_every, &mut |_| {})
-    }
-
-    /// As [`run`](Self::run), telling `progress` the number of each step
-    /// taken (for progress display on long runs).
-    pub fn run_with_progress(
-        &self,
-        complex: &Complex,
-        initial: &dyn Fn(&[f64]) -> f64,
-        steps: usize,
-        save_every: usize,
-        progress: &mut dyn FnMut(usize),
-    ) -> Result<History, HeatError> {
-        self.run_observed(complex, initial, steps, save_every, &mut |event| {
-            if let HeatEvent::Step(step) = event {
-                progress(step);
-            }
-        })
-    }
-
-    /// As [`run`](Self::run), telling `observe` each saved level as soon as
-    /// it is computed and each step as it is taken, so a caller can write
-    /// levels while the run goes on (an interrupted run then keeps them).
-    /// The levels it is told are those of the returned [`History`], in
-    /// order; a failed run has told the ones completed before the failure.
-    ///
-    /// ```
-    /// use hasse_complex::generate::rectangle;
-    /// use hasse_solver::physics::Conductivity;
-    /// use hasse_solver::metric::Method;
-    /// use hasse_solver::physics::heat::{Heat, HeatEvent};
-    /// use std::sync::Arc;
-    /// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
-    /// let heat = Heat::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), 0.01);
-    /// let mut seen = Vec::new();
-    /// let history = heat
-    ///     .run_observed(&mesh, &|x| x[0], 4, 2, &mut |event| {
-    ///         if let HeatEvent::Level { index, time, field } = event {
-    ///             seen.push((index, time, field.len()));
-    ///         }
-    ///     })
-    ///     .unwrap();
-    /// assert_eq!(seen.len(), history.times.len()); // t = 0, 0.02, 0.04
-    /// assert_eq!(seen[2], (2, history.times[2], 25));
-    /// ```
-    pub fn run_observed(
-        &self,
-        complex: &Complex,
-        initial: &dyn Fn(&[f64]) -> f64,
-        steps: usize,
-        save_every: usize,
-        observe: &mut dyn FnMut(HeatEvent<'_>),
-    ) -> Result<History, HeatError> {
-        self.check()?;
-        let n = complex.dim();
-        let d = complex.embedding_dim();
-        let (theta, dt, t0) = (self.theta, self.dt, self.start);
-        let first = self.at(t0).assemble(complex)?;
-        let mass = self.mass(complex)?;
-        let location = first.location;
-        let unknowns = first.rhs.len();
-
-        // u⁰ at the points the unknowns stand for; Dirichlet values win.
-        let points: Vec<f64> = match location {
-            Location::Nodal => complex.vertices().as_slice().to_vec(),
-            _ => first
-                .cell_points
-                .clone()
-                .unwrap_or_else(|| complex.centroid(n).to_vec()),
-        };
-        if let Some(given) = &self.initial_field {
-            if given.len() != unknowns {
-                return Err(HeatError::InitialField {
-                    given: given.len(),
-                    unknowns,
-                });
-            }
-        }
-        let mut u: Vec<f64> = Vec::with_capacity(unknowns);
-        for i in 0..unknowns {
-            let x = &points[i * d..(i + 1) * d];
-            let v = first.fixed[i].unwrap_or_else(|| match &self.initial_field {
-                Some(given) => given[i],
-                None => initial(x),
-            });
-            if !v.is_finite() {
-                return Err(HeatError::NonFinite {
-                    datum: Datum::Initial,
-                    point: x.to_vec(),
-                    value: v,
-                    time: t0,
-                });
-            }
-            u.push(v);
-        }
-
-        // The step matrix L = M/Δt + θK in canonical form: the lumped mass
-        // (A = I, Ω = diag(m)) and the stiffness (A, Ω of the diffusion
-        // assembly) stacked, [I; A]ᵀ diag(m/Δt, θΩ) [I; A]. Its free block
-        // is factorised once; its free-row, fixed-column entries lift the
-        // Dirichlet values of every step.
-        let stiffness = &first.matrix;
-        let lumped = Canonical::new(
-            CsMat::<i8>::eye(unknowns),
-            BlockMetric::from_weights(mass.clone()),
-        )?;
-        let started = Instant::now();
-        let step_matrix =
-            Canonical::sum(&[(1.0 / dt, &lumped), (theta, &first.canonical)])?.assemble_owned();
-        let split = FixedSplit::new(&first.fixed);
-        let free = split.free().to_vec();
-        let reduced = split.free_block(&step_matrix);
-        let lift = split.coupling(&step_matrix);
-        drop(step_matrix);
-        // Analysed once: every step reuses this factor.
-        let (factor, ordering) = if free.is_empty() {
-            (None, None)
-        } else {
-            let solver =
-                DirectSolver::analyse_with(reduced.as_ref(), self.factorization, self.ordering)?;
-            (Some(solver.factorize(reduced.as_ref())?), solver.ordering())
-        };
-        let factorization_seconds = started.elapsed().as_secs_f64();
-
-        let vary = self.data_vary();
-        let mut times = vec![t0];
-        let mut fields = vec![u.clone()];
-        observe(HeatEvent::Level {
-            index: 0,
-            time: t0,
-            field: &u,
-        });
-        let mut b_old = first.rhs.clone();
-        let mut fixed_new: Vec<Option<f64>> = first.fixed.clone();
-        let mut b_new = first.rhs.clone();
-        let mut rhs = vec![0.0; free.len()];
-        let mut ku = vec![0.0; unknowns];
-        let mut solve_seconds = 0.0;
-        // The observer may write output or draw progress: its time is the
-        // caller's, not the scheme's.
-        let mut observed_seconds = 0.0;
-        let started = Instant::now();
-        for step in 1..=steps {
-            let t = t0 + step as f64 * dt;
-            if vary {
-                // Only the data change: Ω, M and the boundary layout are kept.
-                let (rhs, fixed) = self.at(t).data(complex, &first)?;
-                b_new = rhs;
-                fixed_new = fixed;
-            }
-            // K uⁿ (full matrix: fixed unknowns contribute to free rows).
-            ku.iter_mut().for_each(|v| *v = 0.0);
-            for (j, &uj) in u.iter().enumerate() {
-                let range = stiffness.col_range(j);
-                for (&i, &v) in stiffness.row_idx()[range.clone()]
-                    .iter()
-                    .zip(&stiffness.val()[range])
-                {
-                    ku[i] += v * uj;
-                }
-            }
-            for (k, &i) in free.iter().enumerate() {
-                rhs[k] = mass[i] / dt * u[i] - (1.0 - theta) * ku[i]
-                    + theta * b_new[i]
-                    + (1.0 - theta) * b_old[i];
-            }
-            // The fixed pattern is the tags', the same at every time.
-            FixedSplit::lift_into(&lift, &fixed_new, &mut rhs);
-            // An unstable θ < ½ overflows, in the right-hand side or in the
-            // solve. The matrix was factorised, so a non-finite solution
-            // (which the solve reports as a singular matrix) is overflow too.
-            let overflow = |rhs: &[f64]| {
-                let k = rhs
-                    .iter()
-                    .position(|v| !v.is_finite())
-                    .or_else(|| {
-                        (0..rhs.len()).max_by(|&a, &b| rhs[a].abs().total_cmp(&rhs[b].abs()))
-                    })
-                    .unwrap_or(0);
-                let i = free[k];
-                HeatError::Overflow {
-                    point: points[i * d..(i + 1) * d].to_vec(),
-                    time: t,
-                    theta,
-                }
-            };
-            if rhs.iter().any(|v| !v.is_finite()) {
-                return Err(overflow(&rhs));
-            }
-            if let Some(factor) = &factor {
-                let solving = Instant::now();
-                let x = match factor.solve(&rhs) {
-                    Ok(x) => x,
-                    Err(SolveError::Singular { .. }) => return Err(overflow(&rhs)),
-                    Err(e) => return Err(e.into()),
-                };
-                solve_seconds += solving.elapsed().as_secs_f64();
-                for (k, &i) in free.iter().enumerate() {
-                    u[i] = x[k];
-                }
-            }
-            for (i, g) in fixed_new.iter().enumerate() {
-                if let Some(g) = g {
-                    u[i] = *g;
-                }
-            }
-            if vary {
-                std::mem::swap(&mut b_old, &mut b_new);
-            }
-            if step == steps || (save_every > 0 && step % save_every == 0) {
-                let observing = Instant::now();
-                observe(HeatEvent::Level {
-                    index: times.len(),
-                    time: t,
-                    field: &u,
-                });
-                observed_seconds += observing.elapsed().as_secs_f64();
-                times.push(t);
-                fields.push(u.clone());
-            }
-            let observing = Instant::now();
-            observe(HeatEvent::Step(step));
-            observed_seconds += observing.elapsed().as_secs_f64();
-        }
-        let per_step = |seconds: f64| {
-            if steps > 0 {
-                seconds / steps as f64
-            } else {
-                0.0
-            }
-        };
-        let seconds_per_step = per_step(started.elapsed().as_secs_f64() - observed_seconds);
-        Ok(History {
-            location,
-            degree: if location == Location::Nodal { 0 } else { n },
-            times,
-            fields,
-            factorization_seconds,
-            ordering,
-            seconds_per_step,
-            solve_seconds_per_step: per_step(solve_seconds),
-            steps,
-        })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use hasse_complex::generate::rectangle;
-
-    fn heat(dt: f64, theta: f64) -> Heat {
-        Heat::new(Method::Fe, Conductivity::Scalar(Arc::new(|_| 1.0)), dt).with_theta(theta)
-    }
-
-    #[test]
-    fn bad_steps_and_thetas_are_refused() {
-        let mesh = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
-        let one: ScalarFn = Arc::new(|_| 1.0);
-        for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-            assert!(matches!(
-                heat(dt, 1.0).run(&mesh, &*one, 1, 1),
-                Err(HeatError::TimeStep { .. })
-            ));
-        }
-        for theta in [-0.1, 1.5, f64::NAN] {
-            assert!(matches!(
-                heat(0.1, theta).run(&mesh, &*one, 1, 1),
-                Err(HeatError::Theta { .. })
-            ));
-        }
-        let nan: ScalarFn = Arc::new(|_| f64::NAN);
-        assert!(matches!(
-            heat(0.1, 1.0).run(&mesh, &*nan, 1, 1),
-            Err(HeatError::NonFinite {
-                datum: Datum::Initial,
-                ..
-            })
-        ));
-        let bad_source = heat(0.1, 1.0).with_source(TimeFn::Varying(Arc::new(|_, t| {
-            if t > 0.15 {
-                f64::NAN
-            } else {
-                0.0
-            }
-        })));
-        assert!(matches!(
-            bad_source.run(&mesh, &*one, 3, 1),
-            Err(HeatError::Diffusion(DiffusionError::NonFinite {
-                datum: Datum::Source,
-                ..
-            }))
-        ));
-        let hybrid = Heat::new(Method::FvMimetic, Conductivity::Scalar(one.clone()), 0.1);
-        assert!(matches!(
-            hybrid.run(&mesh, &*one, 1, 1),
-            Err(HeatError::Unsupported { .. })
-        ));
-    }
-
-    #[test]
-    fn an_unstable_scheme_reports_the_overflow_and_the_levels_before_it() {
-        // Forward Euler with Δt far above h²/4: each step multiplies the
-        // highest mode by about 1 − Δt λ_max ≈ −100, so it overflows.
-        let mesh = rectangle(8, 8, [0.0, 1.0], [0.0, 1.0]).unwrap();
-        let h = heat(0.05, 0.0).with_boundary(
-            "boundary",
-            HeatBoundary::Dirichlet(TimeFn::Steady(Arc::new(|_| 0.0))),
-        );
-        let initial = |x: &[f64]| x[0] * (1.0 - x[0]) * x[1] * (1.0 - x[1]);
-        let mut levels = Vec::new();
-        let result = h.run_observed(&mesh, &initial, 1000, 10, &mut |event| {
-            if let HeatEvent::Level { time, field, .. } = event {
-                assert!(field.iter().all(|v| v.is_finite()));
-                levels.push(time);
-            }
-        });
-        let Err(HeatError::Overflow { time, .. }) = result else {
-            panic!("expected a non-finite temperature, got {result:?}");
-        };
-        assert!(levels.len() >= 2 && time > *levels.last().unwrap());
-        assert!(time < 1000.0 * 0.05);
-    }
-
-    #[test]
-    fn insulated_domain_keeps_its_heat() {
-        // No flux, no source: Σ mᵢ uᵢ is conserved exactly by every θ, since
-        // 1ᵀK = 0 (K·1 = 0 and K symmetric).
-        let mesh = rectangle(5, 4, [0.0, 1.0], [0.0, 2.0]).unwrap();
-        let initial: ScalarFn = Arc::new(|x| x[0] * x[0] + x[1]);
-        for theta in [0.0, 0.5, 1.0] {
-            let h = heat(0.001, theta);
-            let mass = h.mass(&mesh).unwrap();
-            let history = h.run(&mesh, &*initial, 20, 0).unwrap();
-            let total = |u: &[f64]| u.iter().zip(&mass).map(|(a, m)| a * m).sum::<f64>();
-            let (start, end) = (total(&history.fields[0]), total(&history.fields[1]));
-            assert!(
-                (start - end).abs() < 1e-13 * start.abs(),
-                "θ = {theta}: {start} → {end}"
-            );
-        }
     }
 }
