@@ -480,3 +480,61 @@ fn adaptive_step_counts_follow_the_scheme_order() {
     assert!((7.0..9.0).contains(&be), "backward Euler: ratio {be}");
     assert!((3.5..4.5).contains(&cn), "Crank–Nicolson: ratio {cn}");
 }
+
+/// Conservation: summed over the free unknowns, the θ-scheme's equations
+/// say that the stored heat's change, the θ-mix of the outflow and the
+/// θ-mix of the sources balance exactly, whatever the mesh size, so the
+/// balance of every step must close to rounding (10⁻¹¹ relative) for
+/// every method, with Dirichlet, Neumann and Robin faces and data that
+/// change in time.
+#[test]
+fn every_step_of_every_method_closes_its_heat_balance() {
+    let boxes = rectangle(8, 6, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    let axis_x = uniform_axis(8, 0.0, 2.0).unwrap();
+    let axis_y = uniform_axis(6, 0.0, 1.0).unwrap();
+    let triangles = kuhn(&[axis_x, axis_y]).unwrap();
+    let circumcentric = Method::Dec(hasse_complex::dual::DualKind::Circumcentric);
+    for (name, method, mesh) in [
+        ("fv", Method::Fv, &boxes),
+        ("fd", Method::Fd, &boxes),
+        ("fe Q1", Method::Fe, &boxes),
+        ("fe P1", Method::Fe, &triangles),
+        ("dec", circumcentric, &triangles),
+    ] {
+        for theta in [1.0, 0.5] {
+            let heat = Heat::new(method, unit(), 0.01)
+                .with_theta(theta)
+                .with_source(TimeFn::Varying(Arc::new(|x, t| 1.0 + t * x[0])))
+                .with_boundary(
+                    "xmin",
+                    HeatBoundary::Dirichlet(TimeFn::Varying(Arc::new(|x, t| t * x[1]))),
+                )
+                .with_boundary(
+                    "ymax",
+                    HeatBoundary::Neumann(TimeFn::Varying(Arc::new(|x, t| t.sin() + x[0]))),
+                )
+                .with_boundary(
+                    "xmax",
+                    HeatBoundary::Robin {
+                        alpha: Arc::new(|_| 2.0),
+                        value: TimeFn::Steady(Arc::new(|_| 1.0)),
+                    },
+                );
+            let history = heat.run(mesh, &|x| x[0] * x[1], 5, 1).unwrap();
+            for k in 1..history.times.len() {
+                let (t, u) = (&history.times, &history.fields);
+                let balance = heat
+                    .step_balance(mesh, (t[k - 1], &u[k - 1]), (t[k], &u[k]))
+                    .unwrap();
+                assert!(
+                    balance.relative < 1e-11,
+                    "{name} θ = {theta}, step {k}: {balance:?}"
+                );
+                assert!(
+                    balance.sources > 1.0,
+                    "{name}: the source heats: {balance:?}"
+                );
+            }
+        }
+    }
+}

@@ -139,17 +139,7 @@ impl Case {
         let n = complex.dim();
         for q in &self.output.quantities {
             match (&self.problem, q.kind) {
-                (Problem::Diffusion(_), _) => {}
-                (Problem::Heat(_), QuantityKind::Flux) => {
-                    collector.error(
-                        None,
-                        &format!("{}.type", q.key),
-                        "fluxes of heat runs are not computed yet (integrals, means, minima and maxima are, at every saved level)",
-                        Some("measure the flux in the steady problem (kind = \"diffusion\"), or remove this quantity".into()),
-                    );
-                    continue;
-                }
-                (Problem::Heat(_), _) => {}
+                (Problem::Diffusion(_) | Problem::Heat(_), _) => {}
                 _ => {
                     collector.error(
                         None,

@@ -172,6 +172,16 @@ pub(super) fn solve_streaming<'a>(
     let location = heat.at(time.start).location();
     let mut post_seconds = 0.0;
     let mut stream_seconds = 0.0;
+    // The step before the last saved level, for the balance; fluxes at
+    // every saved level when a quantity asks for one (the first failure
+    // to compute them is reported after the run).
+    let mut last_step: Option<(f64, Vec<f64>)> = None;
+    let wants_fluxes = case
+        .output
+        .quantities
+        .iter()
+        .any(|q| q.kind == crate::frontend::case::QuantityKind::Flux);
+    let mut flux_failure: Option<HeatError> = None;
     // Progress on long runs: at most ~100 updates, each a phase message.
     let report_every = (time.steps / 100).max(1);
     let history = heat
@@ -182,11 +192,43 @@ pub(super) fn solve_streaming<'a>(
             time.save_every,
             &mut |event| match event {
                 HeatEvent::Level {
-                    time: t, field: u, ..
+                    time: t,
+                    field: u,
+                    previous,
+                    ..
                 } => {
                     let post = Instant::now();
-                    level_quantities
-                        .push(super::quantities::level_values(case, complex, u, location));
+                    if let Some((t_before, before)) = previous {
+                        last_step = Some((t_before, before.to_vec()));
+                    }
+                    let fluxes = if wants_fluxes {
+                        match heat.level_solution(complex, t, u) {
+                            Ok(solution) => {
+                                let problem = heat.at(t);
+                                problem
+                                    .boundary_outflow(complex, &solution)
+                                    .map(|outflow| super::quantities::LevelFluxes {
+                                        outflow,
+                                        face_flux: problem.face_flux(complex, &solution),
+                                    })
+                                    .map_err(|e| flux_failure.get_or_insert(e.into()))
+                                    .ok()
+                            }
+                            Err(e) => {
+                                flux_failure.get_or_insert(e);
+                                None
+                            }
+                        }
+                    } else {
+                        None
+                    };
+                    level_quantities.push(super::quantities::level_values(
+                        case,
+                        complex,
+                        u,
+                        location,
+                        fluxes.as_ref(),
+                    ));
                     level_probes.push(super::probes::probe_values(
                         case, complex, location, u, None,
                     ));
@@ -253,8 +295,19 @@ pub(super) fn solve_streaming<'a>(
         }
     }
 
+    if let Some(e) = flux_failure {
+        return Err(run_error(case, spec, e));
+    }
+
     phase("post-processing");
     let post = Instant::now();
+    let balance = match (&last_step, history.times.last(), history.fields.last()) {
+        (Some((t0, u0)), Some(&t1), Some(u1)) => Some(
+            heat.step_balance(complex, (*t0, u0), (t1, u1))
+                .map_err(|e| run_error(case, spec, e))?,
+        ),
+        _ => None,
+    };
     let errors = level_errors
         .last()
         .map(|&(_, l2, max)| Errors::sampled(l2, max));
@@ -321,6 +374,26 @@ pub(super) fn solve_streaming<'a>(
             1e3 * history.solve_seconds_per_step,
         ),
     )];
+    if let Some(b) = &balance {
+        notes.push((
+            "balance".to_string(),
+            format!(
+                "last step (t = {} to {}): stored {:.6e} + outflow {:.6e} − sources {:.6e} = {:.2e}, {:.1e} of the largest term (rates; the method's own fluxes)",
+                short(b.times.0), short(b.times.1), b.stored, b.outflow, b.sources, b.imbalance, b.relative
+            ),
+        ));
+        report.insert(
+            "balance".into(),
+            serde_json::json!({
+                "times": [b.times.0, b.times.1],
+                "stored": b.stored,
+                "outflow": b.outflow,
+                "sources": b.sources,
+                "imbalance": b.imbalance,
+                "relative": b.relative,
+            }),
+        );
+    }
     notes.extend(quantities.notes);
     let (probe_notes, probes) = super::probes::probe_report(case, &history.times, &level_probes);
     notes.extend(probe_notes);
@@ -412,4 +485,12 @@ pub(super) fn check(case: &Case, spec: &HeatSpec, complex: &Complex) -> Result<(
         .at(spec.time.start)
         .check_data(complex)
         .map_err(|e| diffusion_error(case, &keys, e))
+}
+
+/// A time with at most 10 significant digits, as a person would write it
+/// (0.199 rather than 0.19900000000000012).
+fn short(t: f64) -> String {
+    let text = format!("{t:.10e}");
+    let value: f64 = text.parse().unwrap_or(t);
+    format!("{value}")
 }

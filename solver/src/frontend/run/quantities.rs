@@ -25,7 +25,6 @@ pub(super) fn diffusion_quantities(
     solution: &Solution,
     outflow: &[f64],
 ) -> Result<Quantities, DiffusionError> {
-    let n = complex.dim();
     let sources = problem.source_total(complex)?;
     let total: f64 = outflow.iter().sum();
     let scale = outflow
@@ -51,26 +50,10 @@ pub(super) fn diffusion_quantities(
         json!({ "outflow": total, "sources": sources, "imbalance": imbalance, "relative": relative }),
     );
     let face_flux = problem.face_flux(complex, solution);
-    let top = complex.boundary(n);
     let mut entries = Vec::new();
     for q in &case.output.quantities {
         let value = match q.kind {
-            QuantityKind::Flux => {
-                let tag = q.tag.as_deref().and_then(|t| complex.tag(t));
-                let faces = tag.map_or(&[][..], |t| &t.cells[..]);
-                faces
-                    .iter()
-                    .map(|&f| {
-                        let boundary = top.outer_view(f).is_some_and(|r| r.nnz() == 1);
-                        match (&face_flux, boundary) {
-                            (_, true) => outflow[f],
-                            (Some(along), false) => along[f],
-                            // Refused when the mesh was built.
-                            (None, false) => f64::NAN,
-                        }
-                    })
-                    .sum()
-            }
+            QuantityKind::Flux => flux_through(q, complex, outflow, face_flux.as_deref()),
             kind => region_statistic(kind, q, complex, solution.field(complex), solution.location),
         };
         notes.push(("quantity".into(), format!("{} = {value:e}", q.name)));
@@ -82,19 +65,59 @@ pub(super) fn diffusion_quantities(
     Ok(Quantities { notes, report })
 }
 
-/// The quantities of a heat run at one saved level: (name, value) per
-/// quantity (integrals, means and extremes; fluxes are refused for heat
-/// when the mesh is built).
+/// The flux of a `type = "flux"` quantity: the outflow through the faces
+/// of its tag that bound the domain, the flux along their orientation
+/// through interior ones (`face_flux`, which cell-centred and hybrid
+/// methods have; nodal ones are refused when the mesh is built).
+fn flux_through(
+    q: &QuantitySpec,
+    complex: &Complex,
+    outflow: &[f64],
+    face_flux: Option<&[f64]>,
+) -> f64 {
+    let top = complex.boundary(complex.dim());
+    let tag = q.tag.as_deref().and_then(|t| complex.tag(t));
+    let faces = tag.map_or(&[][..], |t| &t.cells[..]);
+    faces
+        .iter()
+        .map(|&f| {
+            let boundary = top.outer_view(f).is_some_and(|r| r.nnz() == 1);
+            match (face_flux, boundary) {
+                (_, true) => outflow[f],
+                (Some(along), false) => along[f],
+                // Refused when the mesh was built.
+                (None, false) => f64::NAN,
+            }
+        })
+        .sum()
+}
+
+/// The fluxes of a level of a heat run: the outflow through each face and,
+/// for methods with face unknowns, the flux along every face.
+pub(super) struct LevelFluxes {
+    pub outflow: Vec<f64>,
+    pub face_flux: Option<Vec<f64>>,
+}
+
+/// The quantities of a heat run at one saved level, one value per
+/// quantity; fluxes from `fluxes` (computed when the case asks for one).
 pub(super) fn level_values(
     case: &Case,
     complex: &Complex,
     field: &[f64],
     location: Location,
+    fluxes: Option<&LevelFluxes>,
 ) -> Vec<f64> {
     case.output
         .quantities
         .iter()
-        .map(|q| region_statistic(q.kind, q, complex, field, location))
+        .map(|q| match (q.kind, fluxes) {
+            (QuantityKind::Flux, Some(f)) => {
+                flux_through(q, complex, &f.outflow, f.face_flux.as_deref())
+            }
+            (QuantityKind::Flux, None) => f64::NAN,
+            (kind, _) => region_statistic(kind, q, complex, field, location),
+        })
         .collect()
 }
 

@@ -16,10 +16,13 @@
 //! every step and is factorised once. θ = 1 is backward Euler (first
 //! order, L-stable), θ = ½ Crank–Nicolson (second order, A-stable).
 
+mod balance;
 mod stepping;
 mod system;
 #[cfg(test)]
 mod tests;
+
+pub use balance::StepBalance;
 
 use crate::la::direct::{Factorization, SolveError};
 use crate::la::iterative::{CgError, CgOptions};
@@ -423,6 +426,10 @@ pub enum HeatEvent<'a> {
         time: f64,
         /// u at t, every unknown.
         field: &'a [f64],
+        /// The level one step before (its time and field), from which
+        /// this one was computed; `None` for t₀. With it the step's
+        /// balance can be checked ([`Heat::step_balance`]).
+        previous: Option<(f64, &'a [f64])>,
     },
     /// A step has been taken (an accepted step, in an adaptive run).
     Step {

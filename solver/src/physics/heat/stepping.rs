@@ -60,7 +60,7 @@ impl Heat {
     /// let mut seen = Vec::new();
     /// let history = heat
     ///     .run_observed(&mesh, &|x| x[0], 4, 2, &mut |event| {
-    ///         if let HeatEvent::Level { index, time, field } = event {
+    ///         if let HeatEvent::Level { index, time, field, .. } = event {
     ///             seen.push((index, time, field.len()));
     ///         }
     ///     })
@@ -159,6 +159,7 @@ impl Heat {
             index: 0,
             time: t0,
             field: &u,
+            previous: None,
         });
         let mut b_old = first.rhs.clone();
         let mut b_new = first.rhs.clone();
@@ -292,11 +293,11 @@ impl Heat {
                 }
                 (h, t_new) = c.step_to(t, end);
             };
+            let u_old = std::mem::replace(&mut u, u_new);
+            let t_old = std::mem::replace(&mut t, t_new);
             if self.iterative.is_some() {
-                previous = Some((h, free.iter().map(|&i| u[i]).collect()));
+                previous = Some((h, free.iter().map(|&i| u_old[i]).collect()));
             }
-            u = u_new;
-            t = t_new;
             step += 1;
             if vary {
                 std::mem::swap(&mut b_old, &mut b_new);
@@ -311,6 +312,7 @@ impl Heat {
                     index: times.len(),
                     time: t,
                     field: &u,
+                    previous: Some((t_old, &u_old)),
                 });
                 excluded_seconds += observing.elapsed().as_secs_f64();
                 times.push(t);
