@@ -903,10 +903,10 @@ fn bad_problem_kind_input_names_the_key() {
         &["`solver.ordering`", "kind = \"darcy\""],
     );
     refused(
-        "multigrid-heat",
-        &format!("{HEAT}\n[solver]\ntype = \"amg\"\n"),
+        "multigrid-darcy",
+        "[mesh]\ngenerator = \"rectangle\"\nn = [4, 4]\n[problem]\nkind = \"darcy\"\n[solver]\ntype = \"amg\"\n",
         2,
-        &["`solver.type`", "diffusion problems"],
+        &["`solver.type`", "diffusion and heat problems"],
     );
     refused(
         "wrong-key",
