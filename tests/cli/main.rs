@@ -37,3 +37,4 @@ mod nonlinear;
 mod probes;
 mod quantities;
 mod regions;
+mod transport;

@@ -20,4 +20,5 @@ mod forms;
 mod maxwell;
 mod nonlinear;
 mod refinement;
+mod transport;
 mod transient;

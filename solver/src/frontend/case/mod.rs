@@ -39,11 +39,13 @@ mod mesh_checks;
 mod problem;
 mod quantity;
 mod reader;
+mod transport_spec;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
 pub use quantity::{ProbeSpec, QuantityKind, QuantitySpec};
+pub use transport_spec::TransportSpec;
 
 use crate::frontend::mesh_spec::{MeshError, MeshSpec};
 use crate::la::direct::Factorization;
@@ -118,6 +120,11 @@ pub enum SolverKind {
     /// `mpi`): CG + GAMG by default, MUMPS when a factorisation is asked
     /// for, and `[solver.petsc] options` on top.
     Petsc,
+    /// Restarted GMRES(30) with ILU(0), for the nonsymmetric systems of
+    /// `kind = "transport"` ([`crate::la::krylov`]).
+    Gmres,
+    /// BiCGStab with ILU(0), for `kind = "transport"`.
+    Bicgstab,
 }
 
 /// Linear solver settings (`[solver]`).
@@ -481,6 +488,7 @@ impl Case {
         match &self.problem {
             Problem::Diffusion(d) => Some(d.method),
             Problem::Heat(h) => Some(h.method),
+            Problem::Transport(_) => Some(Method::Fv),
             Problem::Gradient(_)
             | Problem::Darcy(_)
             | Problem::Maxwell(_)

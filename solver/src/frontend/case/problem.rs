@@ -607,6 +607,8 @@ pub enum Problem {
     Elasticity(ElasticitySpec),
     /// `kind = "coupled"` (boxed: two diffusion specifications).
     Coupled(Box<CoupledSpec>),
+    /// `kind = "transport"`.
+    Transport(super::TransportSpec),
 }
 
 impl Problem {
@@ -621,6 +623,7 @@ impl Problem {
             Problem::Hodge(_) => "hodge-laplacian",
             Problem::Elasticity(_) => "elasticity",
             Problem::Coupled(_) => "coupled",
+            Problem::Transport(_) => "transport",
         }
     }
 
@@ -630,6 +633,7 @@ impl Problem {
             Problem::Diffusion(d) => &d.boundary,
             Problem::Heat(h) => &h.boundary,
             Problem::Darcy(d) => &d.boundary,
+            Problem::Transport(t) => &t.boundary,
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
@@ -667,6 +671,7 @@ impl Problem {
             Problem::Diffusion(d) => Some(&d.conductivity),
             Problem::Heat(h) => Some(&h.conductivity),
             Problem::Darcy(d) => Some(&d.permeability),
+            Problem::Transport(t) => t.conductivity.as_ref(),
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
@@ -682,6 +687,11 @@ impl Problem {
             Problem::Diffusion(d) => vec![("problem.conductivity".into(), &d.conductivity)],
             Problem::Heat(h) => vec![("problem.conductivity".into(), &h.conductivity)],
             Problem::Darcy(d) => vec![("problem.permeability".into(), &d.permeability)],
+            Problem::Transport(t) => t
+                .conductivity
+                .iter()
+                .map(|k| ("problem.conductivity".into(), k))
+                .collect(),
             Problem::Coupled(c) => c
                 .fields
                 .iter()
@@ -718,6 +728,12 @@ impl Problem {
         match self {
             Problem::Diffusion(d) => diffusion(&mut all, "problem", &d.conductivity, &d.source),
             Problem::Heat(h) => diffusion(&mut all, "problem", &h.conductivity, &h.source),
+            Problem::Transport(t) => {
+                if let Some(Coefficient::Scalar(e)) = &t.conductivity {
+                    all.push(("problem.conductivity".into(), e));
+                }
+                all.push(("problem.source".into(), &t.source));
+            }
             Problem::Coupled(c) => {
                 for (i, f) in c.fields.iter().enumerate() {
                     let prefix = format!("field[{i}]");

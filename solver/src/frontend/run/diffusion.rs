@@ -46,7 +46,10 @@ fn with_solver(case: &Case, problem: Diffusion, complex: &Complex) -> Result<Dif
         _ => None,
     };
     let choice = match case.solver.kind {
-        SolverKind::Direct | SolverKind::Petsc => return Ok(problem),
+        // GMRES and BiCGStab are refused for diffusion when the case is read.
+        SolverKind::Direct | SolverKind::Petsc | SolverKind::Gmres | SolverKind::Bicgstab => {
+            return Ok(problem)
+        }
         SolverKind::Multigrid => match grid {
             Some(h) => SolverChoice::Multigrid(h),
             None => {

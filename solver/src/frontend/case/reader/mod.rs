@@ -27,6 +27,7 @@ mod overrides;
 mod problem;
 mod quantities;
 mod sections;
+mod transport;
 #[cfg(test)]
 mod tests;
 
@@ -75,6 +76,8 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "a",
     "b",
     "c",
+    "velocity",
+    "scheme",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -103,6 +106,17 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],
     ),
     ("coupled", &["a", "b", "c"]),
+    (
+        "transport",
+        &[
+            "method",
+            "conductivity",
+            "source",
+            "velocity",
+            "initial",
+            "scheme",
+        ],
+    ),
 ];
 pub(super) const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha", "component"];
 pub(super) const EXACT_KEYS: &[&str] = &["solution", "gradient", "eigenvalues", "displacement"];

@@ -138,6 +138,8 @@ impl Reader {
                 "multigrid" => SolverKind::Multigrid,
                 "amg" => SolverKind::Amg,
                 "auto" => SolverKind::Auto,
+                "gmres" => SolverKind::Gmres,
+                "bicgstab" => SolverKind::Bicgstab,
                 "petsc" => {
                     if !cfg!(feature = "mpi") {
                         let span = self.entry(table, "solver", "type").and_then(|e| e.span());
@@ -156,12 +158,29 @@ impl Reader {
                         span,
                         "solver.type",
                         format!("unknown solver type \"{other}\""),
-                        Some("\"direct\" (faer LLᵀ/LDLᵀ/LU), \"multigrid\" (CG with a V-cycle on the generator's grid levels), \"amg\" (CG with smoothed aggregation, any mesh), \"auto\", or \"petsc\" (PETSc over MPI)".into()),
+                        Some("\"direct\" (faer LLᵀ/LDLᵀ/LU), \"multigrid\" (CG with a V-cycle on the generator's grid levels), \"amg\" (CG with smoothed aggregation, any mesh), \"auto\", \"petsc\" (PETSc over MPI), or for transport \"gmres\" / \"bicgstab\" (ILU(0)-preconditioned)".into()),
                     );
                     SolverKind::Direct
                 }
             };
-            if spec.kind != SolverKind::Direct && problem_kind(root) != "diffusion" {
+            let krylov = matches!(spec.kind, SolverKind::Gmres | SolverKind::Bicgstab);
+            if krylov && problem_kind(root) != "transport" {
+                let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                self.error(
+                    span,
+                    "solver.type",
+                    format!("GMRES and BiCGStab serve the nonsymmetric systems of kind = \"transport\"; this case is kind = \"{}\"", problem_kind(root)),
+                    Some("symmetric problems take \"direct\", \"multigrid\", \"amg\" or \"auto\"".into()),
+                );
+            } else if problem_kind(root) == "transport" && !krylov && spec.kind != SolverKind::Direct {
+                let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                self.error(
+                    span,
+                    "solver.type",
+                    "a transport system is nonsymmetric: conjugate gradients (multigrid, amg, auto) and PETSc's CG do not apply",
+                    Some("use \"direct\" (sparse LU), \"gmres\" or \"bicgstab\"".into()),
+                );
+            } else if !krylov && spec.kind != SolverKind::Direct && problem_kind(root) != "diffusion" {
                 let span = self.entry(table, "solver", "type").and_then(|e| e.span());
                 self.error(
                     span,
