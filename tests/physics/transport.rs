@@ -69,7 +69,7 @@ fn l1_error(mesh: &Complex, values: &[f64], exact: impl Fn(&[f64]) -> f64) -> f6
 fn boundary_layer_converges_at_first_order_for_pe_10_and_100() -> Result {
     // Upwinding adds the numerical diffusion Pe h / 2: the error is O(h)
     // once the cells resolve the layer (cell Péclet ≤ 1 here).
-    for (pe, sizes) in [(10.0, [40, 80, 160]), (100.0, [200, 400, 800])] {
+    for (pe, sizes) in [(10.0, [80, 160, 320]), (100.0, [400, 800, 1600])] {
         let mut h = Vec::new();
         let mut e = Vec::new();
         for n in sizes {
@@ -274,13 +274,13 @@ fn translated(scheme: Scheme, courant: f64, sizes: &[usize]) -> Result<(Vec<f64>
 fn upwind_is_first_order_and_limited_about_second_order_in_l1() -> Result {
     // Forward Euler upwind at Courant ½: modified equation u_t + u_x =
     // (h/4) u_xx, an O(h) error.
-    let (h, e) = translated(Scheme::Upwind, 0.5, &[200, 400, 800])?;
+    let (h, e) = translated(Scheme::Upwind, 0.5, &[400, 800, 1600])?;
     let p = order(&h, &e);
     eprintln!("upwind L1 errors {e:?}, order {p:.3}");
     assert!((p - 1.0).abs() < 0.15, "upwind order {p:.3}, errors {e:?}");
     // The limited scheme (SSP-RK2) at Courant 0.4: second order on smooth
     // data, less at the peak where the limiter clips the slope.
-    let (h, e_limited) = translated(Scheme::Limited, 0.4, &[100, 200, 400])?;
+    let (h, e_limited) = translated(Scheme::Limited, 0.4, &[200, 400, 800])?;
     let p = order(&h, &e_limited);
     eprintln!("limited L1 errors {e_limited:?}, order {p:.3}");
     assert!(p > 1.7 && p < 2.3, "limited order {p:.3}, errors {e_limited:?}");

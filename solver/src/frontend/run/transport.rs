@@ -273,12 +273,20 @@ pub(super) fn solve(
         Scheme::Upwind => format!("upwind, θ = {}, {solver_name}", time.theta),
         Scheme::Limited => "limited (Barth–Jespersen), SSP-RK2".to_string(),
     };
+    let (lo, hi) = run
+        .levels
+        .last()
+        .map(|(_, u)| {
+            u.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)))
+        })
+        .unwrap_or((0.0, 0.0));
     let first = run.mass.first().copied().unwrap_or(0.0);
     let last = run.mass.last().copied().unwrap_or(0.0);
     notes.push((
         "transport".to_string(),
         format!(
-            "{} steps of dt = {} ({scheme}), {} levels saved\ncell Péclet |v|h/K {}, Courant Δt Σout F/|c| max {:.3} (cell {}), positivity number {:.3}\nmass Σ|c|u {first:.6e} → {last:.6e}",
+            "{} steps of dt = {} ({scheme}), {} levels saved\ncell Péclet |v|h/K {}, Courant Δt Σout F/|c| max {:.3} (cell {}), positivity number {:.3}\nmass Σ|c|u {first:.9e} → {last:.9e}, u in [{lo:.3e}, {hi:.6}] at the last level",
             time.steps,
             time.dt,
             run.levels.len(),
