@@ -41,18 +41,30 @@ fn boundary_layer_is_first_order_and_krylov_equals_lu() -> Result {
     let coarse = summary(LAYER, &["mesh.n=[800,1]", "mesh.y=[0,0.00125]"]);
     let fine = summary(LAYER, &["mesh.n=[1600,1]", "mesh.y=[0,0.000625]"]);
     let order = (reported(&coarse, "error", "max")? / reported(&fine, "error", "max")?).log2();
-    assert!((order - 1.0).abs() < 0.15, "order {order}\n{coarse}\n{fine}");
+    assert!(
+        (order - 1.0).abs() < 0.15,
+        "order {order}\n{coarse}\n{fine}"
+    );
     // Cell Péclet Pe h = 0.5 on every cell of the shipped mesh.
-    assert!(shipped.contains("cell Péclet |v|h/K 5.000e-1 to 5.000e-1"), "{shipped}");
+    assert!(
+        shipped.contains("cell Péclet |v|h/K 5.000e-1 to 5.000e-1"),
+        "{shipped}"
+    );
     let ec = reported(&shipped, "error", "max")?;
     for solver in ["gmres", "bicgstab"] {
         let krylov = summary(
             LAYER,
-            &[&format!("solver.type=\"{solver}\""), "solver.tolerance=1e-12"],
+            &[
+                &format!("solver.type=\"{solver}\""),
+                "solver.tolerance=1e-12",
+            ],
         );
         let e = reported(&krylov, "error", "max")?;
         assert!((e - ec).abs() <= 1e-9, "{solver}: {e} vs {ec}\n{krylov}");
-        assert!(krylov.contains(&format!("{solver} with ILU(0)")), "{krylov}");
+        assert!(
+            krylov.contains(&format!("{solver} with ILU(0)")),
+            "{krylov}"
+        );
     }
     Ok(())
 }
@@ -69,7 +81,11 @@ fn rotating_case_keeps_mass_and_bounds() -> Result {
     // A quarter turn on the shipped mesh keeps the test short.
     let out = hasse(&["run", ROTATING, "--set", "time.steps=200", "-o", stem_text]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let mass = stdout
         .lines()
         .find(|l| l.contains("mass Σ|c|u"))
@@ -103,7 +119,9 @@ fn rotating_case_keeps_mass_and_bounds() -> Result {
     assert_eq!(u.len(), 50 * 50);
     let (lo, hi) = u
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
     assert!(lo >= -1e-12 && hi <= 1.0 + 1e-12, "[{lo}, {hi}]");
     Ok(())
 }
@@ -137,9 +155,24 @@ fn check_refuses_bad_transport_input() -> Result {
         &["problem.velocity=[\"0\", \"1\"]"],
         "flow enters the domain through face",
     )?;
-    check_fails(&["solver.type=\"multigrid\""], "a transport system is nonsymmetric")?;
-    check_fails(&["problem.scheme=\"limited\""], "the limited scheme steps in time")?;
-    let out = hasse(&["check", LAYER, "--set", "problem.velocity=[\"-100\", \"0\"]"]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    check_fails(
+        &["solver.type=\"multigrid\""],
+        "a transport system is nonsymmetric",
+    )?;
+    check_fails(
+        &["problem.scheme=\"limited\""],
+        "the limited scheme steps in time",
+    )?;
+    let out = hasse(&[
+        "check",
+        LAYER,
+        "--set",
+        "problem.velocity=[\"-100\", \"0\"]",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     Ok(())
 }

@@ -20,5 +20,5 @@ mod forms;
 mod maxwell;
 mod nonlinear;
 mod refinement;
-mod transport;
 mod transient;
+mod transport;

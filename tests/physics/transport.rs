@@ -81,7 +81,10 @@ fn boundary_layer_converges_at_first_order_for_pe_10_and_100() -> Result {
         }
         let p = order(&h, &e);
         eprintln!("Pe = {pe}: max errors {e:?}, order {p:.3}");
-        assert!((p - 1.0).abs() < 0.15, "Pe = {pe}: order {p:.3}, errors {e:?}");
+        assert!(
+            (p - 1.0).abs() < 0.15,
+            "Pe = {pe}: order {p:.3}, errors {e:?}"
+        );
     }
     Ok(())
 }
@@ -140,7 +143,10 @@ fn krylov_solvers_equal_lu_to_their_tolerance() -> Result {
             FaceFlux::Velocity(Arc::new(|x: &[f64]| [1.0 + x[1], 0.5, 0.0])),
             Arc::new(|x: &[f64]| (PI * x[0]).sin()),
         )
-        .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|x: &[f64]| x[1])))
+        .with_boundary(
+            "boundary",
+            BoundaryKind::Dirichlet(Arc::new(|x: &[f64]| x[1])),
+        )
     };
     let lu = problem().solve(&mesh)?;
     for method in [KrylovMethod::Gmres, KrylovMethod::Bicgstab] {
@@ -283,7 +289,10 @@ fn upwind_is_first_order_and_limited_about_second_order_in_l1() -> Result {
     let (h, e_limited) = translated(Scheme::Limited, 0.4, &[200, 400, 800])?;
     let p = order(&h, &e_limited);
     eprintln!("limited L1 errors {e_limited:?}, order {p:.3}");
-    assert!(p > 1.7 && p < 2.3, "limited order {p:.3}, errors {e_limited:?}");
+    assert!(
+        p > 1.7 && p < 2.3,
+        "limited order {p:.3}, errors {e_limited:?}"
+    );
     Ok(())
 }
 
@@ -323,7 +332,9 @@ fn limiter_creates_no_new_extrema() -> Result {
     for (t, u) in &limited.levels {
         let (lo, hi) = u
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(*v), b.max(*v))
+            });
         assert!(lo >= -1e-14 && hi <= 1.0 + 1e-14, "t = {t}: [{lo:e}, {hi}]");
         peak_limited = hi;
     }
@@ -336,7 +347,10 @@ fn limiter_creates_no_new_extrema() -> Result {
         .map(|(_, u)| u.iter().fold(0.0f64, |m, v| m.max(*v)))
         .ok_or("a level")?;
     eprintln!("plateau after 40 steps: limited {peak_limited}, upwind {peak_upwind}");
-    assert!(peak_limited > peak_upwind, "{peak_limited} vs {peak_upwind}");
+    assert!(
+        peak_limited > peak_upwind,
+        "{peak_limited} vs {peak_upwind}"
+    );
     Ok(())
 }
 

@@ -617,10 +617,10 @@ mod tests {
             max_iterations: 2,
             restart: 30,
         };
-        let identity = Ilu0::new(&RowMatrix::from_rows(
-            400,
-            (0..400).map(|i| vec![(i, 1.0)]).collect(),
-        ).expect("identity"))
+        let identity = Ilu0::new(
+            &RowMatrix::from_rows(400, (0..400).map(|i| vec![(i, 1.0)]).collect())
+                .expect("identity"),
+        )
         .expect("identity");
         assert!(matches!(
             gmres(&m, &b, None, &options, &identity),

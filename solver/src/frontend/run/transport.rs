@@ -278,7 +278,9 @@ pub(super) fn solve(
         .last()
         .map(|(_, u)| {
             u.iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(*v), b.max(*v))
+                })
         })
         .unwrap_or((0.0, 0.0));
     let first = run.mass.first().copied().unwrap_or(0.0);

@@ -29,11 +29,13 @@ fn normal_velocity(v: &[f64; 3], n: &[f64]) -> f64 {
 /// ```
 /// use hasse_complex::generate::rectangle;
 /// use hasse_solver::physics::transport::face_fluxes;
+/// use hasse_solver::physics::VectorFn;
 /// use std::sync::Arc;
 /// // v = (x², 0) on [0, 2]×[0, 1] in 2×1 squares: the middle edge x = 1
 /// // carries ∫ 1 dy = 1 along ±x, the right edge 4, the left 0.
 /// let mesh = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
-/// let flux = face_fluxes(&mesh, &Arc::new(|x: &[f64]| [x[0] * x[0], 0.0, 0.0])).unwrap();
+/// let v: VectorFn = Arc::new(|x: &[f64]| [x[0] * x[0], 0.0, 0.0]);
+/// let flux = face_fluxes(&mesh, &v).unwrap();
 /// let mut sizes: Vec<f64> = flux.iter().map(|f| f.abs()).filter(|f| *f > 0.0).collect();
 /// sizes.sort_by(f64::total_cmp);
 /// assert_eq!(sizes, vec![1.0, 4.0]);
@@ -66,7 +68,11 @@ pub fn face_fluxes(complex: &Complex, velocity: &VectorFn) -> Result<Vec<f64>, T
                 let vs = complex.cell_vertices(1, f);
                 let (a, b) = (point(vs[0]), point(vs[1]));
                 let s = 0.5 * (0.6f64).sqrt();
-                for (t, w) in [(0.5 - s, 5.0 / 18.0), (0.5, 8.0 / 18.0), (0.5 + s, 5.0 / 18.0)] {
+                for (t, w) in [
+                    (0.5 - s, 5.0 / 18.0),
+                    (0.5, 8.0 / 18.0),
+                    (0.5 + s, 5.0 / 18.0),
+                ] {
                     let x: Vec<f64> = a.iter().zip(b).map(|(p, q)| p + t * (q - p)).collect();
                     at(&x, w * areas[f])?;
                 }
@@ -167,7 +173,8 @@ impl Transport {
         let d = complex.embedding_dim();
         let flux = self.fluxes(complex)?;
         let top = complex.boundary(n);
-        let conditions = tagged_boundary_faces(complex, self.boundary.iter().map(|b| b.tag.as_str()))?;
+        let conditions =
+            tagged_boundary_faces(complex, self.boundary.iter().map(|b| b.tag.as_str()))?;
         let condition_of = |f: usize| {
             conditions
                 .binary_search_by_key(&f, |c| c.0)
@@ -201,7 +208,8 @@ impl Transport {
                                 point: x.to_vec(),
                                 flux: f64::from(s) * flow,
                                 condition: other.map(|kind| {
-                                    let tag = k.map_or(String::new(), |k| self.boundary[k].tag.clone());
+                                    let tag =
+                                        k.map_or(String::new(), |k| self.boundary[k].tag.clone());
                                     let name = match kind {
                                         BoundaryKind::Dirichlet(_) => "Dirichlet",
                                         BoundaryKind::Neumann(_) => "Neumann",

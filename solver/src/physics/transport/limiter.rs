@@ -112,8 +112,9 @@ impl Reconstruction {
                     let du = u[nb] - u[c];
                     lo = lo.min(u[nb]);
                     hi = hi.max(u[nb]);
-                    for i in 0..d {
-                        moment[i] += self.offsets[c][k * d + i] * du;
+                    let offset = &self.offsets[c][k * d..(k + 1) * d];
+                    for (m, r) in moment.iter_mut().zip(offset) {
+                        *m += r * du;
                     }
                 }
                 let p = &self.inverse[c];

@@ -120,7 +120,9 @@ impl Reader {
                 self.error(
                     k.span(),
                     "time",
-                    format!("[time] is for kind = \"heat\" or \"transport\"; this problem is {kind}"),
+                    format!(
+                        "[time] is for kind = \"heat\" or \"transport\"; this problem is {kind}"
+                    ),
                     Some("remove [time], or set problem.kind = \"heat\"".into()),
                 );
             }

@@ -27,9 +27,9 @@ mod overrides;
 mod problem;
 mod quantities;
 mod sections;
-mod transport;
 #[cfg(test)]
 mod tests;
+mod transport;
 
 use kinds::{kind_help, problem_kind, Conditions};
 pub(in crate::frontend::case) use overrides::apply_overrides;

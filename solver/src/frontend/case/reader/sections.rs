@@ -172,7 +172,10 @@ impl Reader {
                     format!("GMRES and BiCGStab serve the nonsymmetric systems of kind = \"transport\"; this case is kind = \"{}\"", problem_kind(root)),
                     Some("symmetric problems take \"direct\", \"multigrid\", \"amg\" or \"auto\"".into()),
                 );
-            } else if problem_kind(root) == "transport" && !krylov && spec.kind != SolverKind::Direct {
+            } else if problem_kind(root) == "transport"
+                && !krylov
+                && spec.kind != SolverKind::Direct
+            {
                 let span = self.entry(table, "solver", "type").and_then(|e| e.span());
                 self.error(
                     span,
@@ -180,7 +183,10 @@ impl Reader {
                     "a transport system is nonsymmetric: conjugate gradients (multigrid, amg, auto) and PETSc's CG do not apply",
                     Some("use \"direct\" (sparse LU), \"gmres\" or \"bicgstab\"".into()),
                 );
-            } else if !krylov && spec.kind != SolverKind::Direct && problem_kind(root) != "diffusion" {
+            } else if !krylov
+                && spec.kind != SolverKind::Direct
+                && problem_kind(root) != "diffusion"
+            {
                 let span = self.entry(table, "solver", "type").and_then(|e| e.span());
                 self.error(
                     span,

@@ -72,9 +72,15 @@ impl Reader {
         );
         let boundary = self.boundary(root, scope, Conditions::Steady);
         let transient = root.get("time").is_some();
-        let time = if transient { self.time(root).map(Some) } else { Some(None) };
+        let time = if transient {
+            self.time(root).map(Some)
+        } else {
+            Some(None)
+        };
         let initial = match (self.entry(table, "problem", "initial"), transient) {
-            (Some(_), true) => self.expression_at(table, "problem", "initial", scope).map(Some),
+            (Some(_), true) => self
+                .expression_at(table, "problem", "initial", scope)
+                .map(Some),
             (None, true) => {
                 self.error(
                     header,
