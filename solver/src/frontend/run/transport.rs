@@ -300,7 +300,7 @@ pub(super) fn solve(
     ));
     if run.courant > 1.0 {
         warnings.push(format!(
-            "the largest cell Courant number is {:.3} > 1: the upwind implicit step is stable but smears fronts over several cells per step",
+            "the largest cell Courant number is {:.3} > 1: a front crosses more than one cell per step, and the implicit upwind step smears it over several cells",
             run.courant
         ));
     }
