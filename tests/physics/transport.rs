@@ -8,7 +8,7 @@ use hasse_complex::generate::{interval, rectangle};
 use hasse_complex::Complex;
 use hasse_solver::la::krylov::KrylovOptions;
 use hasse_solver::physics::transport::{
-    FaceFlux, KrylovMethod, LinearSolver, Scheme, TimeStepping, Transport,
+    FaceFlux, KrylovMethod, KrylovPreconditioner, LinearSolver, Scheme, TimeStepping, Transport,
 };
 use hasse_solver::physics::{BoundaryKind, Conductivity};
 use std::f64::consts::PI;
@@ -120,7 +120,11 @@ fn krylov_solvers_equal_lu_to_their_tolerance() -> Result {
             max_iterations: 500,
             restart: 30,
         };
-        let solver = LinearSolver::Krylov { method, options };
+        let solver = LinearSolver::Krylov {
+            method,
+            options,
+            preconditioner: KrylovPreconditioner::Ilu0,
+        };
         let krylov = boundary_layer(100.0).with_solver(solver).solve(&mesh)?;
         let report = krylov.iterations.ok_or("a Krylov report")?;
         // ILU(0) of a tridiagonal matrix (one cell across) is its exact LU:
@@ -156,7 +160,11 @@ fn krylov_solvers_equal_lu_to_their_tolerance() -> Result {
             restart: 30,
         };
         let krylov = problem()
-            .with_solver(LinearSolver::Krylov { method, options })
+            .with_solver(LinearSolver::Krylov {
+                method,
+                options,
+                preconditioner: KrylovPreconditioner::Ilu0,
+            })
             .solve(&mesh)?;
         let iterations = krylov.iterations.ok_or("a Krylov report")?.iterations;
         eprintln!("{method:?} on the 24² grid: {iterations} iterations");
@@ -433,5 +441,72 @@ fn open_domain_balances_inflow_outflow_and_source() -> Result {
         (net_outflow - source).abs() < 1e-13 * scale,
         "{net_outflow} vs {source}"
     );
+    Ok(())
+}
+
+#[test]
+fn multigrid_of_the_diffusion_part_preconditions_independently_of_h() -> Result {
+    // Diffusion-dominated (K = 1, |v| ≈ 1, cell Péclet ≤ 1/32): a V-cycle
+    // of Aᵀ Ω_K A is a spectrally equivalent preconditioner of the whole
+    // operator, so GMRES needs about as many iterations on 64² as on 32²
+    // cells, and returns LU's solution to its tolerance.
+    let problem = || {
+        Transport::new(
+            Some(Conductivity::Scalar(Arc::new(|_| 1.0))),
+            FaceFlux::Velocity(Arc::new(|_| [1.0, 0.5, 0.0])),
+            Arc::new(|_| 1.0),
+        )
+        .with_boundary("boundary", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+    };
+    // Coarse levels down to 64 unknowns, so that the 32² and 64² grids
+    // get real hierarchies (the default factorises up to 4000).
+    let multigrid = hasse_solver::multigrid::MultigridOptions {
+        coarse_size: 64,
+        ..Default::default()
+    };
+    let mut counts = Vec::new();
+    for n in [32, 64] {
+        let mesh = rectangle(n, n, [0.0, 1.0], [0.0, 1.0])?;
+        let lu = problem().solve(&mesh)?;
+        let solver = LinearSolver::Krylov {
+            method: KrylovMethod::Gmres,
+            options: KrylovOptions {
+                tolerance: 1e-10,
+                max_iterations: 200,
+                restart: 30,
+            },
+            preconditioner: KrylovPreconditioner::DiffusionMultigrid(multigrid.clone()),
+        };
+        let krylov = problem().with_solver(solver).solve(&mesh)?;
+        let iterations = krylov.iterations.ok_or("a Krylov report")?.iterations;
+        let scale = lu.values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let difference = krylov
+            .values
+            .iter()
+            .zip(&lu.values)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(difference < 1e-8 * scale, "{n}²: {difference:e}");
+        counts.push(iterations);
+    }
+    eprintln!("GMRES + multigrid of the diffusion part: iterations {counts:?} on 32², 64²");
+    assert!(counts[1] <= 20 && counts[1] <= counts[0] + 3, "{counts:?}");
+    // Pure advection has no diffusion part to build it from.
+    let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0])?;
+    let advection = Transport::new(
+        None,
+        FaceFlux::Velocity(Arc::new(|_| [1.0, 0.0, 0.0])),
+        Arc::new(|_| 0.0),
+    )
+    .with_boundary("xmin", BoundaryKind::Dirichlet(Arc::new(|_| 0.0)))
+    .with_solver(LinearSolver::Krylov {
+        method: KrylovMethod::Bicgstab,
+        options: KrylovOptions::default(),
+        preconditioner: KrylovPreconditioner::DiffusionMultigrid(multigrid),
+    });
+    assert!(matches!(
+        advection.solve(&mesh),
+        Err(hasse_solver::physics::transport::TransportError::NoDiffusion)
+    ));
     Ok(())
 }

@@ -157,6 +157,10 @@ pub struct SolverSpec {
     /// `[solver.petsc] options`: PETSc's own command-line options
     /// (`"-ksp_type cg -pc_type hypre"`), applied after hasse's defaults.
     pub petsc_options: String,
+    /// `solver.preconditioner = "multigrid"` (default `"ilu0"`): GMRES and
+    /// BiCGStab of a transport case preconditioned by a multigrid V-cycle
+    /// of the diffusion part instead of ILU(0).
+    pub multigrid_preconditioner: bool,
     /// Newton/Picard settings of a nonlinear problem (`[solver.nonlinear]`).
     pub nonlinear: NonlinearSolverSpec,
 }
@@ -206,6 +210,7 @@ impl Default for SolverSpec {
             cell_prolongation: CellProlongation::Smoothed,
             ordering: Ordering::Automatic,
             petsc_options: String::new(),
+            multigrid_preconditioner: false,
             nonlinear: NonlinearSolverSpec::default(),
         }
     }

@@ -7,10 +7,12 @@ use super::*;
 use crate::frontend::case::{SolverKind, TransportSpec};
 use crate::la::krylov::KrylovOptions;
 use crate::physics::transport::{
-    FaceFlux, KrylovMethod, LinearSolver, Peclet, Scheme, TimeStepping, Transport, TransportError,
+    FaceFlux, KrylovMethod, KrylovPreconditioner, LinearSolver, Peclet, Scheme, TimeStepping,
+    Transport, TransportError,
 };
+use crate::multigrid::MultigridOptions;
 
-fn problem(case: &Case, spec: &TransportSpec) -> Transport {
+fn problem(case: &Case, spec: &TransportSpec) -> Result<Transport, RunError> {
     let velocity = vector_fn(&spec.velocity);
     let mut problem = Transport::new(
         spec.conductivity.as_ref().map(conductivity),
@@ -32,19 +34,34 @@ fn problem(case: &Case, spec: &TransportSpec) -> Transport {
         tolerance: case.solver.tolerance,
         ..KrylovOptions::default()
     };
-    problem.solver = match case.solver.kind {
-        SolverKind::Gmres => LinearSolver::Krylov {
-            method: KrylovMethod::Gmres,
-            options,
-        },
-        SolverKind::Bicgstab => LinearSolver::Krylov {
-            method: KrylovMethod::Bicgstab,
-            options,
-        },
-        // Others are refused for transport when the case is read.
-        _ => LinearSolver::Lu,
+    let preconditioner = if case.solver.multigrid_preconditioner {
+        if spec.conductivity.is_none() {
+            return Err(RunError::input_at(
+                case,
+                "solver.preconditioner",
+                TransportError::NoDiffusion.to_string(),
+                Some("remove solver.preconditioner (ILU(0)), or give a conductivity".into()),
+            ));
+        }
+        KrylovPreconditioner::DiffusionMultigrid(MultigridOptions::default())
+    } else {
+        KrylovPreconditioner::Ilu0
     };
-    problem
+    let method = match case.solver.kind {
+        SolverKind::Gmres => Some(KrylovMethod::Gmres),
+        SolverKind::Bicgstab => Some(KrylovMethod::Bicgstab),
+        // Others are refused for transport when the case is read.
+        _ => None,
+    };
+    problem.solver = match method {
+        Some(method) => LinearSolver::Krylov {
+            method,
+            options,
+            preconditioner,
+        },
+        None => LinearSolver::Lu,
+    };
+    Ok(problem)
 }
 
 /// A library error in the case's terms.
@@ -99,7 +116,12 @@ fn run_error(case: &Case, spec: &TransportSpec, error: TransportError) -> RunErr
         TransportError::Stepping { .. } => {
             RunError::input_at(case, "time", message, None).because(error)
         }
+        TransportError::NoDiffusion => {
+            RunError::input_at(case, "solver.preconditioner", message, None).because(error)
+        }
         TransportError::FluxSize { .. }
+        | TransportError::Multigrid(_)
+        | TransportError::Iterative(_)
         | TransportError::Canonical(_)
         | TransportError::Solve(_)
         | TransportError::Krylov(_) => RunError::solve(case, message, None).because(error),
@@ -138,7 +160,7 @@ pub(super) fn solve(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     check_dimension(case, spec, complex)?;
-    let transport = problem(case, spec);
+    let transport = problem(case, spec)?;
     let n = complex.dim();
     let started = Instant::now();
     let exact = case.exact.as_ref().and_then(|e| e.solution.as_ref());
@@ -167,9 +189,13 @@ pub(super) fn solve(
     let mut notes = Vec::new();
     let mut warnings = Vec::new();
     let mut report = serde_json::Map::new();
-    let solver_name = match transport.solver {
+    let solver_name = match &transport.solver {
         LinearSolver::Lu => "sparse LU (faer)".to_string(),
-        LinearSolver::Krylov { method, .. } => format!("{} with ILU(0)", method.name()),
+        LinearSolver::Krylov {
+            method,
+            preconditioner,
+            ..
+        } => format!("{} with {}", method.name(), preconditioner.name()),
     };
     let Some(time) = &spec.time else {
         phase("assembling and solving (transport)");
@@ -353,7 +379,7 @@ pub(super) fn solve(
 /// that are not finite where they are evaluated.
 pub(super) fn check(case: &Case, spec: &TransportSpec, complex: &Complex) -> Result<(), RunError> {
     check_dimension(case, spec, complex)?;
-    problem(case, spec)
+    problem(case, spec)?
         .check_data(complex)
         .map_err(|e| run_error(case, spec, e))
 }

@@ -1,9 +1,14 @@
 //! The assembled steady system M u = b and its solve (LU or Krylov).
 
 use super::flux::{Advection, Inflow};
-use super::{KrylovMethod, LinearSolver, Peclet, Transport, TransportError, TransportSolution};
+use super::{
+    KrylovMethod, KrylovPreconditioner, LinearSolver, Peclet, Transport, TransportError,
+    TransportSolution,
+};
 use crate::la::direct::{self, Factorization};
+use crate::la::iterative::{Preconditioner, RowMatrix};
 use crate::la::krylov::{bicgstab, gmres, rows_of, Ilu0};
+use crate::multigrid::Multigrid;
 use crate::physics::diffusion::CellCoefficients;
 use faer::sparse::SparseColMat;
 use hasse_complex::Complex;
@@ -152,8 +157,12 @@ impl Transport {
     /// Solve the steady problem M u = b.
     pub fn solve(&self, complex: &Complex) -> Result<TransportSolution, TransportError> {
         let system = self.assemble(complex)?;
-        let (values, iterations, relative_residual) =
-            solve_system(&system.matrix, &system.rhs, None, &self.solver)?;
+        let (values, iterations, relative_residual) = solve_system(
+            &system.matrix,
+            system.diffusion.as_ref(),
+            &system.rhs,
+            &self.solver,
+        )?;
         Ok(TransportSolution {
             values,
             unknowns: system.matrix.nrows(),
@@ -168,12 +177,31 @@ impl Transport {
 
 type Solved = (Vec<f64>, Option<crate::la::iterative::CgReport>, f64);
 
-/// Solve `matrix` x = `rhs` with `solver`, from `initial` for a Krylov
-/// method.
+/// The preconditioner of a Krylov solve of `rows`, with `diffusion` the
+/// symmetric part a multigrid preconditioner is built from.
+pub(super) fn preconditioner(
+    rows: &RowMatrix,
+    diffusion: Option<&SparseColMat<usize, f64>>,
+    kind: &KrylovPreconditioner,
+) -> Result<Box<dyn Preconditioner>, TransportError> {
+    Ok(match kind {
+        KrylovPreconditioner::Ilu0 => Box::new(Ilu0::new(rows)?),
+        KrylovPreconditioner::DiffusionMultigrid(options) => {
+            let diffusion = diffusion.ok_or(TransportError::NoDiffusion)?;
+            Box::new(Multigrid::algebraic(
+                RowMatrix::from_symmetric(diffusion)?,
+                options,
+            )?)
+        }
+    })
+}
+
+/// Solve `matrix` x = `rhs` with `solver` (`diffusion`: the symmetric part
+/// for a multigrid preconditioner).
 pub(super) fn solve_system(
     matrix: &SparseColMat<usize, f64>,
+    diffusion: Option<&SparseColMat<usize, f64>>,
     rhs: &[f64],
-    initial: Option<&[f64]>,
     solver: &LinearSolver,
 ) -> Result<Solved, TransportError> {
     match solver {
@@ -181,12 +209,16 @@ pub(super) fn solve_system(
             let (x, report) = direct::solve(matrix, rhs, Factorization::Lu)?;
             Ok((x, None, report.relative_residual))
         }
-        LinearSolver::Krylov { method, options } => {
+        LinearSolver::Krylov {
+            method,
+            options,
+            preconditioner: kind,
+        } => {
             let rows = rows_of(matrix)?;
-            let ilu = Ilu0::new(&rows)?;
+            let b = preconditioner(&rows, diffusion, kind)?;
             let (x, report) = match method {
-                KrylovMethod::Bicgstab => bicgstab(&rows, rhs, initial, options, &ilu)?,
-                KrylovMethod::Gmres => gmres(&rows, rhs, initial, options, &ilu)?,
+                KrylovMethod::Bicgstab => bicgstab(&rows, rhs, None, options, b.as_ref())?,
+                KrylovMethod::Gmres => gmres(&rows, rhs, None, options, b.as_ref())?,
             };
             Ok((x, Some(report), report.relative_residual))
         }

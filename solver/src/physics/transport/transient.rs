@@ -20,11 +20,11 @@
 //!   combination of face values.
 
 use super::limiter::Reconstruction;
-use super::steady::TransportSystem;
+use super::steady::{preconditioner, TransportSystem};
 use super::{KrylovMethod, LinearSolver, Peclet, Transport, TransportError};
 use crate::la::direct::{DirectSolver, Factor, Factorization, SolveError};
-use crate::la::iterative::RowMatrix;
-use crate::la::krylov::{bicgstab, gmres, rows_of, Ilu0, KrylovOptions};
+use crate::la::iterative::{Preconditioner, RowMatrix};
+use crate::la::krylov::{bicgstab, gmres, rows_of, KrylovOptions};
 use crate::physics::point_text;
 use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::Complex;
@@ -326,17 +326,35 @@ impl Transport {
             .map_err(|_| SolveError::OutOfMemory)?;
         enum Stepper {
             Lu(Factor),
-            Krylov(RowMatrix, Ilu0, KrylovMethod, KrylovOptions),
+            Krylov(RowMatrix, Box<dyn Preconditioner>, KrylovMethod, KrylovOptions),
         }
-        let stepper = match self.solver {
+        let stepper = match &self.solver {
             LinearSolver::Lu => Stepper::Lu(
                 DirectSolver::analyse(step_matrix.as_ref(), Factorization::Lu)?
                     .factorize(step_matrix.as_ref())?,
             ),
-            LinearSolver::Krylov { method, options } => {
+            LinearSolver::Krylov {
+                method,
+                options,
+                preconditioner: kind,
+            } => {
                 let rows = rows_of(&step_matrix)?;
-                let ilu = Ilu0::new(&rows)?;
-                Stepper::Krylov(rows, ilu, method, options)
+                // The diffusion part of the step matrix: V/Δt + θ D.
+                let diffusion = match &system.diffusion {
+                    Some(d) => {
+                        let mut scaled = d.clone();
+                        for v in scaled.val_mut() {
+                            *v *= theta;
+                        }
+                        Some(
+                            faer::sparse::ops::add(scaled.as_ref(), mass.as_ref())
+                                .map_err(|_| SolveError::OutOfMemory)?,
+                        )
+                    }
+                    None => None,
+                };
+                let b = preconditioner(&rows, diffusion.as_ref(), kind)?;
+                Stepper::Krylov(rows, b, *method, *options)
             }
         };
         for step in 1..=steps {
@@ -347,11 +365,11 @@ impl Transport {
             // Warm start: the previous level.
             let next = match &stepper {
                 Stepper::Lu(factor) => factor.solve(&rhs)?,
-                Stepper::Krylov(rows, ilu, KrylovMethod::Bicgstab, options) => {
-                    bicgstab(rows, &rhs, Some(u), options, ilu)?.0
+                Stepper::Krylov(rows, b, KrylovMethod::Bicgstab, options) => {
+                    bicgstab(rows, &rhs, Some(u), options, b.as_ref())?.0
                 }
-                Stepper::Krylov(rows, ilu, KrylovMethod::Gmres, options) => {
-                    gmres(rows, &rhs, Some(u), options, ilu)?.0
+                Stepper::Krylov(rows, b, KrylovMethod::Gmres, options) => {
+                    gmres(rows, &rhs, Some(u), options, b.as_ref())?.0
                 }
             };
             u.copy_from_slice(&next);

@@ -130,6 +130,7 @@ pub(super) const SOLVER_KEYS: &[&str] = &[
     "ordering",
     "petsc",
     "nonlinear",
+    "preconditioner",
 ];
 pub(super) const PETSC_KEYS: &[&str] = &["options"];
 /// Keys of `[solver.nonlinear]`.

@@ -196,6 +196,29 @@ impl Reader {
                 );
             }
         }
+        if let Some(name) = self.string_at(table, "solver", "preconditioner") {
+            let span = self
+                .entry(table, "solver", "preconditioner")
+                .and_then(|e| e.span());
+            match name.as_str() {
+                "ilu0" => {}
+                "multigrid" => spec.multigrid_preconditioner = true,
+                other => self.error(
+                    span.clone(),
+                    "solver.preconditioner",
+                    format!("unknown preconditioner \"{other}\""),
+                    Some("\"ilu0\" (incomplete LU of the whole matrix) or \"multigrid\" (a V-cycle of the diffusion part)".into()),
+                ),
+            }
+            if !matches!(spec.kind, SolverKind::Gmres | SolverKind::Bicgstab) {
+                self.error(
+                    span,
+                    "solver.preconditioner",
+                    "a preconditioner is chosen for solver.type = \"gmres\" or \"bicgstab\" only",
+                    Some("set solver.type, or remove solver.preconditioner".into()),
+                );
+            }
+        }
         if let Some((petsc, entry)) = self.subtable(table, "solver", "petsc") {
             self.check_keys(petsc, "solver.petsc", PETSC_KEYS);
             if let Some(options) = self.string_at(petsc, "solver.petsc", "options") {
