@@ -66,6 +66,24 @@ fn boundary_layer_is_first_order_and_krylov_equals_lu() -> Result {
             "{krylov}"
         );
     }
+    // A V-cycle of the diffusion part as the preconditioner: the same.
+    let multigrid = summary(
+        LAYER,
+        &[
+            "solver.type=\"gmres\"",
+            "solver.preconditioner=\"multigrid\"",
+            "solver.tolerance=1e-12",
+        ],
+    );
+    let e = reported(&multigrid, "error", "max")?;
+    assert!(
+        (e - ec).abs() <= 1e-9,
+        "multigrid: {e} vs {ec}\n{multigrid}"
+    );
+    assert!(
+        multigrid.contains("gmres with multigrid of the diffusion part"),
+        "{multigrid}"
+    );
     Ok(())
 }
 
@@ -162,6 +180,18 @@ fn check_refuses_bad_transport_input() -> Result {
     check_fails(
         &["problem.scheme=\"limited\""],
         "the limited scheme steps in time",
+    )?;
+    check_fails(
+        &["solver.preconditioner=\"multigrid\""],
+        "a preconditioner is chosen for solver.type = \"gmres\" or \"bicgstab\" only",
+    )?;
+    check_fails(
+        &[
+            "solver.type=\"gmres\"",
+            "solver.preconditioner=\"multigrid\"",
+            "problem.conductivity=0",
+        ],
+        "a pure advection problem has none",
     )?;
     let out = hasse(&[
         "check",

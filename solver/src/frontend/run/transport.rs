@@ -6,11 +6,11 @@
 use super::*;
 use crate::frontend::case::{SolverKind, TransportSpec};
 use crate::la::krylov::KrylovOptions;
+use crate::multigrid::MultigridOptions;
 use crate::physics::transport::{
     FaceFlux, KrylovMethod, KrylovPreconditioner, LinearSolver, Peclet, Scheme, TimeStepping,
     Transport, TransportError,
 };
-use crate::multigrid::MultigridOptions;
 
 fn problem(case: &Case, spec: &TransportSpec) -> Result<Transport, RunError> {
     let velocity = vector_fn(&spec.velocity);

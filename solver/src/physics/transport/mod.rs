@@ -70,8 +70,8 @@ pub use steady::TransportSystem;
 pub use transient::{Scheme, TimeStepping, TransportTransient};
 
 use crate::la::direct::SolveError;
-use crate::la::krylov::{KrylovError, KrylovOptions};
 use crate::la::iterative::CgError;
+use crate::la::krylov::{KrylovError, KrylovOptions};
 use crate::metric::Method;
 use crate::multigrid::{MultigridError, MultigridOptions};
 use crate::operator::CanonicalError;

@@ -326,7 +326,12 @@ impl Transport {
             .map_err(|_| SolveError::OutOfMemory)?;
         enum Stepper {
             Lu(Factor),
-            Krylov(RowMatrix, Box<dyn Preconditioner>, KrylovMethod, KrylovOptions),
+            Krylov(
+                RowMatrix,
+                Box<dyn Preconditioner>,
+                KrylovMethod,
+                KrylovOptions,
+            ),
         }
         let stepper = match &self.solver {
             LinearSolver::Lu => Stepper::Lu(
