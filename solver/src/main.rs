@@ -250,6 +250,15 @@ fn describe_problem(case: &Case) -> String {
             h.boundary.name()
         ),
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
+        Problem::Transport(t) => match &t.time {
+            Some(time) => format!(
+                "transport, method fv, {} scheme, {} steps of dt = {}",
+                t.scheme.name(),
+                time.steps,
+                time.dt
+            ),
+            None => "transport, method fv, upwind, steady".to_string(),
+        },
         Problem::Coupled(c) => format!(
             "coupled fields {} ({}) and {} ({})",
             c.fields[0].name,

@@ -38,3 +38,4 @@ mod nonlinear;
 mod probes;
 mod quantities;
 mod regions;
+mod transport;

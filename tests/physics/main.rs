@@ -21,3 +21,4 @@ mod maxwell;
 mod nonlinear;
 mod refinement;
 mod transient;
+mod transport;

@@ -7,5 +7,6 @@ pub mod direct;
 pub mod eigen;
 pub mod fixed;
 pub mod iterative;
+pub mod krylov;
 pub mod ordering;
 pub(crate) mod parallel;

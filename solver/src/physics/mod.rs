@@ -15,6 +15,7 @@ pub mod maxwell;
 pub mod nonlinear;
 pub mod probe;
 pub mod regions;
+pub mod transport;
 
 use crate::metric::Tensor;
 use hasse_complex::Complex;

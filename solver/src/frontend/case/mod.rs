@@ -39,11 +39,13 @@ mod mesh_checks;
 mod problem;
 mod quantity;
 mod reader;
+mod transport_spec;
 
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
 pub use quantity::{ProbeSpec, QuantityKind, QuantitySpec};
+pub use transport_spec::TransportSpec;
 
 use crate::frontend::mesh_spec::{MeshError, MeshSpec};
 use crate::la::direct::Factorization;
@@ -118,6 +120,11 @@ pub enum SolverKind {
     /// `mpi`): CG + GAMG by default, MUMPS when a factorisation is asked
     /// for, and `[solver.petsc] options` on top.
     Petsc,
+    /// Restarted GMRES(30) with ILU(0), for the nonsymmetric systems of
+    /// `kind = "transport"` ([`crate::la::krylov`]).
+    Gmres,
+    /// BiCGStab with ILU(0), for `kind = "transport"`.
+    Bicgstab,
 }
 
 /// Linear solver settings (`[solver]`).
@@ -150,6 +157,10 @@ pub struct SolverSpec {
     /// `[solver.petsc] options`: PETSc's own command-line options
     /// (`"-ksp_type cg -pc_type hypre"`), applied after hasse's defaults.
     pub petsc_options: String,
+    /// `solver.preconditioner = "multigrid"` (default `"ilu0"`): GMRES and
+    /// BiCGStab of a transport case preconditioned by a multigrid V-cycle
+    /// of the diffusion part instead of ILU(0).
+    pub multigrid_preconditioner: bool,
     /// Newton/Picard settings of a nonlinear problem (`[solver.nonlinear]`).
     pub nonlinear: NonlinearSolverSpec,
 }
@@ -199,6 +210,7 @@ impl Default for SolverSpec {
             cell_prolongation: CellProlongation::Smoothed,
             ordering: Ordering::Automatic,
             petsc_options: String::new(),
+            multigrid_preconditioner: false,
             nonlinear: NonlinearSolverSpec::default(),
         }
     }
@@ -481,6 +493,7 @@ impl Case {
         match &self.problem {
             Problem::Diffusion(d) => Some(d.method),
             Problem::Heat(h) => Some(h.method),
+            Problem::Transport(_) => Some(Method::Fv),
             Problem::Gradient(_)
             | Problem::Darcy(_)
             | Problem::Maxwell(_)

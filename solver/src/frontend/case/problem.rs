@@ -610,6 +610,8 @@ pub enum Problem {
     Elasticity(ElasticitySpec),
     /// `kind = "coupled"` (boxed: two diffusion specifications).
     Coupled(Box<CoupledSpec>),
+    /// `kind = "transport"`.
+    Transport(super::TransportSpec),
 }
 
 impl Problem {
@@ -624,6 +626,7 @@ impl Problem {
             Problem::Hodge(_) => "hodge-laplacian",
             Problem::Elasticity(_) => "elasticity",
             Problem::Coupled(_) => "coupled",
+            Problem::Transport(_) => "transport",
         }
     }
 
@@ -633,6 +636,7 @@ impl Problem {
             Problem::Diffusion(d) => &d.boundary,
             Problem::Heat(h) => &h.boundary,
             Problem::Darcy(d) => &d.boundary,
+            Problem::Transport(t) => &t.boundary,
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
@@ -670,6 +674,7 @@ impl Problem {
             Problem::Diffusion(d) => Some(&d.conductivity),
             Problem::Heat(h) => Some(&h.conductivity),
             Problem::Darcy(d) => Some(&d.permeability),
+            Problem::Transport(t) => t.conductivity.as_ref(),
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
@@ -685,6 +690,11 @@ impl Problem {
             Problem::Diffusion(d) => vec![("problem.conductivity".into(), &d.conductivity)],
             Problem::Heat(h) => vec![("problem.conductivity".into(), &h.conductivity)],
             Problem::Darcy(d) => vec![("problem.permeability".into(), &d.permeability)],
+            Problem::Transport(t) => t
+                .conductivity
+                .iter()
+                .map(|k| ("problem.conductivity".into(), k))
+                .collect(),
             Problem::Coupled(c) => c
                 .fields
                 .iter()
@@ -721,6 +731,12 @@ impl Problem {
         match self {
             Problem::Diffusion(d) => diffusion(&mut all, "problem", &d.conductivity, &d.source),
             Problem::Heat(h) => diffusion(&mut all, "problem", &h.conductivity, &h.source),
+            Problem::Transport(t) => {
+                if let Some(Coefficient::Scalar(e)) = &t.conductivity {
+                    all.push(("problem.conductivity".into(), e));
+                }
+                all.push(("problem.source".into(), &t.source));
+            }
             Problem::Coupled(c) => {
                 for (i, f) in c.fields.iter().enumerate() {
                     let prefix = format!("field[{i}]");

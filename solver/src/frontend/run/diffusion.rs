@@ -50,7 +50,11 @@ pub(super) fn solver_choice(
         _ => None,
     };
     Ok(Some(match case.solver.kind {
-        SolverKind::Direct | SolverKind::Petsc => return Ok(None),
+        // GMRES and BiCGStab are refused for diffusion and heat when the
+        // case is read.
+        SolverKind::Direct | SolverKind::Petsc | SolverKind::Gmres | SolverKind::Bicgstab => {
+            return Ok(None)
+        }
         SolverKind::Multigrid => match grid {
             Some(h) => SolverChoice::Multigrid(h),
             None => {

@@ -50,6 +50,8 @@ pub enum Failure {
     Refine(RefineError),
     /// Nonlinear diffusion (Newton or Picard).
     Nonlinear(NonlinearError),
+    /// Advection–diffusion.
+    Transport(crate::physics::transport::TransportError),
 }
 
 impl Failure {
@@ -65,6 +67,7 @@ impl Failure {
             Failure::Gradient(e) => e,
             Failure::Refine(e) => e,
             Failure::Nonlinear(e) => e,
+            Failure::Transport(e) => e,
         }
     }
 }
@@ -89,7 +92,8 @@ failure_from!(
     CoupledError => Coupled,
     GradientError => Gradient,
     RefineError => Refine,
-    NonlinearError => Nonlinear
+    NonlinearError => Nonlinear,
+    crate::physics::transport::TransportError => Transport
 );
 
 /// Why a run failed after the case was read: bad input found while

@@ -62,6 +62,7 @@ mod quantities;
 pub mod refine;
 mod restart;
 mod stream;
+mod transport;
 
 pub(crate) use diffusion::diffusion_problem;
 use diffusion::solve_diffusion;
@@ -155,6 +156,7 @@ pub fn solve(
         Problem::Hodge(spec) => hodge::solve(case, spec, complex, phase),
         Problem::Elasticity(spec) => elasticity::solve(case, spec, complex, phase),
         Problem::Coupled(spec) => coupled::solve(case, spec, complex, phase),
+        Problem::Transport(spec) => transport::solve(case, spec, complex, phase),
     }
 }
 
@@ -183,6 +185,7 @@ pub fn check_data(case: &Case, complex: &Complex) -> Result<(), RunError> {
         Problem::Maxwell(_) | Problem::Hodge(_) => Ok(()),
         Problem::Elasticity(spec) => elasticity::check(case, spec, complex),
         Problem::Coupled(spec) => coupled::check(case, spec, complex),
+        Problem::Transport(spec) => transport::check(case, spec, complex),
     }
 }
 

@@ -102,12 +102,14 @@ impl Reader {
                 );
             }
         }
-        if kind != "heat" {
+        if kind != "heat" && kind != "transport" {
             if let Some((k, _)) = root.get_key_value("time") {
                 self.error(
                     k.span(),
                     "time",
-                    format!("[time] is for kind = \"heat\"; this problem is {kind}"),
+                    format!(
+                        "[time] is for kind = \"heat\" or \"transport\"; this problem is {kind}"
+                    ),
                     Some("remove [time], or set problem.kind = \"heat\"".into()),
                 );
             }

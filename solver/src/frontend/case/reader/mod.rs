@@ -30,6 +30,7 @@ mod sections;
 #[cfg(test)]
 mod tests;
 mod time;
+mod transport;
 
 use kinds::{kind_help, problem_kind, Conditions};
 pub(in crate::frontend::case) use overrides::apply_overrides;
@@ -76,6 +77,8 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "a",
     "b",
     "c",
+    "velocity",
+    "scheme",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -104,6 +107,17 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],
     ),
     ("coupled", &["a", "b", "c"]),
+    (
+        "transport",
+        &[
+            "method",
+            "conductivity",
+            "source",
+            "velocity",
+            "initial",
+            "scheme",
+        ],
+    ),
 ];
 pub(super) const BOUNDARY_KEYS: &[&str] = &["tag", "type", "value", "alpha", "component"];
 pub(super) const EXACT_KEYS: &[&str] = &["solution", "gradient", "eigenvalues", "displacement"];
@@ -117,6 +131,7 @@ pub(super) const SOLVER_KEYS: &[&str] = &[
     "ordering",
     "petsc",
     "nonlinear",
+    "preconditioner",
 ];
 pub(super) const PETSC_KEYS: &[&str] = &["options"];
 /// Keys of `[solver.nonlinear]`.

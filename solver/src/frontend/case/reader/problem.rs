@@ -182,6 +182,7 @@ impl Reader {
             "hodge-laplacian" => self.hodge(root, table, problem_entry.span()),
             "elasticity" => self.elasticity(root, table, problem_entry.span(), scope),
             "coupled" => self.coupled(root, table, problem_entry.span(), scope),
+            "transport" => self.transport(root, table, problem_entry.span(), scope),
             "gradient" => {
                 if let Some(e) = self.entry(root, "", "boundary") {
                     self.error(

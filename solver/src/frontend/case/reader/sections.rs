@@ -138,6 +138,8 @@ impl Reader {
                 "multigrid" => SolverKind::Multigrid,
                 "amg" => SolverKind::Amg,
                 "auto" => SolverKind::Auto,
+                "gmres" => SolverKind::Gmres,
+                "bicgstab" => SolverKind::Bicgstab,
                 "petsc" => {
                     if !cfg!(feature = "mpi") {
                         let span = self.entry(table, "solver", "type").and_then(|e| e.span());
@@ -156,18 +158,36 @@ impl Reader {
                         span,
                         "solver.type",
                         format!("unknown solver type \"{other}\""),
-                        Some("\"direct\" (faer LLᵀ/LDLᵀ/LU), \"multigrid\" (CG with a V-cycle on the generator's grid levels), \"amg\" (CG with smoothed aggregation, any mesh), \"auto\", or \"petsc\" (PETSc over MPI)".into()),
+                        Some("\"direct\" (faer LLᵀ/LDLᵀ/LU), \"multigrid\" (CG with a V-cycle on the generator's grid levels), \"amg\" (CG with smoothed aggregation, any mesh), \"auto\", \"petsc\" (PETSc over MPI), or for transport \"gmres\" / \"bicgstab\" (ILU(0)-preconditioned)".into()),
                     );
                     SolverKind::Direct
                 }
             };
             let kind = problem_kind(root);
+            let krylov = matches!(spec.kind, SolverKind::Gmres | SolverKind::Bicgstab);
             let serves = match spec.kind {
                 SolverKind::Direct => true,
                 SolverKind::Petsc => kind == "diffusion",
+                SolverKind::Gmres | SolverKind::Bicgstab => kind == "transport",
                 _ => matches!(kind, "diffusion" | "heat"),
             };
-            if !serves {
+            if krylov && !serves {
+                let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                self.error(
+                    span,
+                    "solver.type",
+                    format!("GMRES and BiCGStab serve the nonsymmetric systems of kind = \"transport\"; this case is kind = \"{kind}\""),
+                    Some("symmetric problems take \"direct\", \"multigrid\", \"amg\" or \"auto\"".into()),
+                );
+            } else if kind == "transport" && !serves {
+                let span = self.entry(table, "solver", "type").and_then(|e| e.span());
+                self.error(
+                    span,
+                    "solver.type",
+                    "a transport system is nonsymmetric: conjugate gradients (multigrid, amg, auto) and PETSc's CG do not apply",
+                    Some("use \"direct\" (sparse LU), \"gmres\" or \"bicgstab\"".into()),
+                );
+            } else if !serves {
                 let span = self.entry(table, "solver", "type").and_then(|e| e.span());
                 let served = if spec.kind == SolverKind::Petsc {
                     "PETSc serves steady diffusion problems"
@@ -179,6 +199,29 @@ impl Reader {
                     "solver.type",
                     format!("{served}; this case is kind = \"{kind}\""),
                     Some("remove solver.type (direct)".into()),
+                );
+            }
+        }
+        if let Some(name) = self.string_at(table, "solver", "preconditioner") {
+            let span = self
+                .entry(table, "solver", "preconditioner")
+                .and_then(|e| e.span());
+            match name.as_str() {
+                "ilu0" => {}
+                "multigrid" => spec.multigrid_preconditioner = true,
+                other => self.error(
+                    span.clone(),
+                    "solver.preconditioner",
+                    format!("unknown preconditioner \"{other}\""),
+                    Some("\"ilu0\" (incomplete LU of the whole matrix) or \"multigrid\" (a V-cycle of the diffusion part)".into()),
+                ),
+            }
+            if !matches!(spec.kind, SolverKind::Gmres | SolverKind::Bicgstab) {
+                self.error(
+                    span,
+                    "solver.preconditioner",
+                    "a preconditioner is chosen for solver.type = \"gmres\" or \"bicgstab\" only",
+                    Some("set solver.type, or remove solver.preconditioner".into()),
                 );
             }
         }
