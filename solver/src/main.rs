@@ -249,6 +249,10 @@ fn describe_problem(case: &Case) -> String {
             h.method.name(),
             h.boundary.name()
         ),
+        Problem::Cohomology(c) => format!("cohomology, degree {}, {}", c.degree, c.method.name()),
+        Problem::Decomposition(d) => {
+            format!("hodge-decomposition of a 1-cochain, {}", d.method.name())
+        }
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
         Problem::Coupled(c) => format!(
             "coupled fields {} ({}) and {} ({})",
