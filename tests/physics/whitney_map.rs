@@ -112,8 +112,8 @@ fn whitney_reproduces_constant_fields_and_rotations() -> Result {
         for t in 0..box3.cell_count(3) {
             for p in points_in(&box3, t) {
                 let v = vector(interpolate(&box3, k, &c, t, &p)?);
-                for a in 0..3 {
-                    assert_abs_diff_eq!(v[a], constant(&p)[a], epsilon = 1e-13);
+                for (got, want) in v.iter().zip(constant(&p)) {
+                    assert_abs_diff_eq!(*got, want, epsilon = 1e-13);
                 }
             }
         }

@@ -69,6 +69,16 @@ pub struct HarmonicBasis {
     pub coclosed: Vec<f64>,
 }
 
+/// The exact part d α of a cochain and its potential α
+/// ([`Forms::exact_part`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExactPart {
+    /// α on the (k−1)-cells.
+    pub potential: Vec<f64>,
+    /// d α on the k-cells.
+    pub exact: Vec<f64>,
+}
+
 fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
@@ -357,12 +367,9 @@ impl Forms<'_> {
     /// least ⋆-distance, solving d_{k−1}ᵀ ⋆_k d_{k−1} α = d_{k−1}ᵀ ⋆_k ω
     /// (the canonical operator A = d_{k−1}, Ω = ⋆_k). For k = 1 the kernel
     /// (constants per component) is removed by holding α = 0 at one vertex
-    /// per component; other degrees are refused. Returns (α, d α).
-    pub fn exact_part(
-        &self,
-        k: usize,
-        omegas: &[Vec<f64>],
-    ) -> Result<Vec<(Vec<f64>, Vec<f64>)>, FormsError> {
+    /// per component; other degrees are refused. One [`ExactPart`] per
+    /// cochain of `omegas` (one factorisation for all).
+    pub fn exact_part(&self, k: usize, omegas: &[Vec<f64>]) -> Result<Vec<ExactPart>, FormsError> {
         self.check(k)?;
         if k != 1 {
             return Err(FormsError::Cohomology(format!(
@@ -404,7 +411,10 @@ impl Forms<'_> {
                 };
                 let alpha = split.lift(&free, &[]);
                 let exact = multiply(&d0, &alpha);
-                Ok((alpha, exact))
+                Ok(ExactPart {
+                    potential: alpha,
+                    exact,
+                })
             })
             .collect()
     }
@@ -439,7 +449,7 @@ impl Forms<'_> {
             self.exact_part(k, &generators)?
                 .into_iter()
                 .zip(&generators)
-                .map(|((_, exact), c)| c.iter().zip(&exact).map(|(a, b)| a - b).collect())
+                .map(|(part, c)| c.iter().zip(&part.exact).map(|(a, b)| a - b).collect())
                 .collect()
         };
         let d = self.d(k)?;

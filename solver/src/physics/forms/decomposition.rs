@@ -77,8 +77,8 @@ impl Forms<'_> {
             )));
         }
         let star = self.positive_diagonal(1, None, "the coexact part ⋆₁⁻¹ d₁ᵀ γ")?;
-        let mut exact = self.exact_part(1, &[omega.to_vec()])?;
-        let (potential, exact) = exact
+        let super::cohomology::ExactPart { potential, exact } = self
+            .exact_part(1, &[omega.to_vec()])?
             .pop()
             .ok_or_else(|| FormsError::Internal("no exact part".into()))?;
         let faces = complex.cell_count(2);

@@ -34,7 +34,7 @@ pub mod decomposition;
 pub mod laplacian;
 pub mod whitney_map;
 
-pub use cohomology::{cocycle_generators, HarmonicBasis};
+pub use cohomology::{cocycle_generators, ExactPart, HarmonicBasis};
 pub use decomposition::Decomposition;
 pub use laplacian::{Boundary, FormModes, HodgeLaplacian};
 
