@@ -15,7 +15,9 @@
 //!   period 1 along the tube, and co-closed exactly on the generator's
 //!   grid: each vertex's two θ-edges are mirror images (same ⋆, opposite
 //!   Δθ) and its φ-edges have Δθ = 0. So it is one of the harmonic forms'
-//!   span to rounding.
+//!   span to rounding. The other, f(φ) dφ around the tube with
+//!   f ∝ 1/(R + r cos φ), is the discrete harmonic form's limit at second
+//!   order.
 //! - The three parts of a Hodge decomposition are ⋆-orthogonal, so
 //!   ‖ω‖² = Σ‖part‖² (Pythagoras), whatever the solver does; ω = R₁∇φ
 //!   = d R₀ φ (Stokes, to rounding for polynomial φ) is all exact.
@@ -348,6 +350,59 @@ fn sphere_parts_converge_to_the_analytic_ones() -> Result {
             eprintln!("rate {rate:.3}");
             assert!((rate - 2.0).abs() < 0.15, "rate {rate} from {errors:?}");
         }
+    }
+    Ok(())
+}
+
+/// The harmonic 1-form around the tube of a torus of revolution (major
+/// radius R, minor r, ρ = R + r cos φ): h = f(φ) dφ is co-closed when
+/// ⋆h = f ρ/r dθ is closed, so f ∝ 1/ρ, and of period 1 around the tube
+/// for f = √(R² − r²)/(2π ρ) (since ∫₀^{2π} dφ/ρ = 2π/√(R² − r²)). Its de
+/// Rham cochain (∫ f dφ along each edge, 4-point Gauss in φ) is closed
+/// exactly and harmonic up to the discretisation: the exact part the
+/// discrete projection removes, relative in ⋆-norm, falls at second
+/// order: measured 1.4e-2, 3.7e-3, 9.3e-4 on 16×8, 32×16, 64×32 quads
+/// (rates 1.97, 1.99).
+#[test]
+fn torus_form_around_the_tube_converges_at_second_order() -> Result {
+    let (big, small): (f64, f64) = (2.0, 0.7);
+    let f = |phi: f64| (big * big - small * small).sqrt() / (2.0 * PI * (big + small * phi.cos()));
+    let mut errors = Vec::new();
+    for (n_major, n_minor) in [(16, 8), (32, 16), (64, 32)] {
+        let k = torus(big, small, n_major, n_minor)?;
+        let angle = |v: usize| {
+            let p = k.vertices().point(v);
+            p[2].atan2((p[0] * p[0] + p[1] * p[1]).sqrt() - big)
+        };
+        let cochain: Vec<f64> = (0..k.cell_count(1))
+            .map(|e| {
+                let v = k.cell_vertices(1, e);
+                let start = angle(v[0]);
+                let mut step = angle(v[1]) - start;
+                step -= 2.0 * PI * (step / (2.0 * PI)).round();
+                let nodes = [
+                    (-0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+                    (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+                    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+                    (0.861_136_311_594_052_6, 0.347_854_845_137_453_9),
+                ];
+                nodes
+                    .iter()
+                    .map(|(x, w)| w / 2.0 * step * f(start + step * (1.0 + x) / 2.0))
+                    .sum()
+            })
+            .collect();
+        let forms = Forms::new(&k, BARYCENTRIC);
+        let exact = forms.exact_part(1, std::slice::from_ref(&cochain))?;
+        let removed = &exact[0].exact;
+        errors
+            .push((forms.inner(1, removed, removed)? / forms.inner(1, &cochain, &cochain)?).sqrt());
+    }
+    eprintln!("‖dα‖/‖R₁h‖ at 16×8, 32×16, 64×32: {errors:?}");
+    for pair in errors.windows(2) {
+        let rate = (pair[0] / pair[1]).log2();
+        eprintln!("rate {rate:.3}");
+        assert!((rate - 2.0).abs() < 0.15, "rate {rate} from {errors:?}");
     }
     Ok(())
 }
