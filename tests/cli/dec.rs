@@ -104,6 +104,11 @@ fn check_refuses_what_is_not_computed() -> Result {
             "`problem.method`: the coexact part ⋆₁⁻¹ d₁ᵀ γ needs a diagonal Hodge star",
         ),
         (
+            "cases/cohomology-torus.toml",
+            vec!["exact.solution=\"0\""],
+            "`exact`: kind = \"cohomology\" compares with no exact solution",
+        ),
+        (
             "cases/hodge-decomposition-sphere.toml",
             vec!["problem.field=[\"x\", \"y\"]"],
             "`problem.field`: 2 components, but the mesh lives in R^3",

@@ -29,9 +29,17 @@ impl Reader {
         (method, span)
     }
 
-    /// Refuse `[[boundary]]` tables: these kinds use absolute (natural)
-    /// conditions only.
+    /// Refuse `[[boundary]]` tables (these kinds use absolute, natural,
+    /// conditions only) and `[exact]` (nothing is compared with it).
     fn refuse_boundary_tables(&mut self, root: &dyn TableLike, kind: &str) {
+        if let Some((k, _)) = root.get_key_value("exact") {
+            self.error(
+                k.span(),
+                "exact",
+                format!("kind = \"{kind}\" compares with no exact solution: its checks (closedness, co-closedness, orthogonality) need none"),
+                Some("remove the [exact] table".into()),
+            );
+        }
         if let Some((k, _)) = root.get_key_value("boundary") {
             self.error(
                 k.span(),
