@@ -36,7 +36,8 @@
 //! R_k of a polynomial field of degree ≤ 5 is exact to rounding. W_k is
 //! exact on the Whitney forms: W_k R_k reproduces constant vector fields on
 //! every simplex (k = 1 and the flux, see [`interpolate`]), linear
-//! functions for k = 0 and constant densities for k = n.
+//! functions for k = 0 and constant densities for k = n. [`probe`] finds
+//! the simplex that holds a point and evaluates the form there.
 //!
 //! ```
 //! use hasse_complex::generate::{kuhn, uniform_axis};
@@ -429,6 +430,37 @@ fn whitney_value(
             Proxy::Vector(v.into())
         }
     })
+}
+
+/// A probe of a k-cochain: the Whitney form at the point `x` of a mesh
+/// that fills its space, in the top simplex `locator` finds for it
+/// ([`crate::physics::probe::PointLocator`]); `None` outside the mesh.
+/// For a 1-cochain this is its Whitney vector at `x`.
+///
+/// ```
+/// use hasse_complex::generate::{kuhn, uniform_axis};
+/// use hasse_solver::physics::forms::whitney_map::{de_rham, probe, Field, Proxy};
+/// use hasse_solver::physics::probe::PointLocator;
+/// let x = uniform_axis(4, 0.0, 1.0).unwrap();
+/// let k = kuhn(&[x.clone(), x]).unwrap();
+/// let c = de_rham(&k, 1, Field::Vector(&|p| [-p[1], p[0], 0.0])).unwrap();
+/// let locator = PointLocator::new(&k).unwrap();
+/// // The rotation is a Whitney form: the probe gives it back exactly.
+/// let Some(Proxy::Vector(v)) = probe(&k, &locator, 1, &c, &[0.3, 0.8]).unwrap() else { panic!() };
+/// assert!((v[0] + 0.8).abs() < 1e-14 && (v[1] - 0.3).abs() < 1e-14);
+/// assert_eq!(probe(&k, &locator, 1, &c, &[1.5, 0.5]).unwrap(), None);
+/// ```
+pub fn probe(
+    complex: &Complex,
+    locator: &crate::physics::probe::PointLocator<'_>,
+    k: usize,
+    cochain: &[f64],
+    x: &[f64],
+) -> Result<Option<Proxy>, FormsError> {
+    match locator.locate(x) {
+        Some(cell) => interpolate(complex, k, cochain, cell, x).map(Some),
+        None => Ok(None),
+    }
 }
 
 /// The vector proxy of a k-cochain (k = 1, or k = 2 on a 3-complex) per
