@@ -249,7 +249,12 @@ fn describe_problem(case: &Case) -> String {
             h.method.name(),
             h.boundary.name()
         ),
-        Problem::Cohomology(c) => format!("cohomology, degree {}, {}", c.degree, c.method.name()),
+        Problem::Cohomology(c) => format!(
+            "cohomology, degree {}, {}, {} boundary",
+            c.degree,
+            c.method.name(),
+            c.boundary.name()
+        ),
         Problem::Decomposition(d) => {
             format!("hodge-decomposition of a 1-cochain, {}", d.method.name())
         }

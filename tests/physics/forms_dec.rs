@@ -406,3 +406,55 @@ fn torus_form_around_the_tube_converges_at_second_order() -> Result {
     }
     Ok(())
 }
+
+/// Relative (essential) harmonic 1-forms, zero on the boundary's edges:
+/// β₁(K, ∂K) = 1 on the annulus (Lefschetz: β₁ of the annulus), 0 on the
+/// square. On the annulus 1 ≤ r ≤ 2 it is d u for the harmonic function
+/// u = ln r / ln 2 that is 0 inside and 1 outside (⋆ of the absolute form
+/// dθ/2π, normalised to period 1 across): the discrete one, closed and
+/// co-closed at the interior vertices to 1e-12, approaches d R₀ u at
+/// second order: measured 1.3e-3, 3.6e-4, 9.1e-5 relative in ⋆-norm on
+/// 4×32, 8×64, 16×128 quads (rates 1.90, 1.97).
+#[test]
+fn relative_harmonic_forms_of_annulus_and_square() -> Result {
+    use hasse_complex::generate::rectangle;
+    use hasse_solver::physics::forms::Boundary;
+    let square = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0])?;
+    let basis = Forms::new(&square, BARYCENTRIC).harmonic_basis_with(1, Boundary::Essential)?;
+    assert_eq!((basis.forms.len(), basis.betti), (0, 0));
+    let mut errors = Vec::new();
+    for (n_radial, n_angular) in [(4, 32), (8, 64), (16, 128)] {
+        let ring = annulus(1.0, 2.0, n_radial, n_angular)?;
+        let forms = Forms::new(&ring, BARYCENTRIC);
+        let basis = forms.harmonic_basis_with(1, Boundary::Essential)?;
+        assert_eq!((basis.forms.len(), basis.betti), (1, 1));
+        assert!(
+            basis.closed[0] < 1e-12 && basis.coclosed[0] < 1e-12,
+            "{basis:?}"
+        );
+        let h = &basis.forms[0];
+        let wall = ring.boundary_subcomplex();
+        assert!((0..ring.cell_count(1)).all(|e| !wall.contains(1, e) || h[e] == 0.0));
+        let u = de_rham(
+            &ring,
+            0,
+            Field::Scalar(&|p| (p[0] * p[0] + p[1] * p[1]).sqrt().ln() / 2f64.ln()),
+        )?;
+        let du: Vec<f64> = forms
+            .d(0)?
+            .outer_iterator()
+            .map(|row| row.iter().map(|(v, &s)| f64::from(s) * u[v]).sum())
+            .collect();
+        // The sign of the class is the generator's: match it to d u.
+        let sign = forms.inner(1, h, &du)?.signum();
+        let difference: Vec<f64> = h.iter().zip(&du).map(|(a, b)| sign * a - b).collect();
+        errors.push((forms.inner(1, &difference, &difference)? / forms.inner(1, &du, &du)?).sqrt());
+    }
+    eprintln!("relative annulus errors: {errors:?}");
+    for pair in errors.windows(2) {
+        let rate = (pair[0] / pair[1]).log2();
+        eprintln!("rate {rate:.3}");
+        assert!((rate - 2.0).abs() < 0.15, "rate {rate} from {errors:?}");
+    }
+    Ok(())
+}

@@ -36,6 +36,10 @@ pub struct CohomologySpec {
     pub degree: usize,
     /// Where `problem.degree` is written, for the check against the mesh.
     pub degree_span: Option<Range<usize>>,
+    /// `problem.boundary`: natural (absolute, default) or essential
+    /// (relative: the forms vanish on the boundary; degree 1 on
+    /// 2-dimensional meshes).
+    pub boundary: crate::physics::forms::Boundary,
 }
 
 /// The Hodge decomposition of a 1-cochain given as a vector field

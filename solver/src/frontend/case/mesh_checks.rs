@@ -59,7 +59,19 @@ impl Case {
                         "k-forms live on k-cells; choose a degree from 0 to {n}"
                     )),
                 );
-            } else if matches!(self.problem, Problem::Cohomology(_))
+            } else if let Problem::Cohomology(spec) = &self.problem {
+                let relative = spec.boundary == crate::physics::forms::Boundary::Essential;
+                if relative && !(degree == 1 && n == 2) {
+                    collector.error(
+                        span.clone(),
+                        "problem.degree",
+                        format!("relative (essential) harmonic forms are computed for degree 1 on 2-dimensional meshes, not degree {degree} on a {n}-dimensional one"),
+                        Some("use boundary = \"natural\", or degree 1 on a surface or planar mesh".into()),
+                    );
+                }
+            }
+            if matches!(self.problem, Problem::Cohomology(_))
+                && degree <= n
                 && !(degree == 0 || degree == n || (degree == 1 && n == 2))
             {
                 collector.error(

@@ -10,7 +10,7 @@ use crate::frontend::case::{Case, CohomologySpec, DecompositionSpec};
 use crate::frontend::output::Cochain;
 use crate::la::direct::Factorization;
 use crate::physics::forms::whitney_map::{cell_vectors, de_rham, Field, ProxyKind};
-use crate::physics::forms::{Forms, FormsError};
+use crate::physics::forms::{Boundary, Forms, FormsError};
 use hasse_complex::Complex;
 use std::time::Instant;
 
@@ -82,13 +82,19 @@ pub(super) fn cohomology(
     let started = Instant::now();
     let k = spec.degree;
     let forms = Forms::new(complex, spec.method.star());
-    let basis = forms.harmonic_basis(k).map_err(|e| run_error(case, e))?;
+    let basis = forms
+        .harmonic_basis_with(k, spec.boundary)
+        .map_err(|e| run_error(case, e))?;
+    let betti_name = match spec.boundary {
+        Boundary::Natural => format!("β_{k}"),
+        Boundary::Essential => format!("β_{k}(K, ∂K)"),
+    };
     let seconds = started.elapsed().as_secs_f64();
     let count = basis.forms.len();
     let mut warnings = Vec::new();
     if count != basis.betti {
         warnings.push(format!(
-            "{count} cohomology generators of degree {k}, but the Betti number β_{k} = {} (a non-manifold or non-orientable complex?)",
+            "{count} cohomology generators of degree {k}, but the Betti number {betti_name} = {} (a non-manifold or non-orientable complex?)",
             basis.betti
         ));
     }
@@ -142,13 +148,18 @@ pub(super) fn cohomology(
     report.insert("forms".into(), serde_json::Value::Array(rows));
     report.insert(
         "cohomology".into(),
-        serde_json::json!({ "degree": k, "count": count, "betti": basis.betti }),
+        serde_json::json!({
+            "degree": k,
+            "count": count,
+            "betti": basis.betti,
+            "boundary": spec.boundary.name(),
+        }),
     );
     let notes = vec![
         (
             "cohomology".to_string(),
             format!(
-                "{count} harmonic {k}-forms from {count} cocycle generators, β_{k} = {}{}",
+                "{count} harmonic {k}-forms from {count} cocycle generators, {betti_name} = {}{}",
                 basis.betti,
                 if count == basis.betti {
                     ""

@@ -31,6 +31,12 @@
 //!   h = ⋆_n⁻¹ z / ⟨z, ⋆_n⁻¹ z⟩, the normalised volume form (co-closed:
 //!   dᵀ ⋆ h ∝ ∂z = 0). On a component with boundary H^n is zero.
 //!
+//! Relative classes, H¹(K, ∂K) for k = 1 on a 2-complex
+//! ([`Forms::harmonic_basis_with`] and [`Boundary::Essential`]), come from
+//! the same construction with the boundary's vertices as one ground node
+//! of the tree and the boundary's edges held at 0; their harmonic forms
+//! vanish on the boundary and are co-closed at the interior vertices.
+//!
 //! Other degrees (k = 1 or 2 on a 3-complex) are refused with
 //! [`FormsError::Cohomology`].
 //!
@@ -44,7 +50,7 @@
 //! assert!(basis.closed.iter().chain(&basis.coclosed).all(|r| *r < 1e-12));
 //! ```
 
-use super::{Forms, FormsError};
+use super::{Boundary, Forms, FormsError};
 use crate::la::direct::{DirectSolver, Factorization};
 use crate::la::fixed::FixedSplit;
 use crate::operator::Canonical;
@@ -61,7 +67,8 @@ pub struct HarmonicBasis {
     pub generators: Vec<Vec<f64>>,
     /// Their harmonic representatives h = c − dα, in the same order.
     pub forms: Vec<Vec<f64>>,
-    /// β_k over Q, from the ranks of ∂: `forms.len()` must equal it.
+    /// β_k over Q, from the ranks of ∂ (the relative β_k(K, ∂K) for
+    /// essential conditions): `forms.len()` must equal it.
     pub betti: usize,
     /// ‖d h‖_∞ / ‖h‖_∞ per form (0 for k = n).
     pub closed: Vec<f64>,
@@ -101,13 +108,26 @@ pub(crate) fn multiply_transpose(a: &CsMat<i8>, x: &[f64]) -> Vec<f64> {
     y
 }
 
-/// The vertices of each connected component of the 1-skeleton: a
-/// spanning forest as (tree edges mask, one root per component).
+/// A spanning forest of the 1-skeleton as (tree edges mask, one root per
+/// component).
 fn spanning_forest(complex: &Complex) -> (Vec<bool>, Vec<usize>) {
+    grounded_forest(complex, None)
+}
+
+/// A spanning forest of the 1-skeleton. With `wall` (the boundary
+/// subcomplex's vertices and edges), the wall's vertices are one ground
+/// node: the search starts from all of them at once and never uses a wall
+/// edge, so every interior vertex hangs on the ground or, in a component
+/// without boundary, on a root; the roots are returned (wall vertices are
+/// not).
+fn grounded_forest(complex: &Complex, wall: Option<(&[bool], &[bool])>) -> (Vec<bool>, Vec<usize>) {
     let vertices = complex.cell_count(0);
     let edges = complex.cell_count(1);
     let mut around = vec![Vec::new(); vertices];
     for e in 0..edges {
+        if wall.is_some_and(|(_, on_wall)| on_wall[e]) {
+            continue;
+        }
         let ends = complex.cell_vertices(1, e);
         if let [a, b] = ends {
             around[*a].push((e, *b));
@@ -117,13 +137,15 @@ fn spanning_forest(complex: &Complex) -> (Vec<bool>, Vec<usize>) {
     let mut seen = vec![false; vertices];
     let mut tree = vec![false; edges];
     let mut roots = Vec::new();
-    for start in 0..vertices {
-        if seen[start] {
-            continue;
+    let mut queue = VecDeque::new();
+    if let Some((ground, _)) = wall {
+        for v in (0..vertices).filter(|&v| ground[v]) {
+            seen[v] = true;
+            queue.push_back(v);
         }
-        roots.push(start);
-        seen[start] = true;
-        let mut queue = VecDeque::from([start]);
+    }
+    let mut next = 0;
+    loop {
         while let Some(v) = queue.pop_front() {
             for &(e, w) in &around[v] {
                 if !seen[w] {
@@ -133,8 +155,30 @@ fn spanning_forest(complex: &Complex) -> (Vec<bool>, Vec<usize>) {
                 }
             }
         }
+        while next < vertices && seen[next] {
+            next += 1;
+        }
+        if next == vertices {
+            break;
+        }
+        roots.push(next);
+        seen[next] = true;
+        queue.push_back(next);
     }
     (tree, roots)
+}
+
+/// The boundary subcomplex's vertices and edges as masks.
+fn wall_masks(complex: &Complex) -> (Vec<bool>, Vec<bool>) {
+    let wall = complex.boundary_subcomplex();
+    (
+        (0..complex.cell_count(0))
+            .map(|v| wall.contains(0, v))
+            .collect(),
+        (0..complex.cell_count(1))
+            .map(|e| wall.contains(1, e))
+            .collect(),
+    )
 }
 
 /// The integer cocycles of a basis of H^k(K) (see the module docs for
@@ -187,7 +231,7 @@ pub fn cocycle_generators(complex: &Complex, k: usize) -> Result<Vec<Vec<f64>>, 
             .collect());
     }
     if k == 1 && n == 2 {
-        return tree_cotree(complex);
+        return tree_cotree(complex, false);
     }
     Err(FormsError::Cohomology(format!(
         "cohomology generators of degree {k} on a {n}-complex are not computed (degrees 0 and {n}, and 1 on 2-complexes, are)"
@@ -242,11 +286,24 @@ pub(super) fn top_cycles(complex: &Complex) -> Vec<Vec<i8>> {
         .collect()
 }
 
-/// The tree–cotree cocycles of H¹ of a 2-complex.
-fn tree_cotree(complex: &Complex) -> Result<Vec<Vec<f64>>, FormsError> {
+/// The tree–cotree cocycles of H¹ of a 2-complex, or with `relative` of
+/// H¹(K, ∂K): then the wall's vertices are one ground node of the tree,
+/// wall edges are neither tree, cotree nor generators (their value is 0),
+/// and the cotree has no outside node (every face has its equation; the
+/// root's holds because the others do and the wall edges are 0).
+fn tree_cotree(complex: &Complex, relative: bool) -> Result<Vec<Vec<f64>>, FormsError> {
     let edges = complex.cell_count(1);
     let faces = complex.cell_count(2);
-    let (tree, _) = spanning_forest(complex);
+    let (ground, on_wall) = if relative {
+        wall_masks(complex)
+    } else {
+        (Vec::new(), vec![false; edges])
+    };
+    let (tree, _) = if relative {
+        grounded_forest(complex, Some((&ground, &on_wall)))
+    } else {
+        spanning_forest(complex)
+    };
     let cofaces = complex.boundary(2);
     let by_face = complex.boundary_csc(2);
     let outside = faces;
@@ -267,7 +324,7 @@ fn tree_cotree(complex: &Complex) -> Result<Vec<Vec<f64>>, FormsError> {
         }
     };
     let boundary_edges: Vec<usize> = (0..edges)
-        .filter(|&e| cofaces.outer_view(e).map_or(0, |r| r.nnz()) == 1)
+        .filter(|&e| !relative && cofaces.outer_view(e).map_or(0, |r| r.nnz()) == 1)
         .collect();
     let mut seen = vec![false; faces + 1];
     let mut cotree = vec![false; edges];
@@ -288,7 +345,7 @@ fn tree_cotree(complex: &Complex) -> Result<Vec<Vec<f64>>, FormsError> {
                         .unwrap_or_default()
                 };
                 for e in around {
-                    if tree[e] || cotree[e] {
+                    if tree[e] || cotree[e] || on_wall[e] {
                         continue;
                     }
                     let v = across(e, u)?;
@@ -312,7 +369,9 @@ fn tree_cotree(complex: &Complex) -> Result<Vec<Vec<f64>>, FormsError> {
             visit(f, &mut seen, &mut cotree)?;
         }
     }
-    let generators: Vec<usize> = (0..edges).filter(|&e| !tree[e] && !cotree[e]).collect();
+    let generators: Vec<usize> = (0..edges)
+        .filter(|&e| !tree[e] && !cotree[e] && !on_wall[e])
+        .collect();
     let d1 = complex.coboundary(1);
     generators
         .iter()
@@ -370,6 +429,19 @@ impl Forms<'_> {
     /// per component; other degrees are refused. One [`ExactPart`] per
     /// cochain of `omegas` (one factorisation for all).
     pub fn exact_part(&self, k: usize, omegas: &[Vec<f64>]) -> Result<Vec<ExactPart>, FormsError> {
+        self.exact_part_with(k, omegas, Boundary::Natural)
+    }
+
+    /// [`Forms::exact_part`] with a boundary condition: `Essential` holds α
+    /// = 0 on the boundary's vertices (the relative complex), so the exact
+    /// part vanishes on the boundary's edges, and pins a vertex only in
+    /// components without boundary.
+    pub fn exact_part_with(
+        &self,
+        k: usize,
+        omegas: &[Vec<f64>],
+        boundary: Boundary,
+    ) -> Result<Vec<ExactPart>, FormsError> {
         self.check(k)?;
         if k != 1 {
             return Err(FormsError::Cohomology(format!(
@@ -377,8 +449,17 @@ impl Forms<'_> {
             )));
         }
         let complex = self.complex;
-        let (_, roots) = spanning_forest(complex);
-        let mut pinned = vec![false; complex.cell_count(0)];
+        let (mut pinned, roots) = match boundary {
+            Boundary::Natural => (
+                vec![false; complex.cell_count(0)],
+                spanning_forest(complex).1,
+            ),
+            Boundary::Essential => {
+                let (ground, on_wall) = wall_masks(complex);
+                let roots = grounded_forest(complex, Some((&ground, &on_wall))).1;
+                (ground, roots)
+            }
+        };
         roots.iter().for_each(|&r| pinned[r] = true);
         let split = FixedSplit::from_mask(pinned);
         let d0 = complex.coboundary(0);
@@ -423,10 +504,33 @@ impl Forms<'_> {
     /// cohomology generator ([`cocycle_generators`]), with the closedness
     /// and co-closedness residuals of each.
     pub fn harmonic_basis(&self, k: usize) -> Result<HarmonicBasis, FormsError> {
+        self.harmonic_basis_with(k, Boundary::Natural)
+    }
+
+    /// [`Forms::harmonic_basis`] with a boundary condition: `Essential`
+    /// (relative: the forms vanish on the boundary's edges) is computed
+    /// for k = 1 on 2-complexes, from the relative tree–cotree cocycles
+    /// of H¹(K, ∂K), and the count is the relative Betti number; the
+    /// co-closedness residual is then measured at the interior vertices.
+    pub fn harmonic_basis_with(
+        &self,
+        k: usize,
+        boundary: Boundary,
+    ) -> Result<HarmonicBasis, FormsError> {
         self.check(k)?;
         let complex = self.complex;
         let n = complex.dim();
-        let generators = cocycle_generators(complex, k)?;
+        let relative = boundary == Boundary::Essential;
+        if relative && !(k == 1 && n == 2) {
+            return Err(FormsError::Cohomology(format!(
+                "relative (essential) harmonic forms are computed for degree 1 on 2-complexes, not degree {k} on a {n}-complex"
+            )));
+        }
+        let generators = if relative {
+            tree_cotree(complex, true)?
+        } else {
+            cocycle_generators(complex, k)?
+        };
         let forms: Vec<Vec<f64>> = if k == 0 {
             generators.clone()
         } else if k == n {
@@ -446,7 +550,7 @@ impl Forms<'_> {
                 })
                 .collect::<Result<_, _>>()?
         } else {
-            self.exact_part(k, &generators)?
+            self.exact_part_with(k, &generators, boundary)?
                 .into_iter()
                 .zip(&generators)
                 .map(|(part, c)| c.iter().zip(&part.exact).map(|(a, b)| a - b).collect())
@@ -463,11 +567,24 @@ impl Forms<'_> {
                 0.0
             } else {
                 let weighted = star.apply(h);
-                let divergence = multiply_transpose(&self.d(k - 1)?, &weighted);
+                let mut divergence = multiply_transpose(&self.d(k - 1)?, &weighted);
+                if relative {
+                    // Only interior (k−1)-cells carry the equation.
+                    let (ground, _) = wall_masks(complex);
+                    divergence
+                        .iter_mut()
+                        .zip(ground)
+                        .filter(|(_, wall)| *wall)
+                        .for_each(|(v, _)| *v = 0.0);
+                }
                 max_abs(&divergence) / max_abs(&weighted).max(f64::MIN_POSITIVE)
             });
         }
-        let betti = complex.betti_numbers().get(k).copied().unwrap_or(0);
+        let betti = if relative {
+            super::laplacian::relative_betti_numbers(complex)[k]
+        } else {
+            complex.betti_numbers().get(k).copied().unwrap_or(0)
+        };
         Ok(HarmonicBasis {
             degree: k,
             generators,

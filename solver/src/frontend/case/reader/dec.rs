@@ -4,6 +4,7 @@
 use super::*;
 use crate::frontend::case::expr::Scope;
 use crate::frontend::case::{CohomologySpec, DecompositionSpec, HodgeMethod, Problem};
+use crate::physics::forms::Boundary;
 use std::ops::Range;
 use toml_edit::TableLike;
 
@@ -64,6 +65,15 @@ impl Reader {
             header,
             "the degree k of the harmonic forms: 1 (one-forms) on a surface or planar mesh, or 0 or the mesh's dimension",
         );
+        let boundary = self.choice(
+            table,
+            "boundary",
+            &[Boundary::Natural, Boundary::Essential],
+            Boundary::name,
+            "boundary condition",
+            None,
+            Some(Boundary::Natural),
+        );
         self.refuse_boundary_tables(root, "cohomology");
         let (degree, degree_span) = degree?;
         Some(Problem::Cohomology(CohomologySpec {
@@ -71,6 +81,7 @@ impl Reader {
             method_span,
             degree,
             degree_span,
+            boundary: boundary?,
         }))
     }
 

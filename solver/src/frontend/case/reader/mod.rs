@@ -99,7 +99,7 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
         "hodge-laplacian",
         &["method", "degree", "modes", "boundary"],
     ),
-    ("cohomology", &["method", "degree"]),
+    ("cohomology", &["method", "degree", "boundary"]),
     ("hodge-decomposition", &["method", "field"]),
     (
         "elasticity",
