@@ -49,7 +49,9 @@
 //! - [`physics`]: each problem as canonical operators plus its data:
 //!   diffusion, transient heat, mixed Darcy, Maxwell cavities, linear
 //!   elasticity, coupled fields, normal gradients, and the k-form layer
-//!   [`physics::forms`] (d, ⋆, δ and the Hodge Laplacian Δ_k).
+//!   [`physics::forms`] (d, ⋆, δ, the Hodge Laplacian Δ_k, harmonic
+//!   forms from cohomology generators, the Hodge decomposition, and the
+//!   de Rham and Whitney maps between fields and cochains).
 //! - [`refine`] (re-solving on SPLIT-refined meshes) and [`study`]
 //!   (convergence orders and their tables).
 //! - [`distributed`]: the partitioned complex (owned top cells and their

@@ -249,6 +249,15 @@ fn describe_problem(case: &Case) -> String {
             h.method.name(),
             h.boundary.name()
         ),
+        Problem::Cohomology(c) => format!(
+            "cohomology, degree {}, {}, {} boundary",
+            c.degree,
+            c.method.name(),
+            c.boundary.name()
+        ),
+        Problem::Decomposition(d) => {
+            format!("hodge-decomposition of a 1-cochain, {}", d.method.name())
+        }
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
         Problem::Transport(t) => match &t.time {
             Some(time) => format!(

@@ -25,6 +25,7 @@ mod cli_input;
 mod cli_output;
 mod cli_physics;
 mod darcy_reports;
+mod dec;
 #[cfg(feature = "mpi")]
 mod distributed;
 mod doc_commands;

@@ -9,51 +9,97 @@ use crate::physics::regions::{top_cell_tags, RegionError, Regional};
 use hasse_complex::Complex;
 
 impl Case {
-    /// A Hodge Laplacian's degree must be at most the mesh's dimension, and
-    /// the circumcentric and Whitney stars need simplices.
+    /// A DEC kind's degree must be at most the mesh's dimension (and one
+    /// whose cohomology or decomposition is computed), and the
+    /// circumcentric and Whitney stars need simplices. Only these kinds
+    /// measure a periodic mesh unwrapped.
     pub(super) fn check_hodge(&self, complex: &Complex, collector: &mut Collector) {
-        let super::Problem::Hodge(spec) = &self.problem else {
-            // Only the stars and Whitney forms read a cell's geometry from
-            // its unwrapped points; every other kind's metrics, loads and
-            // error norms read vertex coordinates directly, and would see
-            // the cells that wrap around stretched across the domain.
-            if complex.vertices().period().is_some() {
-                collector.error(
-                    self.mesh_spans.get("generator").cloned(),
-                    "mesh.generator",
-                    format!(
-                        "a periodic mesh (the flat torus) is measured unwrapped only by the Hodge Laplacian's stars; kind = \"{}\" would read the wrapped cells' coordinates directly",
-                        self.problem.kind()
-                    ),
-                    Some("use kind = \"hodge-laplacian\" on generator = \"torus-flat\"".into()),
-                );
+        use super::Problem;
+        let (method, method_span, degree) = match &self.problem {
+            Problem::Hodge(spec) => (
+                spec.method,
+                &spec.method_span,
+                Some((spec.degree, &spec.degree_span)),
+            ),
+            Problem::Cohomology(spec) => (
+                spec.method,
+                &spec.method_span,
+                Some((spec.degree, &spec.degree_span)),
+            ),
+            Problem::Decomposition(spec) => (spec.method, &spec.method_span, None),
+            _ => {
+                // Only the stars and Whitney forms read a cell's geometry from
+                // its unwrapped points; every other kind's metrics, loads and
+                // error norms read vertex coordinates directly, and would see
+                // the cells that wrap around stretched across the domain.
+                if complex.vertices().period().is_some() {
+                    collector.error(
+                        self.mesh_spans.get("generator").cloned(),
+                        "mesh.generator",
+                        format!(
+                            "a periodic mesh (the flat torus) is measured unwrapped only by the DEC kinds (hodge-laplacian, cohomology, hodge-decomposition); kind = \"{}\" would read the wrapped cells' coordinates directly",
+                            self.problem.kind()
+                        ),
+                        Some("use kind = \"hodge-laplacian\" on generator = \"torus-flat\"".into()),
+                    );
+                }
+                return;
             }
-            return;
         };
         let n = complex.dim();
-        if spec.degree > n {
+        if let Some((degree, span)) = degree {
+            if degree > n {
+                collector.error(
+                    span.clone(),
+                    "problem.degree",
+                    format!(
+                        "degree {degree} is out of range: the mesh is {n}-dimensional, so 0 ≤ degree ≤ {n}"
+                    ),
+                    Some(format!(
+                        "k-forms live on k-cells; choose a degree from 0 to {n}"
+                    )),
+                );
+            } else if let Problem::Cohomology(spec) = &self.problem {
+                let relative = spec.boundary == crate::physics::forms::Boundary::Essential;
+                if relative && !(degree == 1 && n == 2) {
+                    collector.error(
+                        span.clone(),
+                        "problem.degree",
+                        format!("relative (essential) harmonic forms are computed for degree 1 on 2-dimensional meshes, not degree {degree} on a {n}-dimensional one"),
+                        Some("use boundary = \"natural\", or degree 1 on a surface or planar mesh".into()),
+                    );
+                }
+            }
+            if matches!(self.problem, Problem::Cohomology(_))
+                && degree <= n
+                && !(degree == 0 || degree == n || (degree == 1 && n == 2))
+            {
+                collector.error(
+                    span.clone(),
+                    "problem.degree",
+                    format!("cohomology generators of degree {degree} on a {n}-dimensional mesh are not computed (tree–cotree gives degree 1 on surfaces and planar meshes)"),
+                    Some(format!("choose degree 0 or {n}, or a 2-dimensional mesh for degree 1")),
+                );
+            }
+        }
+        if matches!(self.problem, Problem::Decomposition(_)) && n != 2 {
             collector.error(
-                spec.degree_span.clone(),
-                "problem.degree",
-                format!(
-                    "degree {} is out of range: the mesh is {n}-dimensional, so 0 ≤ degree ≤ {n}",
-                    spec.degree
-                ),
-                Some(format!(
-                    "k-forms live on k-cells; choose a degree from 0 to {n}"
-                )),
+                self.mesh_spans.get("").cloned(),
+                "mesh",
+                format!("the Hodge decomposition of 1-cochains is computed on 2-dimensional meshes (surfaces and planar domains); this mesh is {n}-dimensional"),
+                Some("use a surface (sphere, torus) or a planar mesh".into()),
             );
         }
-        if spec.method != super::HodgeMethod::DecBarycentric {
+        if method != super::HodgeMethod::DecBarycentric {
             if let Some(c) =
                 (0..complex.cell_count(n)).find(|&c| complex.cell_vertices(n, c).len() != n + 1)
             {
                 collector.error(
-                    spec.method_span.clone(),
+                    method_span.clone(),
                     "problem.method",
                     format!(
                         "method \"{}\" needs a simplicial mesh; top cell {c} has {} vertices",
-                        spec.method.name(),
+                        method.name(),
                         complex.cell_vertices(n, c).len()
                     ),
                     Some("use method = \"dec-barycentric\" on cells that are not simplices".into()),

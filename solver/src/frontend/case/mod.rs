@@ -32,6 +32,7 @@
 //! assert!(bad.to_string().contains("demo.toml:6:1: `problem.methdo`: unknown key"));
 //! ```
 
+mod dec_spec;
 pub mod diagnostic;
 pub mod expr;
 mod hodge_spec;
@@ -41,6 +42,7 @@ mod quantity;
 mod reader;
 mod transport_spec;
 
+pub use dec_spec::{CohomologySpec, DecompositionSpec};
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
@@ -498,6 +500,8 @@ impl Case {
             | Problem::Darcy(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
+            | Problem::Cohomology(_)
+            | Problem::Decomposition(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => None,
         }

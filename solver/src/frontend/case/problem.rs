@@ -3,7 +3,7 @@
 //! the file and before any mesh exists.
 
 use super::expr::Expression;
-use super::HodgeSpec;
+use super::{CohomologySpec, DecompositionSpec, HodgeSpec};
 use crate::metric::Method;
 use std::ops::Range;
 use std::path::PathBuf;
@@ -606,6 +606,10 @@ pub enum Problem {
     Maxwell(MaxwellSpec),
     /// `kind = "hodge-laplacian"`.
     Hodge(HodgeSpec),
+    /// `kind = "cohomology"`.
+    Cohomology(CohomologySpec),
+    /// `kind = "hodge-decomposition"`.
+    Decomposition(DecompositionSpec),
     /// `kind = "elasticity"`.
     Elasticity(ElasticitySpec),
     /// `kind = "coupled"` (boxed: two diffusion specifications).
@@ -624,6 +628,8 @@ impl Problem {
             Problem::Darcy(_) => "darcy",
             Problem::Maxwell(_) => "maxwell",
             Problem::Hodge(_) => "hodge-laplacian",
+            Problem::Cohomology(_) => "cohomology",
+            Problem::Decomposition(_) => "hodge-decomposition",
             Problem::Elasticity(_) => "elasticity",
             Problem::Coupled(_) => "coupled",
             Problem::Transport(_) => "transport",
@@ -640,6 +646,8 @@ impl Problem {
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
+            | Problem::Cohomology(_)
+            | Problem::Decomposition(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => &[],
         }
@@ -678,6 +686,8 @@ impl Problem {
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
+            | Problem::Cohomology(_)
+            | Problem::Decomposition(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => None,
         }
@@ -709,6 +719,8 @@ impl Problem {
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
+            | Problem::Cohomology(_)
+            | Problem::Decomposition(_)
             | Problem::Elasticity(_) => Vec::new(),
         }
     }
@@ -758,7 +770,12 @@ impl Problem {
                     all.push(("problem.poisson".into(), poisson));
                 }
             },
-            Problem::Gradient(_) | Problem::Darcy(_) | Problem::Maxwell(_) | Problem::Hodge(_) => {}
+            Problem::Gradient(_)
+            | Problem::Darcy(_)
+            | Problem::Maxwell(_)
+            | Problem::Hodge(_)
+            | Problem::Cohomology(_)
+            | Problem::Decomposition(_) => {}
         }
         all.retain(|(_, e)| e.regions().is_some());
         all

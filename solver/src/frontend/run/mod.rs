@@ -47,6 +47,7 @@ use std::time::Instant;
 mod consistency;
 mod coupled;
 mod darcy;
+mod dec;
 mod diffusion;
 mod disk;
 mod elasticity;
@@ -154,6 +155,8 @@ pub fn solve(
         Problem::Darcy(spec) => darcy::solve(case, spec, complex, phase),
         Problem::Maxwell(spec) => maxwell::solve(case, spec, complex, phase),
         Problem::Hodge(spec) => hodge::solve(case, spec, complex, phase),
+        Problem::Cohomology(spec) => dec::cohomology(case, spec, complex, phase),
+        Problem::Decomposition(spec) => dec::decomposition(case, spec, complex, phase),
         Problem::Elasticity(spec) => elasticity::solve(case, spec, complex, phase),
         Problem::Coupled(spec) => coupled::solve(case, spec, complex, phase),
         Problem::Transport(spec) => transport::solve(case, spec, complex, phase),
@@ -182,7 +185,8 @@ pub fn check_data(case: &Case, complex: &Complex) -> Result<(), RunError> {
         Problem::Gradient(spec) => gradient::check(case, spec, complex),
         Problem::Heat(spec) => heat::check(case, spec, complex),
         Problem::Darcy(spec) => darcy::check(case, spec, complex),
-        Problem::Maxwell(_) | Problem::Hodge(_) => Ok(()),
+        Problem::Maxwell(_) | Problem::Hodge(_) | Problem::Cohomology(_) => Ok(()),
+        Problem::Decomposition(spec) => dec::check(case, spec, complex),
         Problem::Elasticity(spec) => elasticity::check(case, spec, complex),
         Problem::Coupled(spec) => coupled::check(case, spec, complex),
         Problem::Transport(spec) => transport::check(case, spec, complex),

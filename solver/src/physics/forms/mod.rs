@@ -8,6 +8,9 @@
 //! | [`Forms::star`] | ⋆_k, an Ω over the k-cells | [`Star`]: circumcentric or barycentric diagonal \|⋆σ\|/\|σ\|, or the Whitney mass M_k |
 //! | [`Forms::codifferential`] | δ_k = ⋆_{k−1}⁻¹ d_{k−1}ᵀ ⋆_k (diagonal stars) | canonical coupling d_{k−1}ᵀ ⋆_k, scaled by 1/⋆_{k−1} |
 //! | [`Forms::hodge_laplacian`] | Δ_k as the pencil (K, M) | [`laplacian::HodgeLaplacian`] |
+//! | [`Forms::harmonic_basis`] | harmonic k-forms, one per cohomology class | integer cocycles ([`cohomology`]) made harmonic by one Poisson solve |
+//! | [`Forms::hodge_decomposition`] | ω = dα + δβ + h for 1-cochains on 2-complexes | two Poisson solves ([`decomposition`]) |
+//! | [`whitney_map::de_rham`], [`whitney_map::interpolate`] | fields ↔ cochains | quadrature over k-cells; Whitney forms |
 //!
 //! Every matrix is a canonical operator Aᵀ Ω B with A, B exact incidence
 //! matrices (d or a selection of cells) and Ω a star; nothing here is
@@ -26,8 +29,13 @@
 //! assert!(area < 4.0 * std::f64::consts::PI && area > 11.5);
 //! ```
 
+pub mod cohomology;
+pub mod decomposition;
 pub mod laplacian;
+pub mod whitney_map;
 
+pub use cohomology::{cocycle_generators, ExactPart, HarmonicBasis};
+pub use decomposition::Decomposition;
 pub use laplacian::{Boundary, FormModes, HodgeLaplacian};
 
 use crate::la::direct::SolveError;
@@ -85,6 +93,24 @@ pub enum FormsError {
     /// sparse matrix).
     #[error("{0} needs a diagonal Hodge star")]
     NeedsDiagonal(&'static str),
+    /// A field or cochain does not fit the degree (a vector field for a
+    /// function, a cochain of the wrong length, a degree without proxy).
+    #[error("{0}")]
+    Field(String),
+    /// A cell the operation needs to be a simplex is not one.
+    #[error("{dim}-cell {cell} has {vertices} vertices, but Whitney forms and the quadrature of the de Rham map need simplices here")]
+    NotSimplex {
+        /// Its dimension.
+        dim: usize,
+        /// The cell.
+        cell: usize,
+        /// Its vertex count.
+        vertices: usize,
+    },
+    /// Cohomology generators of this degree are not computed, or the
+    /// complex does not allow them (non-manifold, non-orientable).
+    #[error("{0}")]
+    Cohomology(String),
     /// The complex could not give a dual or a star.
     #[error(transparent)]
     Complex(#[from] ComplexError),

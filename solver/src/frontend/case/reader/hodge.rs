@@ -9,7 +9,7 @@ use toml_edit::TableLike;
 impl Reader {
     /// A nonnegative integer key of `[problem]` (`degree`, `modes`) with
     /// its span; `minimum` is its least value.
-    fn count(
+    pub(super) fn count(
         &mut self,
         table: &dyn TableLike,
         key: &str,

@@ -20,6 +20,7 @@ use std::path::{Path, PathBuf};
 use toml_edit::{ImDocument, Item, TableLike, Value};
 
 mod coupled;
+mod dec;
 mod elasticity;
 mod hodge;
 mod kinds;
@@ -102,6 +103,8 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
         "hodge-laplacian",
         &["method", "degree", "modes", "boundary"],
     ),
+    ("cohomology", &["method", "degree", "boundary"]),
+    ("hodge-decomposition", &["method", "field"]),
     (
         "elasticity",
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],

@@ -180,6 +180,8 @@ impl Reader {
             "darcy" => self.darcy(root, table, problem_entry.span(), scope),
             "maxwell" => self.maxwell(root, table, problem_entry.span()),
             "hodge-laplacian" => self.hodge(root, table, problem_entry.span()),
+            "cohomology" => self.cohomology(root, table, problem_entry.span()),
+            "hodge-decomposition" => self.decomposition(root, table, problem_entry.span(), scope),
             "elasticity" => self.elasticity(root, table, problem_entry.span(), scope),
             "coupled" => self.coupled(root, table, problem_entry.span(), scope),
             "transport" => self.transport(root, table, problem_entry.span(), scope),

@@ -1,0 +1,123 @@
+//! The `[problem]` tables of kind = "cohomology" and kind =
+//! "hodge-decomposition".
+
+use super::*;
+use crate::frontend::case::expr::Scope;
+use crate::frontend::case::{CohomologySpec, DecompositionSpec, HodgeMethod, Problem};
+use crate::physics::forms::Boundary;
+use std::ops::Range;
+use toml_edit::TableLike;
+
+impl Reader {
+    /// `problem.method` of a DEC kind, with its span.
+    fn star_method(
+        &mut self,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+    ) -> (Option<HodgeMethod>, Option<Range<usize>>) {
+        let span = self
+            .entry(table, "problem", "method")
+            .and_then(|e| e.span());
+        let method = self.choice(
+            table,
+            "method",
+            &HodgeMethod::ALL,
+            HodgeMethod::name,
+            "Hodge star",
+            header,
+            None,
+        );
+        (method, span)
+    }
+
+    /// Refuse `[[boundary]]` tables (these kinds use absolute, natural,
+    /// conditions only) and `[exact]` (nothing is compared with it).
+    fn refuse_boundary_tables(&mut self, root: &dyn TableLike, kind: &str) {
+        if let Some((k, _)) = root.get_key_value("exact") {
+            self.error(
+                k.span(),
+                "exact",
+                format!("kind = \"{kind}\" compares with no exact solution: its checks (closedness, co-closedness, orthogonality) need none"),
+                Some("remove the [exact] table".into()),
+            );
+        }
+        if let Some((k, _)) = root.get_key_value("boundary") {
+            self.error(
+                k.span(),
+                "boundary",
+                format!("kind = \"{kind}\" takes no boundary conditions (absolute conditions: no cochain is constrained)"),
+                Some("remove the [[boundary]] tables".into()),
+            );
+        }
+    }
+
+    pub(super) fn cohomology(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+    ) -> Option<Problem> {
+        let (method, method_span) = self.star_method(table, header.clone());
+        let degree = self.count(
+            table,
+            "degree",
+            0,
+            header,
+            "the degree k of the harmonic forms: 1 (one-forms) on a surface or planar mesh, or 0 or the mesh's dimension",
+        );
+        let boundary = self.choice(
+            table,
+            "boundary",
+            &[Boundary::Natural, Boundary::Essential],
+            Boundary::name,
+            "boundary condition",
+            None,
+            Some(Boundary::Natural),
+        );
+        self.refuse_boundary_tables(root, "cohomology");
+        let (degree, degree_span) = degree?;
+        Some(Problem::Cohomology(CohomologySpec {
+            method: method?,
+            method_span,
+            degree,
+            degree_span,
+            boundary: boundary?,
+        }))
+    }
+
+    pub(super) fn decomposition(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+        scope: &Scope,
+    ) -> Option<Problem> {
+        let (method, method_span) = self.star_method(table, header.clone());
+        if method == Some(HodgeMethod::Whitney) {
+            self.error(
+                method_span.clone(),
+                "problem.method",
+                "the coexact part ⋆₁⁻¹ d₁ᵀ γ needs a diagonal Hodge star; the Whitney mass is not diagonal",
+                Some("use method = \"dec\" (well-centred triangles) or \"dec-barycentric\"".into()),
+            );
+        }
+        let field = match self.entry(table, "problem", "field") {
+            Some(e) => self.expression_list(&e, scope),
+            None => {
+                self.error(
+                    header,
+                    "problem.field",
+                    "missing: the vector field whose line integrals along the edges are the 1-cochain ω",
+                    Some("e.g. field = [\"-y\", \"x\"] (one expression per coordinate)".into()),
+                );
+                None
+            }
+        };
+        self.refuse_boundary_tables(root, "hodge-decomposition");
+        Some(Problem::Decomposition(DecompositionSpec {
+            method: method.filter(|m| *m != HodgeMethod::Whitney)?,
+            method_span,
+            field: field?,
+        }))
+    }
+}

@@ -1,0 +1,350 @@
+//! Running the DEC kinds of the k-form layer besides the Hodge Laplacian:
+//! `cohomology` (a basis of harmonic k-forms from cohomology generators)
+//! and `hodge-decomposition` (a 1-cochain split into exact, coexact and
+//! harmonic parts). Both write their cochains and, where the degree's
+//! proxy is a vector field, its Whitney vector per top cell
+//! (`NAME_x`, `NAME_y`, `NAME_z`).
+
+use super::{vector_fn, RunError, RunResult};
+use crate::frontend::case::{Case, CohomologySpec, DecompositionSpec};
+use crate::frontend::output::Cochain;
+use crate::la::direct::Factorization;
+use crate::physics::forms::whitney_map::{cell_vectors, de_rham, Field, ProxyKind};
+use crate::physics::forms::{Boundary, Forms, FormsError};
+use hasse_complex::Complex;
+use std::time::Instant;
+
+/// Above this, a harmonic form's closedness or co-closedness residual is
+/// worth a warning: the construction is exact to rounding (≈ 1e-15).
+const RESIDUAL_WARNING: f64 = 1e-10;
+
+fn run_error(case: &Case, e: FormsError) -> RunError {
+    let message = e.to_string();
+    let located = match &e {
+        FormsError::Solve(_) | FormsError::Eigen(_) => RunError::solve(case, message, None),
+        FormsError::NonPositiveStar { .. } | FormsError::Metric(_) => RunError::input_at(
+            case,
+            "problem.method",
+            message,
+            Some("set `method = \"dec-barycentric\"` under [problem]".into()),
+        ),
+        FormsError::Degree { .. } | FormsError::Cohomology(_) => {
+            RunError::input_at(case, "problem.degree", message, None)
+        }
+        FormsError::Field(_) | FormsError::NotSimplex { .. } => {
+            RunError::input_at(case, "problem.field", message, None)
+        }
+        _ => RunError::input(case, message),
+    };
+    located.because(e)
+}
+
+/// The Whitney vector per top cell of a k-cochain as one cell field per
+/// embedding axis, when k-forms are vector fields here.
+fn vector_fields(
+    case: &Case,
+    complex: &Complex,
+    k: usize,
+    name: &str,
+    cochain: &[f64],
+    what: &str,
+) -> Result<Vec<Cochain>, RunError> {
+    let is_vector = ProxyKind::of(complex, k).is_ok_and(|p| p.is_vector());
+    if !is_vector {
+        return Ok(Vec::new());
+    }
+    let vectors = cell_vectors(complex, k, cochain).map_err(|e| run_error(case, e))?;
+    let n = complex.dim();
+    Ok(["x", "y", "z"]
+        .iter()
+        .enumerate()
+        .take(complex.embedding_dim())
+        .map(|(a, axis)| {
+            Cochain::new(
+                format!("{name}_{axis}"),
+                n,
+                vectors.iter().map(|v| v[a]).collect(),
+            )
+            .with_description(format!(
+                "{what}: component {axis} of its Whitney vector at each top cell's centroid (least-squares constant field on cells that are not simplices)"
+            ))
+        })
+        .collect())
+}
+
+pub(super) fn cohomology(
+    case: &Case,
+    spec: &CohomologySpec,
+    complex: &Complex,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    phase("cohomology generators and harmonic projection");
+    let started = Instant::now();
+    let k = spec.degree;
+    let forms = Forms::new(complex, spec.method.star());
+    let basis = forms
+        .harmonic_basis_with(k, spec.boundary)
+        .map_err(|e| run_error(case, e))?;
+    let betti_name = match spec.boundary {
+        Boundary::Natural => format!("β_{k}"),
+        Boundary::Essential => format!("β_{k}(K, ∂K)"),
+    };
+    let seconds = started.elapsed().as_secs_f64();
+    let count = basis.forms.len();
+    let mut warnings = Vec::new();
+    if count != basis.betti {
+        warnings.push(format!(
+            "{count} cohomology generators of degree {k}, but the Betti number {betti_name} = {} (a non-manifold or non-orientable complex?)",
+            basis.betti
+        ));
+    }
+    let mut table = String::from("  j   ‖h‖_⋆             ‖dh‖/‖h‖    ‖dᵀ⋆h‖/‖⋆h‖");
+    let mut rows = Vec::new();
+    let mut fields = Vec::new();
+    for (j, (h, c)) in basis.forms.iter().zip(&basis.generators).enumerate() {
+        let norm = forms.inner(k, h, h).map_err(|e| run_error(case, e))?.sqrt();
+        let (closed, coclosed) = (basis.closed[j], basis.coclosed[j]);
+        if closed.max(coclosed) > RESIDUAL_WARNING {
+            warnings.push(format!(
+                "harmonic form {} is closed to {closed:.1e} and co-closed to {coclosed:.1e}, above {RESIDUAL_WARNING:.0e}",
+                j + 1
+            ));
+        }
+        table.push_str(&format!(
+            "\n{:>3}   {norm:<17.10e} {closed:<11.3e} {coclosed:.3e}",
+            j + 1
+        ));
+        rows.push(serde_json::json!({
+            "form": j + 1,
+            "norm": norm,
+            "closed": closed,
+            "coclosed": coclosed,
+        }));
+        fields.push(
+            Cochain::new(format!("generator_{}", j + 1), k, c.clone())
+                .with_description(format!("integer {k}-cocycle of cohomology class {}", j + 1)),
+        );
+        fields.push(
+            Cochain::new(format!("harmonic_{}", j + 1), k, h.clone()).with_description(format!(
+                "the harmonic {k}-form of class {} (generator − dα)",
+                j + 1
+            )),
+        );
+        fields.extend(vector_fields(
+            case,
+            complex,
+            k,
+            &format!("harmonic_{}", j + 1),
+            h,
+            &format!("harmonic {k}-form {}", j + 1),
+        )?);
+    }
+    let worst = basis
+        .closed
+        .iter()
+        .chain(&basis.coclosed)
+        .fold(0.0f64, |m, r| m.max(*r));
+    let mut report = serde_json::Map::new();
+    report.insert("forms".into(), serde_json::Value::Array(rows));
+    report.insert(
+        "cohomology".into(),
+        serde_json::json!({
+            "degree": k,
+            "count": count,
+            "betti": basis.betti,
+            "boundary": spec.boundary.name(),
+        }),
+    );
+    let notes = vec![
+        (
+            "cohomology".to_string(),
+            format!(
+                "{count} harmonic {k}-forms from {count} cocycle generators, {betti_name} = {}{}",
+                basis.betti,
+                if count == basis.betti {
+                    ""
+                } else {
+                    "  ← differs"
+                }
+            ),
+        ),
+        ("forms".to_string(), table),
+    ];
+    Ok(RunResult {
+        problem: "cohomology".into(),
+        method: Some(spec.method.name().to_string()),
+        unknowns: complex.cell_count(k),
+        fields,
+        errors: None,
+        flux_error: None,
+        relative_residual: Some(worst),
+        factorization: Some(Factorization::Llt),
+        ordering: None,
+        timings: vec![("generators + projection".to_string(), seconds)],
+        warnings,
+        pure_neumann: false,
+        series: Vec::new(),
+        notes,
+        report,
+    })
+}
+
+/// The field must have one expression per coordinate and be finite at
+/// the edges' midpoints (where `hasse check` can see it).
+pub(super) fn check(
+    case: &Case,
+    spec: &DecompositionSpec,
+    complex: &Complex,
+) -> Result<(), RunError> {
+    let d = complex.embedding_dim();
+    if spec.field.len() != d {
+        return Err(RunError::input_at(
+            case,
+            "problem.field",
+            format!(
+                "{} components, but the mesh lives in R^{d}",
+                spec.field.len()
+            ),
+            Some(format!("give {d} expressions, one per coordinate")),
+        ));
+    }
+    let f = vector_fn(&spec.field);
+    let centroids = complex.centroid(1);
+    for e in 0..complex.cell_count(1) {
+        let x = &centroids[e * d..(e + 1) * d];
+        if f(x)[..d].iter().any(|v| !v.is_finite()) {
+            return Err(RunError::input_at(
+                case,
+                "problem.field",
+                format!("the field is not finite at {x:?} (the midpoint of edge {e})"),
+                Some("the field must be defined on the whole mesh".into()),
+            ));
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn decomposition(
+    case: &Case,
+    spec: &DecompositionSpec,
+    complex: &Complex,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    check(case, spec, complex)?;
+    phase("de Rham map and two Poisson solves");
+    let started = Instant::now();
+    let f = vector_fn(&spec.field);
+    let omega = de_rham(complex, 1, Field::Vector(&*f)).map_err(|e| run_error(case, e))?;
+    let forms = Forms::new(complex, spec.method.star());
+    let split = forms
+        .hodge_decomposition(&omega)
+        .map_err(|e| run_error(case, e))?;
+    let seconds = started.elapsed().as_secs_f64();
+    let inner = |a: &[f64], b: &[f64]| forms.inner(1, a, b).map_err(|e| run_error(case, e));
+    let total = inner(&omega, &omega)?;
+    let scale = total.max(f64::MIN_POSITIVE);
+    let names = ["exact", "coexact", "harmonic"];
+    let parts = split.parts();
+    let mut norms = Vec::new();
+    for p in parts {
+        norms.push(inner(p, p)?.sqrt());
+    }
+    let mut products = Vec::new();
+    for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+        products.push((i, j, inner(parts[i], parts[j])?));
+    }
+    let sum_squares: f64 = norms.iter().map(|n| n * n).sum();
+    let pythagoras = (total - sum_squares).abs() / scale;
+    let remainder: Vec<f64> = omega
+        .iter()
+        .enumerate()
+        .map(|(e, w)| w - parts.iter().map(|p| p[e]).sum::<f64>())
+        .collect();
+    let remainder_norm = inner(&remainder, &remainder)?.sqrt();
+    let mut table = format!("  ‖ω‖_⋆ = {:.10e}", total.sqrt());
+    for (name, norm) in names.iter().zip(&norms) {
+        table.push_str(&format!("\n  ‖{name}‖_⋆ = {norm:.10e}"));
+    }
+    let mut worst = pythagoras;
+    for (i, j, p) in &products {
+        let relative = p.abs() / scale;
+        worst = worst.max(relative);
+        table.push_str(&format!(
+            "\n  ⟨{}, {}⟩_⋆ / ‖ω‖² = {relative:.3e}",
+            names[*i], names[*j]
+        ));
+    }
+    table.push_str(&format!(
+        "\n  |‖ω‖² − Σ‖part‖²| / ‖ω‖² = {pythagoras:.3e}\n  ‖ω − (exact + coexact + harmonic)‖_⋆ = {remainder_norm:.3e}"
+    ));
+    let mut warnings = Vec::new();
+    if worst > RESIDUAL_WARNING {
+        warnings.push(format!(
+            "the parts are ⋆-orthogonal only to {worst:.1e} of ‖ω‖², above {RESIDUAL_WARNING:.0e}"
+        ));
+    }
+    let mut fields = vec![Cochain::new("omega", 1, omega.clone())
+        .with_description("ω = R₁F, the line integrals of the field along the edges")];
+    fields.extend(vector_fields(case, complex, 1, "omega", &omega, "ω")?);
+    let descriptions = [
+        "the exact part dα",
+        "the coexact part ⋆₁⁻¹ d₁ᵀ γ (δβ)",
+        "the harmonic part",
+    ];
+    for ((name, part), what) in names.iter().zip(parts).zip(descriptions) {
+        fields.push(Cochain::new(*name, 1, part.to_vec()).with_description(what));
+        fields.extend(vector_fields(case, complex, 1, name, part, what)?);
+    }
+    fields.push(
+        Cochain::new("potential", 0, split.potential.clone())
+            .with_description("α on the vertices, exact part = dα"),
+    );
+    fields.push(
+        Cochain::new("copotential", 2, split.copotential.clone())
+            .with_description("γ = ⋆₂β on the faces, coexact part = ⋆₁⁻¹ d₁ᵀ γ"),
+    );
+    let mut report = serde_json::Map::new();
+    report.insert(
+        "decomposition".into(),
+        serde_json::json!({
+            "norm": total.sqrt(),
+            "exact": norms[0],
+            "coexact": norms[1],
+            "harmonic": norms[2],
+            "exact_coexact": products[0].2,
+            "exact_harmonic": products[1].2,
+            "coexact_harmonic": products[2].2,
+            "pythagoras": pythagoras,
+            "remainder": remainder_norm,
+        }),
+    );
+    let notes = vec![
+        (
+            "split".to_string(),
+            format!(
+                "ω = R₁F on {} edges = exact + coexact + harmonic (Poisson on {} vertices, on {} faces)",
+                complex.cell_count(1),
+                complex.cell_count(0),
+                complex.cell_count(2)
+            ),
+        ),
+        ("parts".to_string(), table),
+    ];
+    Ok(RunResult {
+        problem: "hodge-decomposition".into(),
+        method: Some(spec.method.name().to_string()),
+        unknowns: complex.cell_count(0) + complex.cell_count(2),
+        fields,
+        errors: None,
+        flux_error: None,
+        relative_residual: Some(worst),
+        factorization: Some(Factorization::Llt),
+        ordering: None,
+        timings: vec![("de Rham map + two solves".to_string(), seconds)],
+        warnings,
+        pure_neumann: false,
+        series: Vec::new(),
+        notes,
+        report,
+    })
+}
