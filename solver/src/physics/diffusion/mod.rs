@@ -183,6 +183,47 @@ pub struct Iterative {
     pub preconditioner: Preconditioning,
 }
 
+impl Iterative {
+    /// The iterative solve `choice` asks for on `complex`, for unknowns at
+    /// `location`: multigrid-preconditioned CG to `tolerance`, or `None`
+    /// for a direct solve ([`SolverChoice::Auto`] decides by
+    /// [`multigrid::automatic`] on the number of unknowns). Diffusion and
+    /// heat choose alike.
+    pub fn chosen(
+        choice: SolverChoice,
+        tolerance: f64,
+        location: Location,
+        complex: &Complex,
+    ) -> Option<Self> {
+        let choice = match choice {
+            SolverChoice::Auto(hierarchy) => {
+                let n = complex.dim();
+                let unknowns = match location {
+                    Location::Nodal => complex.cell_count(0),
+                    Location::CellCentred => complex.cell_count(n),
+                    Location::Hybrid => complex.cell_count(n) + complex.cell_count(n - 1),
+                };
+                multigrid::automatic(n, unknowns, hierarchy)
+            }
+            other => other,
+        };
+        match choice {
+            SolverChoice::Multigrid(hierarchy) => Some(Iterative {
+                options: CgOptions {
+                    tolerance,
+                    ..CgOptions::default()
+                },
+                initial: None,
+                preconditioner: Preconditioning::Multigrid {
+                    hierarchy,
+                    options: MultigridOptions::default(),
+                },
+            }),
+            _ => None,
+        }
+    }
+}
+
 /// The preconditioner of an iterative solve.
 ///
 /// ```
@@ -583,32 +624,7 @@ impl Diffusion {
     /// assert!(report.relative_residual <= 1e-8 && report.iterations < 15);
     /// ```
     pub fn with_solver(mut self, choice: SolverChoice, tolerance: f64, complex: &Complex) -> Self {
-        let choice = match choice {
-            SolverChoice::Auto(hierarchy) => {
-                let n = complex.dim();
-                let unknowns = match self.location() {
-                    Location::Nodal => complex.cell_count(0),
-                    Location::CellCentred => complex.cell_count(n),
-                    Location::Hybrid => complex.cell_count(n) + complex.cell_count(n - 1),
-                };
-                multigrid::automatic(n, unknowns, hierarchy)
-            }
-            other => other,
-        };
-        self.iterative = match choice {
-            SolverChoice::Multigrid(hierarchy) => Some(Iterative {
-                options: CgOptions {
-                    tolerance,
-                    ..CgOptions::default()
-                },
-                initial: None,
-                preconditioner: Preconditioning::Multigrid {
-                    hierarchy,
-                    options: MultigridOptions::default(),
-                },
-            }),
-            _ => None,
-        };
+        self.iterative = Iterative::chosen(choice, tolerance, self.location(), complex);
         self
     }
 

@@ -25,14 +25,14 @@ mod tests;
 pub use balance::StepBalance;
 
 use crate::la::direct::{Factorization, SolveError};
-use crate::la::iterative::{CgError, CgOptions};
+use crate::la::iterative::CgError;
 use crate::la::ordering::Ordering;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::Location;
 use crate::metric::Method;
-use crate::multigrid::{self, MultigridError, MultigridOptions, SolverChoice};
+use crate::multigrid::{MultigridError, SolverChoice};
 use crate::operator::CanonicalError;
-use crate::physics::diffusion::{Diffusion, DiffusionError, Iterative, Preconditioning};
+use crate::physics::diffusion::{Diffusion, DiffusionError, Iterative};
 use crate::physics::regions::Regional;
 use crate::physics::{non_finite_text, point_text, BoundaryKind, Conductivity, Datum, ScalarFn};
 use hasse_complex::Complex;
@@ -467,7 +467,7 @@ impl Heat {
     /// [`SolverChoice::Multigrid`] builds a multigrid preconditioner once
     /// and runs conjugate gradients to `tolerance` at every step, started
     /// from the previous level, [`SolverChoice::Auto`] applies
-    /// [`multigrid::automatic`] to this method's unknowns on `complex`.
+    /// [`crate::multigrid::automatic`] to this method's unknowns on `complex`.
     ///
     /// ```
     /// use hasse_complex::generate::rectangle;
@@ -493,31 +493,8 @@ impl Heat {
     /// }
     /// ```
     pub fn with_solver(mut self, choice: SolverChoice, tolerance: f64, complex: &Complex) -> Self {
-        let choice = match choice {
-            SolverChoice::Auto(hierarchy) => {
-                let n = complex.dim();
-                let unknowns = match self.at(self.start).location() {
-                    Location::Nodal => complex.cell_count(0),
-                    _ => complex.cell_count(n),
-                };
-                multigrid::automatic(n, unknowns, hierarchy)
-            }
-            other => other,
-        };
-        self.iterative = match choice {
-            SolverChoice::Multigrid(hierarchy) => Some(Iterative {
-                options: CgOptions {
-                    tolerance,
-                    ..CgOptions::default()
-                },
-                initial: None,
-                preconditioner: Preconditioning::Multigrid {
-                    hierarchy,
-                    options: MultigridOptions::default(),
-                },
-            }),
-            _ => None,
-        };
+        let location = self.at(self.start).location();
+        self.iterative = Iterative::chosen(choice, tolerance, location, complex);
         self
     }
 
