@@ -234,12 +234,20 @@ fn describe_problem(case: &Case) -> String {
     match &case.problem {
         Problem::Diffusion(d) => format!("diffusion, method {}", d.method.name()),
         Problem::Gradient(_) => "gradient".to_string(),
-        Problem::Heat(h) => format!(
-            "heat, method {}, {} steps of dt = {}",
-            h.method.name(),
-            h.time.steps,
-            h.time.dt
-        ),
+        Problem::Heat(h) => match h.time.adaptive {
+            None => format!(
+                "heat, method {}, {} steps of dt = {}",
+                h.method.name(),
+                h.time.steps,
+                h.time.dt
+            ),
+            Some(tolerance) => format!(
+                "heat, method {}, adaptive steps from dt = {} to t = {} (tolerance {tolerance:e})",
+                h.method.name(),
+                h.time.dt,
+                h.time.start + h.time.steps as f64 * h.time.dt
+            ),
+        },
         Problem::Darcy(d) => format!("darcy, flux mass {:?}", d.mass),
         Problem::Maxwell(m) => format!("maxwell, {} modes, dual {:?}", m.modes, m.dual),
         Problem::Hodge(h) => format!(
