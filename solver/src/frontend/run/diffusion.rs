@@ -11,15 +11,7 @@ pub(crate) fn diffusion_problem(case: &Case, spec: &DiffusionSpec) -> Diffusion 
         problem = problem.with_source_by_region(source);
     }
     for b in &spec.boundary {
-        let kind = match &b.kind {
-            BoundaryKindSpec::Dirichlet(v) => BoundaryKind::Dirichlet(scalar_fn(v)),
-            BoundaryKindSpec::Neumann(v) => BoundaryKind::Neumann(scalar_fn(v)),
-            BoundaryKindSpec::Robin { alpha, value } => BoundaryKind::Robin {
-                alpha: scalar_fn(alpha),
-                value: scalar_fn(value),
-            },
-        };
-        problem = problem.with_boundary(&b.tag, kind);
+        problem = problem.with_boundary(&b.tag, super::boundary_kind(&b.kind));
     }
     if let Some(f) = case.solver.factorization {
         problem.factorization = f;

@@ -117,6 +117,19 @@ pub struct RunResult {
     pub report: serde_json::Map<String, serde_json::Value>,
 }
 
+/// A steady boundary condition of the case as the physics takes it:
+/// diffusion, nonlinear diffusion and transport read `[[boundary]]` alike.
+pub(crate) fn boundary_kind(spec: &BoundaryKindSpec) -> BoundaryKind {
+    match spec {
+        BoundaryKindSpec::Dirichlet(v) => BoundaryKind::Dirichlet(scalar_fn(v)),
+        BoundaryKindSpec::Neumann(v) => BoundaryKind::Neumann(scalar_fn(v)),
+        BoundaryKindSpec::Robin { alpha, value } => BoundaryKind::Robin {
+            alpha: scalar_fn(alpha),
+            value: scalar_fn(value),
+        },
+    }
+}
+
 pub(crate) fn scalar_fn(e: &crate::frontend::case::expr::Expression) -> ScalarFn {
     let e = e.clone();
     Arc::new(move |x: &[f64]| e.eval(x, 0.0))

@@ -62,15 +62,7 @@ pub(super) fn nonlinear_problem(
         problem = problem.with_reaction(coefficient(case, "problem.reaction", r)?);
     }
     for b in &spec.boundary {
-        let kind = match &b.kind {
-            BoundaryKindSpec::Dirichlet(v) => BoundaryKind::Dirichlet(scalar_fn(v)),
-            BoundaryKindSpec::Neumann(v) => BoundaryKind::Neumann(scalar_fn(v)),
-            BoundaryKindSpec::Robin { alpha, value } => BoundaryKind::Robin {
-                alpha: scalar_fn(alpha),
-                value: scalar_fn(value),
-            },
-        };
-        problem = problem.with_boundary(&b.tag, kind);
+        problem = problem.with_boundary(&b.tag, super::boundary_kind(&b.kind));
     }
     let settings = &case.solver.nonlinear;
     let monitor: Option<nonlinear::Monitor> = settings.monitor.then(|| {

@@ -20,15 +20,7 @@ fn problem(case: &Case, spec: &TransportSpec) -> Result<Transport, RunError> {
         scalar_fn(&spec.source),
     );
     for b in &spec.boundary {
-        let kind = match &b.kind {
-            BoundaryKindSpec::Dirichlet(v) => BoundaryKind::Dirichlet(scalar_fn(v)),
-            BoundaryKindSpec::Neumann(v) => BoundaryKind::Neumann(scalar_fn(v)),
-            BoundaryKindSpec::Robin { alpha, value } => BoundaryKind::Robin {
-                alpha: scalar_fn(alpha),
-                value: scalar_fn(value),
-            },
-        };
-        problem = problem.with_boundary(&b.tag, kind);
+        problem = problem.with_boundary(&b.tag, super::boundary_kind(&b.kind));
     }
     let options = KrylovOptions {
         tolerance: case.solver.tolerance,
