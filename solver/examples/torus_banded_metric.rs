@@ -21,6 +21,8 @@
 //!
 //! Usage: cargo run -p hasse-solver --example torus_banded_metric -- 50 50 minor cases/torus-banded-omega.txt
 
+// ci-args: 10 4 minor {tmp}/banded.txt
+
 use std::io::Write;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
