@@ -15,7 +15,7 @@
 //! // Nodal Q1 elements: A = δ⁰ (edges × vertices), Ω one block per cell.
 //! let stiffness = Canonical::new(k.coboundary(0), fe::stiffness_metric(&k, &[1.0; 64]).unwrap()).unwrap();
 //! // Cell-centred two-point finite volumes: A = ∂₂ (edges × cells), Ω diagonal.
-//! let tpfa = Canonical::new(k.shared_boundary(2), fv::two_point(&k, &[1.0; 64]).unwrap()).unwrap();
+//! let tpfa = Canonical::new(k.boundary(2), fv::two_point(&k, &[1.0; 64]).unwrap()).unwrap();
 //! // The FE rows of A are differences along edges: constants are the
 //! // kernel of the (Neumann) operator.
 //! assert!(stiffness.apply(&vec![1.0; 81]).iter().all(|v| v.abs() < 1e-12));
@@ -63,16 +63,45 @@
 //!
 //! The rule is checked by the test `tests/methods/layers.rs`: it fails when a
 //! lower layer names a higher one.
+//!
+//! ## Using it as a library
+//!
+//! [`prelude`] brings the common names in with one `use`; `sprs`, `faer`
+//! and `hasse_complex` are re-exported so that a program names the
+//! versions hasse was built with. The front end (case files, HDF5
+//! output, the command line, convergence plots) is the default cargo
+//! feature `cli`; a program that only builds operators and solves can
+//! leave it and its dependencies out:
+//!
+//! ```toml
+//! hasse-solver = { path = "…/solver", default-features = false }
+//! ```
+//!
+//! Accessors of the complex return shared matrices: `k.boundary(p)` and
+//! `k.coboundary(p)` are `&Arc<CsMat<i8>>`, read through deref and handed
+//! to operators without a copy; `try_boundary`/`try_coboundary` return an
+//! error instead of panicking for a degree out of range. Products of them
+//! dereference explicitly (`&**k.boundary(1) * &**k.boundary(2)`), since
+//! `sprs` multiplies matrices, not pointers to them.
 
 #![warn(missing_docs)]
 
+// The crates whose types appear in hasse's public API, so that a user
+// names the same versions: `hasse_solver::sprs::CsMat`,
+// `hasse_solver::faer::Mat`, `hasse_solver::complex::Complex`.
+pub use faer;
+pub use hasse_complex as complex;
+pub use sprs;
+
 pub mod distributed;
+#[cfg(feature = "cli")]
 pub mod frontend;
 pub mod la;
 pub mod metric;
 pub mod multigrid;
 pub mod operator;
 pub mod physics;
+pub mod prelude;
 pub mod refine;
 pub mod study;
 

@@ -11,10 +11,12 @@
 //! (SVG or PNG bytes); writing the files is the front end's.
 
 mod orders;
+#[cfg(feature = "cli")]
 mod plot;
 mod table;
 
 pub use orders::{least_squares_order, pairwise_orders, OrderError};
+#[cfg(feature = "cli")]
 pub use plot::{PlotError, PlotFormat, PlotOptions};
 
 use serde::Serialize;
