@@ -72,11 +72,11 @@ fn diffusion_case(label: &str, complex: &Complex, method: Method, plain: Option<
     let (t, faults_start) = (Instant::now(), faults());
     let (incidence, metric) = match method {
         Method::Fv => (
-            complex.shared_boundary(d),
+            Arc::clone(complex.boundary(d)),
             fv::two_point(complex, &tensors).expect("metric"),
         ),
         _ => (
-            Arc::new(complex.coboundary(0)),
+            Arc::clone(complex.coboundary(0)),
             fe::stiffness_metric(complex, &tensors).expect("metric"),
         ),
     };

@@ -178,7 +178,7 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
         "direct" => {
             let (system, complex_s, assembly_s) = build(d, n);
             let t = Instant::now();
-            let solver = DirectSolver::analyse(system.matrix.as_ref(), Factorization::Llt)
+            let solver = DirectSolver::analyze(system.matrix.as_ref(), Factorization::Llt)
                 .expect("analysis");
             let factor = solver.factorize(system.matrix.as_ref()).expect("SPD");
             let factor_s = seconds(t);
@@ -315,7 +315,7 @@ fn whole_solve(mut problem: Diffusion, complex: &Complex) -> String {
         report.symbolic_seconds,
         report.numeric_seconds,
         report.solve_seconds,
-        solution.analysed_during_assembly,
+        solution.analyzed_during_assembly,
         report.factor_entries.unwrap_or(0),
         report.factor_flops.unwrap_or(f64::NAN),
         report.relative_residual
@@ -354,7 +354,7 @@ fn ordered_llt(matrix: &SparseColMat<usize, f64>, rhs: &[f64], phase: &str) -> S
     };
     let reset = reset_peak_memory();
     let t = Instant::now();
-    let solver = DirectSolver::analyse_with(matrix.as_ref(), Factorization::Llt, ordering)
+    let solver = DirectSolver::analyze_with(matrix.as_ref(), Factorization::Llt, ordering)
         .expect("analysis");
     let analysis_s = seconds(t);
     let t = Instant::now();

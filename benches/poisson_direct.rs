@@ -24,11 +24,12 @@ use std::time::Instant;
 #[path = "common/measure.rs"]
 mod measure;
 use measure::{max_difference, peak_memory_gib, plain_matrix, plain_q1_matrix, seconds};
+use std::sync::Arc;
 
 fn factor_and_solve(matrix: &SparseColMat<usize, f64>) -> (f64, f64, f64, String) {
     let rhs = vec![1.0; matrix.nrows()];
     let t = Instant::now();
-    let solver = DirectSolver::analyse(matrix.as_ref(), Factorization::Llt).expect("analysis");
+    let solver = DirectSolver::analyze(matrix.as_ref(), Factorization::Llt).expect("analysis");
     let symbolic = seconds(t);
     let t = Instant::now();
     let factor = solver.factorize(matrix.as_ref()).expect("SPD");
@@ -47,11 +48,11 @@ fn run(label: &str, complex: &Complex, n: usize, method: &str) {
     let tensors = vec![1.0; cells];
     let (incidence, metric) = match method {
         "fv" => (
-            complex.shared_boundary(d),
+            Arc::clone(complex.boundary(d)),
             fv::two_point(complex, &tensors).expect("metric"),
         ),
         _ => (
-            complex.shared_coboundary(0),
+            Arc::clone(complex.coboundary(0)),
             fe::stiffness_metric(complex, &tensors).expect("metric"),
         ),
     };

@@ -27,7 +27,7 @@ use std::sync::{Arc, OnceLock};
 /// assert_eq!(k.cell_counts(), vec![4, 5, 2]);
 /// assert_eq!(k.euler_characteristic(), 1);
 /// // ∂1 ∂2 = 0, exactly.
-/// let dd = k.boundary(1) * k.boundary(2);
+/// let dd = &**k.boundary(1) * &**k.boundary(2);
 /// assert!(dd.data().iter().all(|&x| x == 0));
 /// ```
 #[derive(Clone, Debug)]
@@ -212,60 +212,124 @@ impl Complex {
         self.lar.cell_vertices(p, i)
     }
 
-    /// The signed boundary matrix ∂_p (|K_{p-1}| × |K_p|, CSR), 1 ≤ p ≤ n.
+    /// The signed boundary matrix ∂_p (|K_{p-1}| × |K_p|, CSR), 1 ≤ p ≤ n,
+    /// shared with the complex: deref it to read (`k.boundary(2).rows()`),
+    /// pass it where an operator keeps its incidence matrix
+    /// (`Canonical::new(k.boundary(2), …)` clones the pointer, not the
+    /// matrix), or `Arc::clone` it to keep it beyond the complex.
     ///
     /// # Panics
-    /// When p is 0 or exceeds the dimension; use [`Complex::try_boundary`] for
-    /// indices that come from user input.
-    pub fn boundary(&self, p: usize) -> &CsMat<i8> {
-        &self.boundaries[p - 1]
-    }
-
-    /// ∂_p, shared with the complex (no copy), for operators that keep it.
+    /// When p is 0 or exceeds the dimension; [`Complex::try_boundary`]
+    /// returns an error instead, for degrees that come from user input.
     ///
     /// ```
     /// use hasse_complex::generate::rectangle;
     /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
-    /// let shared = k.shared_boundary(2);
-    /// assert!(std::ptr::eq(&*shared, k.boundary(2)));
+    /// assert_eq!(k.boundary(2).shape(), (7, 2)); // 7 edges, 2 squares
+    /// let kept = std::sync::Arc::clone(k.boundary(2)); // no copy
+    /// assert!(std::sync::Arc::ptr_eq(&kept, k.boundary(2)));
     /// ```
-    pub fn shared_boundary(&self, p: usize) -> Arc<CsMat<i8>> {
-        Arc::clone(&self.boundaries[p - 1])
+    pub fn boundary(&self, p: usize) -> &Arc<CsMat<i8>> {
+        match self.try_boundary(p) {
+            Ok(d) => d,
+            Err(e) => panic!("{e}"),
+        }
     }
 
-    /// ∂_p, or an error naming the valid range.
-    pub fn try_boundary(&self, p: usize) -> Result<&CsMat<i8>> {
-        if p == 0 || p > self.dim() {
-            return Err(ComplexError::DimensionOutOfRange { p, dim: self.dim() });
+    /// ∂_p, or an error naming the valid range 1 ≤ p ≤ n.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    /// assert!(k.try_boundary(2).is_ok());
+    /// assert!(k.try_boundary(0).is_err() && k.try_boundary(3).is_err());
+    /// ```
+    pub fn try_boundary(&self, p: usize) -> Result<&Arc<CsMat<i8>>> {
+        let dim = self.dim();
+        if p == 0 || p > dim {
+            return Err(ComplexError::DegreeOutOfRange {
+                operator: "∂_p",
+                p,
+                dim,
+                valid: if dim == 0 {
+                    "no p (a 0-complex has no boundary operators)".into()
+                } else {
+                    format!("1 ≤ p ≤ {dim}")
+                },
+            });
         }
         Ok(&self.boundaries[p - 1])
     }
 
     /// ∂_p in CSC storage, for column (cell → facets) access; built on
-    /// first use and kept.
-    pub fn boundary_csc(&self, p: usize) -> &CsMat<i8> {
-        self.facets_by_cell(p)
-    }
-
-    /// [`Complex::boundary_csc`], shared with the complex (no copy).
+    /// first use and kept, shared like [`Complex::boundary`].
+    ///
+    /// # Panics
+    /// When p is 0 or exceeds the dimension ([`Complex::try_boundary_csc`]
+    /// does not).
     ///
     /// ```
     /// use hasse_complex::generate::rectangle;
     /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
-    /// let by_cell = k.shared_boundary_csc(2);
+    /// let by_cell = k.boundary_csc(2);
     /// assert!(by_cell.is_csc());
-    /// assert!(std::ptr::eq(&*by_cell, k.boundary_csc(2)));
+    /// assert_eq!(by_cell.outer_view(0).unwrap().nnz(), 4); // a square has 4 edges
     /// ```
-    pub fn shared_boundary_csc(&self, p: usize) -> Arc<CsMat<i8>> {
-        Arc::clone(self.facets_by_cell(p))
+    pub fn boundary_csc(&self, p: usize) -> &Arc<CsMat<i8>> {
+        match self.try_boundary_csc(p) {
+            Ok(d) => d,
+            Err(e) => panic!("{e}"),
+        }
     }
 
-    fn facets_by_cell(&self, p: usize) -> &Arc<CsMat<i8>> {
-        self.geometry.facets[p].get_or_init(|| Arc::new(self.boundary(p).to_csc()))
+    /// [`Complex::boundary_csc`], or an error naming the valid range.
+    pub fn try_boundary_csc(&self, p: usize) -> Result<&Arc<CsMat<i8>>> {
+        let by_rows = self.try_boundary(p)?;
+        Ok(self.geometry.facets[p].get_or_init(|| Arc::new(by_rows.to_csc())))
     }
 
-    /// The coboundary δ^p = ∂_{p+1}ᵀ (|K_{p+1}| × |K_p|, CSR), 0 ≤ p < n.
-    pub fn coboundary(&self, p: usize) -> CsMat<i8> {
+    /// The coboundary δ^p = ∂_{p+1}ᵀ (|K_{p+1}| × |K_p|, CSR), 0 ≤ p < n,
+    /// built on first use and then shared like [`Complex::boundary`], for
+    /// operators that keep δ^p as their A and for repeated readers of it
+    /// (the nodal metrics, loads and operator of one solve).
+    ///
+    /// # Panics
+    /// When p ≥ n ([`Complex::try_coboundary`] returns an error instead).
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+    /// let delta = k.coboundary(0);
+    /// assert_eq!(**delta, k.boundary(1).transpose_view().to_csr());
+    /// assert!(std::sync::Arc::ptr_eq(delta, k.coboundary(0))); // built once
+    /// assert!(k.try_coboundary(2).is_err()); // no 3-cells in a 2-complex
+    /// ```
+    pub fn coboundary(&self, p: usize) -> &Arc<CsMat<i8>> {
+        match self.try_coboundary(p) {
+            Ok(d) => d,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    /// δ^p, or an error naming the valid range 0 ≤ p < n.
+    pub fn try_coboundary(&self, p: usize) -> Result<&Arc<CsMat<i8>>> {
+        let dim = self.dim();
+        if p >= dim {
+            return Err(ComplexError::DegreeOutOfRange {
+                operator: "δ^p",
+                p,
+                dim,
+                valid: if dim == 0 {
+                    "no p (a 0-complex has no coboundary operators)".into()
+                } else {
+                    format!("0 ≤ p ≤ {}", dim - 1)
+                },
+            });
+        }
+        Ok(self.geometry.coboundaries[p].get_or_init(|| Arc::new(self.build_coboundary(p))))
+    }
+
+    fn build_coboundary(&self, p: usize) -> CsMat<i8> {
         if p == 0 && self.dim() >= 2 {
             if let Some(delta) = self.edge_coboundary() {
                 return delta;
@@ -296,21 +360,6 @@ impl Complex {
             .map(|k| if k % 2 == 0 { -1 } else { 1 })
             .collect();
         CsMat::try_new((edges.rows(), edges.cols()), pointers, vertices, signs).ok()
-    }
-
-    /// [`Complex::coboundary`], built on first use and then shared (no
-    /// copy), for operators that keep δ^p as their A and for repeated
-    /// readers of it (the nodal metrics, loads and operator of one solve).
-    ///
-    /// ```
-    /// use hasse_complex::generate::rectangle;
-    /// let k = rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
-    /// let delta = k.shared_coboundary(0);
-    /// assert_eq!(*delta, k.coboundary(0));
-    /// assert!(std::sync::Arc::ptr_eq(&delta, &k.shared_coboundary(0)));
-    /// ```
-    pub fn shared_coboundary(&self, p: usize) -> Arc<CsMat<i8>> {
-        Arc::clone(self.geometry.coboundaries[p].get_or_init(|| Arc::new(self.coboundary(p))))
     }
 
     /// Orientation of each top cell relative to the frame of its sorted
@@ -803,8 +852,7 @@ mod tests {
         ];
         for k in &complexes {
             let transposed: CsMat<i8> = k.boundary(1).transpose_view().to_csr();
-            assert_eq!(k.coboundary(0), transposed, "dimension {}", k.dim());
-            assert_eq!(*k.shared_coboundary(0), transposed);
+            assert_eq!(**k.coboundary(0), transposed, "dimension {}", k.dim());
         }
     }
 

@@ -61,6 +61,16 @@ pub enum ComplexError {
     },
     #[error("cell dimension {p} is out of range: this complex has cells of dimension 0..={dim}")]
     DimensionOutOfRange { p: usize, dim: usize },
+    /// An incidence operator asked for at a degree where it does not exist.
+    #[error("{operator} exists for {valid} on this {dim}-complex, not for p = {p}")]
+    DegreeOutOfRange {
+        /// The operator's name, "∂_p" or "δ^p".
+        operator: &'static str,
+        p: usize,
+        dim: usize,
+        /// The valid degrees, e.g. "1 ≤ p ≤ 2".
+        valid: String,
+    },
     #[error("characteristic matrix M_{p} has {found} columns but there are {expected} vertices")]
     CharacteristicShape {
         p: usize,

@@ -422,7 +422,7 @@ fn parse(text: &str, path: &Path) -> Result<Complex, JsonError> {
         )));
     }
     for p in 2..=n {
-        let dd = complex.boundary(p - 1) * complex.boundary(p);
+        let dd = &**complex.boundary(p - 1) * &**complex.boundary(p);
         if dd.data().iter().any(|&x| x != 0) {
             return Err(inconsistent(format!(
                 "the boundary of the boundary of the {p}-cells is not zero (a face of some {p}-cell is missing or extra)"

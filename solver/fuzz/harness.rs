@@ -162,7 +162,7 @@ pub fn complex_build(data: &[u8]) {
 fn check_complex(k: &Complex) {
     let n = k.dim();
     for p in 2..=n {
-        let product = k.boundary(p - 1) * k.boundary(p);
+        let product = &**k.boundary(p - 1) * &**k.boundary(p);
         assert!(product.data().iter().all(|&v| v == 0), "∂∂ ≠ 0 at p = {p}");
     }
     for p in 0..=n {

@@ -150,7 +150,7 @@ fn is_zero(m: &CsMat<i8>) -> bool {
 fn boundary_of_boundary_vanishes_on_every_mesh_type() {
     for (name, k) in every_mesh() {
         for p in 2..=k.dim() {
-            let product = k.boundary(p - 1) * k.boundary(p);
+            let product = &**k.boundary(p - 1) * &**k.boundary(p);
             assert!(is_zero(&product), "{name}: ∂{}∂{p} ≠ 0", p - 1);
         }
         // Every boundary matrix has entries ±1 only.

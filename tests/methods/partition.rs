@@ -107,7 +107,7 @@ fn local_incidence_is_the_global_incidence_and_squares_to_zero() -> TestResult {
                     );
                 }
                 if p >= 2 {
-                    let dd = local.complex.boundary(p - 1) * local.complex.boundary(p);
+                    let dd = &**local.complex.boundary(p - 1) * &**local.complex.boundary(p);
                     assert!(
                         dd.data().iter().all(|&x| x == 0),
                         "{name}, rank {rank}: ∂∂ ≠ 0"

@@ -118,14 +118,14 @@ fn plane(d: usize, a: f64, b: f64, offset: f64) -> Hyperplane {
 fn check_refinement(coarse: &Complex, fine: &Complex, r: &Refinement) -> Result<(), TestCaseError> {
     let n = coarse.dim();
     for p in 2..=n {
-        let product = fine.boundary(p - 1) * fine.boundary(p);
+        let product = &**fine.boundary(p - 1) * &**fine.boundary(p);
         prop_assert!(product.data().iter().all(|&v| v == 0), "∂∂ ≠ 0 at {p}");
     }
     prop_assert_eq!(fine.euler_characteristic(), coarse.euler_characteristic());
     prop_assert_eq!(fine.betti_numbers(), coarse.betti_numbers());
     for p in 1..=n {
-        let left = fine.boundary(p) * r.zeta(p);
-        let right = r.zeta(p - 1) * coarse.boundary(p);
+        let left = &**fine.boundary(p) * r.zeta(p);
+        let right = r.zeta(p - 1) * &**coarse.boundary(p);
         prop_assert_eq!(dense_i8(&left), dense_i8(&right), "∂ζ ≠ ζ∂ at {}", p);
         let mut sum = vec![0.0; coarse.cell_count(p)];
         for i in 0..fine.cell_count(p) {

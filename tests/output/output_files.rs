@@ -167,7 +167,7 @@ fn check_mesh_at(f: &hdf5::File, group: &str, k: &Complex) {
             usizes(&read_u64(f, &format!("{g}/indices"))),
             data,
         );
-        assert_eq!(&m, k.boundary(p));
+        assert_eq!(&m, &**k.boundary(p));
         assert_eq!((m.rows(), m.cols()), (k.cell_count(p - 1), k.cell_count(p)));
     }
     for (name, tag) in k.tags().iter() {

@@ -688,9 +688,9 @@ fn cell_points_are_checked() {
     ));
 }
 
-/// The cell-centred methods analyse M's pattern (that of ∂ₙᵀ∂ₙ) beside the
+/// The cell-centred methods analyze M's pattern (that of ∂ₙᵀ∂ₙ) beside the
 /// assembly. The solution must be the one of the plain path (assemble,
-/// then analyse the assembled matrix): same ordering of the same pattern,
+/// then analyze the assembled matrix): same ordering of the same pattern,
 /// same values, so the same factor up to the order of parallel sums.
 /// Held unknowns (pure Neumann pins one) change the pattern, and the
 /// analysis is then not used.
@@ -844,9 +844,9 @@ fn analysis_beside_the_assembly_gives_the_plain_solution() {
             problem.ordering = Ordering::Amd;
         }
         let solution = problem.solve(&mesh).unwrap();
-        assert_eq!(solution.analysed_during_assembly, early, "{name}");
+        assert_eq!(solution.analyzed_during_assembly, early, "{name}");
         let automatic = given.solve(&mesh).unwrap();
-        assert_eq!(automatic.analysed_during_assembly, early, "{name}");
+        assert_eq!(automatic.analyzed_during_assembly, early, "{name}");
         if given.ordering == Ordering::Automatic && given.factorization == Factorization::Llt {
             assert_eq!(
                 automatic.report.ordering,

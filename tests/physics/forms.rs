@@ -143,7 +143,7 @@ fn d_of_d_is_zero() -> Result {
     for k in &meshes {
         let forms = Forms::new(k, Star::Whitney);
         for p in 0..k.dim() {
-            let dd = &forms.d(p + 1)? * &forms.d(p)?;
+            let dd = &*forms.d(p + 1)? * &*forms.d(p)?;
             assert!(dd.data().iter().all(|&v| v == 0), "d{} d{p} ≠ 0", p + 1);
             assert_eq!(
                 dd.shape(),

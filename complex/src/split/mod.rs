@@ -42,8 +42,8 @@
 //! assert_eq!(fine.cell_counts(), vec![8, 10, 3]);
 //! assert_eq!(fine.euler_characteristic(), k.euler_characteristic());
 //! // ∂ζ = ζ∂ on the 2-cells.
-//! let left = fine.boundary(2) * r.zeta(2);
-//! let right = r.zeta(1) * k.boundary(2);
+//! let left = &**fine.boundary(2) * r.zeta(2);
+//! let right = r.zeta(1) * &**k.boundary(2);
 //! assert_eq!(left.to_dense(), right.to_dense());
 //! ```
 

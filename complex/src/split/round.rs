@@ -247,7 +247,7 @@ pub(super) fn round(
     let mut straddled: Vec<(usize, usize)> = Vec::new();
     let mut stack: Vec<(usize, usize)> = Vec::new();
     let csc: Vec<Option<&CsMat<i8>>> = (0..=n)
-        .map(|p| (p >= 1).then(|| k.boundary_csc(p)))
+        .map(|p| (p >= 1).then(|| &**k.boundary_csc(p)))
         .collect();
     for &(c, id) in cuts {
         if splits[n].plane[c] != NONE {

@@ -85,7 +85,7 @@ fn signed_volume(k: &Complex, c: usize) -> f64 {
 fn assert_chain_complex(k: &Complex) {
     let n = k.dim();
     for p in 2..=n {
-        let dd = k.boundary(p - 1) * k.boundary(p);
+        let dd = &**k.boundary(p - 1) * &**k.boundary(p);
         assert!(dd.data().iter().all(|&x| x == 0), "∂{}∂{} ≠ 0", p - 1, p);
     }
     for (face, row) in k.boundary(n).outer_iterator().enumerate() {

@@ -222,7 +222,7 @@ fn given_lower_cells_keep_their_numbering() -> TestResult {
     let k = lar_json::from_str(text)?;
     let edges: Vec<&[usize]> = (0..5).map(|e| k.cell_vertices(1, e)).collect();
     assert_eq!(edges, vec![&[2, 3][..], &[1, 3], &[1, 2], &[0, 2], &[0, 1]]);
-    assert!((k.boundary(1) * k.boundary(2))
+    assert!((&**k.boundary(1) * &**k.boundary(2))
         .data()
         .iter()
         .all(|&x| x == 0));

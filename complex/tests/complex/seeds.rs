@@ -144,7 +144,7 @@ fn lar_fig_2d_oriented_the_non_convex_hexagons_by_their_boundary_cycles() -> Tes
     // The file's edge numbering e0 … e9 is kept.
     let lar = fig_2d()?;
     assert_eq!(k.lar(), &lar);
-    let dd = k.boundary(1) * k.boundary(2);
+    let dd = &**k.boundary(1) * &**k.boundary(2);
     assert!(dd.data().iter().all(|&x| x == 0), "∂1∂2 = 0");
     // Unsigned, ∂2 is the printed [∂2].
     assert_eq!(
@@ -223,7 +223,10 @@ fn lar_unoriented_boundaries_compose_to_zero_mod_2() -> TestResult {
         for p in 1..=k.dim() {
             let unsigned = k.boundary(p).map(|&x| x.unsigned_abs());
             assert_eq!(unsigned, k.lar().unoriented_boundary(p)?, "p = {p}");
-            assert_eq!(k.coboundary(p - 1), k.boundary(p).transpose_view().to_csr());
+            assert_eq!(
+                **k.coboundary(p - 1),
+                k.boundary(p).transpose_view().to_csr()
+            );
         }
     }
     Ok(())

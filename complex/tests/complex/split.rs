@@ -163,7 +163,7 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
     assert_eq!(fine.dim(), n);
     for p in 2..=n {
         assert!(
-            is_zero(&(fine.boundary(p - 1) * fine.boundary(p))),
+            is_zero(&(&**fine.boundary(p - 1) * &**fine.boundary(p))),
             "∂∂ ≠ 0 at p = {p}"
         );
     }
@@ -171,8 +171,8 @@ fn check_split(coarse: &Complex, fine: &Complex, r: &Refinement) {
     assert_eq!(fine.betti_numbers(), coarse.betti_numbers());
     // ∂ζ = ζ∂, exactly.
     for p in 1..=n {
-        let left = fine.boundary(p) * r.zeta(p);
-        let right = r.zeta(p - 1) * coarse.boundary(p);
+        let left = &**fine.boundary(p) * r.zeta(p);
+        let right = r.zeta(p - 1) * &**coarse.boundary(p);
         assert_eq!(dense(&left), dense(&right), "∂ζ ≠ ζ∂ at p = {p}");
     }
     // The orientation the split assembled is the one geometry gives.

@@ -22,7 +22,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMat, SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Mat, Par, Side};
+use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -147,7 +147,7 @@ impl Analysis {
 ///     Triplet::new(0, 0, a), Triplet::new(1, 0, -1.0),
 ///     Triplet::new(0, 1, -1.0), Triplet::new(1, 1, a),
 /// ]).unwrap();
-/// let solver = DirectSolver::analyse(m(2.0).as_ref(), Factorization::Llt).unwrap();
+/// let solver = DirectSolver::analyze(m(2.0).as_ref(), Factorization::Llt).unwrap();
 /// for a in [2.0, 3.0] {
 ///     let x = solver.factorize(m(a).as_ref()).unwrap().solve(&[1.0, 1.0]).unwrap();
 ///     // Both rows read (a − 1) x = 1.
@@ -172,7 +172,7 @@ pub struct DirectSolver {
 ///     Triplet::new(0, 0, 2.0), Triplet::new(1, 0, -1.0),
 ///     Triplet::new(0, 1, -1.0), Triplet::new(1, 1, 2.0),
 /// ]).unwrap();
-/// let factor = DirectSolver::analyse(m.as_ref(), Factorization::Llt)
+/// let factor = DirectSolver::analyze(m.as_ref(), Factorization::Llt)
 ///     .unwrap()
 ///     .factorize(m.as_ref())
 ///     .unwrap();
@@ -322,11 +322,11 @@ impl DirectSolver {
     /// Symbolic analysis of `matrix` (only the lower triangle is read for
     /// the symmetric factorisations) with the [`Ordering::Automatic`]
     /// fill-reducing ordering.
-    pub fn analyse(
+    pub fn analyze(
         matrix: SparseColMatRef<'_, usize, f64>,
         kind: Factorization,
     ) -> Result<Self, SolveError> {
-        Self::analyse_with(matrix, kind, Ordering::Automatic)
+        Self::analyze_with(matrix, kind, Ordering::Automatic)
     }
 
     /// Symbolic analysis of `matrix` with the given fill-reducing ordering
@@ -346,35 +346,35 @@ impl DirectSolver {
     ///     }
     /// }
     /// let a = SparseColMat::<usize, f64>::try_new_from_triplets(5, 5, &t).unwrap();
-    /// let solver = DirectSolver::analyse_with(a.as_ref(), Factorization::Ldlt, Ordering::Amd).unwrap();
+    /// let solver = DirectSolver::analyze_with(a.as_ref(), Factorization::Ldlt, Ordering::Amd).unwrap();
     /// let x = solver.factorize(a.as_ref()).unwrap().solve(&[1.0, 0.0, 0.0, 0.0, 1.0]).unwrap();
     /// assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-14));
     /// assert_eq!(solver.ordering(), Some(Ordering::Amd));
     /// ```
-    pub fn analyse_with(
+    pub fn analyze_with(
         matrix: SparseColMatRef<'_, usize, f64>,
         kind: Factorization,
         ordering: Ordering,
     ) -> Result<Self, SolveError> {
-        Self::analyse_pattern(matrix.symbolic(), kind, ordering)
+        Self::analyze_pattern(matrix.symbolic(), kind, ordering)
     }
 
     /// Symbolic analysis of a sparsity pattern alone: the analysis never
     /// reads values, so it can run before (or while) they are computed,
     /// when the pattern is known from topology. Every matrix later
     /// factorised must have exactly this pattern.
-    pub fn analyse_pattern(
+    pub fn analyze_pattern(
         matrix: SymbolicSparseColMatRef<'_, usize>,
         kind: Factorization,
         ordering: Ordering,
     ) -> Result<Self, SolveError> {
-        Self::analyse_pattern_at(matrix, kind, ordering, None)
+        Self::analyze_pattern_at(matrix, kind, ordering, None)
     }
 
-    /// [`DirectSolver::analyse_pattern`] for unknowns at `points`, which
+    /// [`DirectSolver::analyze_pattern`] for unknowns at `points`, which
     /// [`Ordering::Geometric`] needs and [`Ordering::Automatic`] uses for
     /// LLᵀ (see there).
-    pub fn analyse_pattern_at(
+    pub fn analyze_pattern_at(
         matrix: SymbolicSparseColMatRef<'_, usize>,
         kind: Factorization,
         ordering: Ordering,
@@ -631,11 +631,47 @@ impl Factor {
             });
         }
         let mut x = Mat::from_fn(self.size, 1, |i, _| rhs[i]);
+        self.solve_in_place(x.as_mut())?;
+        Ok((0..self.size).map(|i| x[(i, 0)]).collect())
+    }
+
+    /// Solve M X = B for every column of B at once (one pass over the
+    /// factor per block of columns instead of one per column).
+    ///
+    /// ```
+    /// use faer::sparse::{SparseColMat, Triplet};
+    /// use faer::Mat;
+    /// use hasse_solver::la::direct::{DirectSolver, Factorization};
+    /// // M = [[2, 1], [1, 2]]: M⁻¹ = [[2, −1], [−1, 2]] / 3.
+    /// let entries = [Triplet::new(0, 0, 2.0), Triplet::new(1, 0, 1.0),
+    ///                Triplet::new(0, 1, 1.0), Triplet::new(1, 1, 2.0)];
+    /// let m = SparseColMat::<usize, f64>::try_new_from_triplets(2, 2, &entries).unwrap();
+    /// let solver = DirectSolver::analyze(m.as_ref(), Factorization::Llt).unwrap();
+    /// let factor = solver.factorize(m.as_ref()).unwrap();
+    /// let x = factor.solve_many(Mat::<f64>::identity(2, 2).as_ref()).unwrap();
+    /// assert!((x[(0, 0)] - 2.0 / 3.0).abs() < 1e-15 && (x[(1, 0)] + 1.0 / 3.0).abs() < 1e-15);
+    /// ```
+    pub fn solve_many(&self, rhs: MatRef<'_, f64>) -> Result<Mat<f64>, SolveError> {
+        if rhs.nrows() != self.size {
+            return Err(SolveError::RhsSize {
+                expected: self.size,
+                found: rhs.nrows(),
+            });
+        }
+        let mut x = rhs.to_owned();
+        self.solve_in_place(x.as_mut())?;
+        Ok(x)
+    }
+
+    /// Overwrite the columns of `x` (right-hand sides) with the solutions.
+    fn solve_in_place(&self, mut x: MatMut<'_, f64>) -> Result<(), SolveError> {
+        let columns = x.ncols();
         match &self.inner {
             Numeric::Llt(symbolic, values) => {
                 let par = faer::get_global_parallelism();
-                let mut buffer = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, par))
-                    .map_err(|_| SolveError::OutOfMemory)?;
+                let mut buffer =
+                    MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(columns, par))
+                        .map_err(|_| SolveError::OutOfMemory)?;
                 LltRef::new(symbolic, values).solve_in_place_with_conj(
                     Conj::No,
                     x.as_mut(),
@@ -646,8 +682,9 @@ impl Factor {
             Numeric::Lu(f) => f.solve_in_place(x.as_mut()),
             Numeric::Ldlt(symbolic, values) => {
                 let par = Par::Seq;
-                let mut buffer = MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(1, par))
-                    .map_err(|_| SolveError::OutOfMemory)?;
+                let mut buffer =
+                    MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(columns, par))
+                        .map_err(|_| SolveError::OutOfMemory)?;
                 LdltRef::new(symbolic, values).solve_in_place_with_conj(
                     Conj::No,
                     x.as_mut(),
@@ -658,7 +695,7 @@ impl Factor {
             Numeric::Lblt(f) => {
                 let par = Par::Seq;
                 let mut buffer =
-                    MemBuffer::try_new(f.symbolic.solve_in_place_scratch::<f64>(1, par))
+                    MemBuffer::try_new(f.symbolic.solve_in_place_scratch::<f64>(columns, par))
                         .map_err(|_| SolveError::OutOfMemory)?;
                 // The permutation arrays were written by faer's factorisation
                 // as mutual inverses of length n.
@@ -672,8 +709,8 @@ impl Factor {
                     );
             }
         }
-        let solution: Vec<f64> = (0..self.size).map(|i| x[(i, 0)]).collect();
-        if solution.iter().any(|v| !v.is_finite()) {
+        let finite = (0..columns).all(|j| (0..self.size).all(|i| x[(i, j)].is_finite()));
+        if !finite {
             return Err(SolveError::Singular {
                 method: match self.kind {
                     Factorization::Llt => "LLᵀ",
@@ -683,7 +720,7 @@ impl Factor {
                 },
             });
         }
-        Ok(solution)
+        Ok(())
     }
 }
 
@@ -741,14 +778,14 @@ pub(crate) fn solve_with(
     kind: Factorization,
     ordering: Ordering,
 ) -> Result<(Vec<f64>, SolveReport), SolveError> {
-    let solver = DirectSolver::analyse_with(matrix.as_ref(), kind, ordering)?;
-    solve_analysed(&solver, matrix, rhs)
+    let solver = DirectSolver::analyze_with(matrix.as_ref(), kind, ordering)?;
+    solve_analyzed(&solver, matrix, rhs)
 }
 
 /// Factorise and solve once with an analysis made beforehand (of this
-/// matrix's pattern, see [`DirectSolver::analyse_pattern`]), and report;
+/// matrix's pattern, see [`DirectSolver::analyze_pattern`]), and report;
 /// the report's symbolic time is the analysis's own.
-pub fn solve_analysed(
+pub fn solve_analyzed(
     solver: &DirectSolver,
     matrix: &SparseColMat<usize, f64>,
     rhs: &[f64],
@@ -825,7 +862,7 @@ mod tests {
     #[test]
     fn symbolic_analysis_is_reused_for_new_values() {
         let a = laplacian();
-        let solver = DirectSolver::analyse(a.as_ref(), Factorization::Llt).unwrap();
+        let solver = DirectSolver::analyze(a.as_ref(), Factorization::Llt).unwrap();
         let scaled = matrix(
             4,
             &a.triplet_iter()
@@ -922,7 +959,7 @@ mod tests {
     #[test]
     fn lblt_analysis_is_reused_and_singular_matrices_are_reported() {
         let kkt = saddle_point(5, 2, 1.0);
-        let solver = DirectSolver::analyse(kkt.as_ref(), Factorization::Lblt).unwrap();
+        let solver = DirectSolver::analyze(kkt.as_ref(), Factorization::Lblt).unwrap();
         let exact: Vec<f64> = (0..7).map(|i| (i as f64).sin() + 2.0).collect();
         for scale in [1.0, -3.0] {
             let scaled = matrix(
@@ -993,7 +1030,7 @@ mod tests {
             "{:e}",
             relative_error(&x, &exact)
         );
-        let solver = DirectSolver::analyse(a.as_ref(), Factorization::Lblt).unwrap();
+        let solver = DirectSolver::analyze(a.as_ref(), Factorization::Lblt).unwrap();
         let Analysis::Lblt(analysis) = &solver.analysis else {
             panic!("an LBLᵀ analysis was asked for");
         };
@@ -1071,7 +1108,7 @@ mod tests {
         // diagonal (still SPD: diagonally dominant).
         let a = grid_laplacian(12, 2);
         let solver =
-            DirectSolver::analyse_with(a.as_ref(), Factorization::Llt, Ordering::NestedDissection)
+            DirectSolver::analyze_with(a.as_ref(), Factorization::Llt, Ordering::NestedDissection)
                 .unwrap();
         assert_eq!(solver.ordering(), Some(Ordering::NestedDissection));
         let exact = smooth_field(144);
@@ -1140,7 +1177,7 @@ mod tests {
         // on the 300² grid, 143 on 20³, 414 on 40³.
         let entries_per_unknown = |a: &SparseColMat<usize, f64>| {
             let amd =
-                DirectSolver::analyse_with(a.as_ref(), Factorization::Llt, Ordering::Amd).unwrap();
+                DirectSolver::analyze_with(a.as_ref(), Factorization::Llt, Ordering::Amd).unwrap();
             amd.factor_entries().unwrap() as f64 / a.nrows() as f64
         };
         for (a, expected) in [
@@ -1149,7 +1186,7 @@ mod tests {
             (grid_laplacian(40, 3), Ordering::NestedDissection),
         ] {
             let fill = entries_per_unknown(&a);
-            let solver = DirectSolver::analyse(a.as_ref(), Factorization::Llt).unwrap();
+            let solver = DirectSolver::analyze(a.as_ref(), Factorization::Llt).unwrap();
             assert_eq!(
                 solver.ordering(),
                 Some(expected),
@@ -1161,10 +1198,10 @@ mod tests {
                 "{fill}"
             );
             // LDLᵀ keeps AMD whatever the fill.
-            let ldlt = DirectSolver::analyse(a.as_ref(), Factorization::Ldlt).unwrap();
+            let ldlt = DirectSolver::analyze(a.as_ref(), Factorization::Ldlt).unwrap();
             assert_eq!(ldlt.ordering(), Some(Ordering::Amd));
         }
-        let lu = DirectSolver::analyse(grid_laplacian(6, 3).as_ref(), Factorization::Lu).unwrap();
+        let lu = DirectSolver::analyze(grid_laplacian(6, 3).as_ref(), Factorization::Lu).unwrap();
         assert_eq!(lu.ordering(), None);
         assert_eq!(lu.factor_entries(), None);
     }
@@ -1197,7 +1234,7 @@ mod tests {
             dimension: 1,
         };
         let a = matrix(n, &e);
-        let solver = DirectSolver::analyse_pattern_at(
+        let solver = DirectSolver::analyze_pattern_at(
             a.symbolic(),
             Factorization::Llt,
             Ordering::Geometric,
@@ -1215,7 +1252,7 @@ mod tests {
                 dense.push((i, j, if i == j { 2.0 } else { 1.0 }));
             }
         }
-        let solver = DirectSolver::analyse_with(
+        let solver = DirectSolver::analyze_with(
             matrix(m, &dense).as_ref(),
             Factorization::Llt,
             Ordering::Amd,
@@ -1226,7 +1263,7 @@ mod tests {
             Analysis::Llt(ref s) if matches!(s.raw(), SymbolicCholeskyRaw::Supernodal(_))
         ));
         assert_eq!(solver.factor_flops(), Some((200 * 201 * 401 / 6) as f64));
-        let lu = DirectSolver::analyse(a.as_ref(), Factorization::Lu).unwrap();
+        let lu = DirectSolver::analyze(a.as_ref(), Factorization::Lu).unwrap();
         assert_eq!(lu.factor_flops(), None);
     }
 
@@ -1241,18 +1278,18 @@ mod tests {
             coordinates: &x,
             dimension: 3,
         };
-        let analyse = |kind, ordering, points| {
-            DirectSolver::analyse_pattern_at(a.symbolic(), kind, ordering, points).unwrap()
+        let analyze = |kind, ordering, points| {
+            DirectSolver::analyze_pattern_at(a.symbolic(), kind, ordering, points).unwrap()
         };
-        let automatic = analyse(Factorization::Llt, Ordering::Automatic, Some(points));
+        let automatic = analyze(Factorization::Llt, Ordering::Automatic, Some(points));
         assert_eq!(automatic.ordering(), Some(Ordering::Geometric));
         assert_eq!(
-            analyse(Factorization::Ldlt, Ordering::Automatic, Some(points)).ordering(),
+            analyze(Factorization::Ldlt, Ordering::Automatic, Some(points)).ordering(),
             Some(Ordering::Amd)
         );
         assert_eq!(
-            analyse(Factorization::Llt, Ordering::Automatic, None).ordering(),
-            DirectSolver::analyse(a.as_ref(), Factorization::Llt)
+            analyze(Factorization::Llt, Ordering::Automatic, None).ordering(),
+            DirectSolver::analyze(a.as_ref(), Factorization::Llt)
                 .unwrap()
                 .ordering()
         );
@@ -1277,11 +1314,11 @@ mod tests {
             dimension: 3,
         };
         assert_ne!(
-            analyse(Factorization::Llt, Ordering::Automatic, Some(bad_points)).ordering(),
+            analyze(Factorization::Llt, Ordering::Automatic, Some(bad_points)).ordering(),
             Some(Ordering::Geometric)
         );
         for points in [Some(bad_points), None] {
-            let error = DirectSolver::analyse_pattern_at(
+            let error = DirectSolver::analyze_pattern_at(
                 a.symbolic(),
                 Factorization::Llt,
                 Ordering::Geometric,
@@ -1307,7 +1344,7 @@ mod tests {
         )
         .unwrap();
         let solver =
-            DirectSolver::analyse_pattern(a.symbolic(), Factorization::Llt, Ordering::Amd).unwrap();
+            DirectSolver::analyze_pattern(a.symbolic(), Factorization::Llt, Ordering::Amd).unwrap();
         let x = solver
             .factorize(a.as_ref())
             .unwrap()
@@ -1334,7 +1371,7 @@ mod tests {
             coordinates: &x,
             dimension: 1,
         };
-        let solver = DirectSolver::analyse_pattern_at(
+        let solver = DirectSolver::analyze_pattern_at(
             a.symbolic(),
             Factorization::Llt,
             Ordering::Geometric,

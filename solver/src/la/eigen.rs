@@ -210,7 +210,7 @@ pub fn smallest(
     } else {
         Factorization::Lblt
     };
-    let factor = DirectSolver::analyse(shifted.as_ref(), kind)?.factorize(shifted.as_ref())?;
+    let factor = DirectSolver::analyze(shifted.as_ref(), kind)?.factorize(shifted.as_ref())?;
     let project = |v: &mut [f64]| -> Result<(), SolveError> {
         match projection {
             Some(p) => p(v),

@@ -50,7 +50,7 @@ use std::sync::atomic::Ordering::Relaxed;
 /// }}}
 /// let n = m * m * m;
 /// let a = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &t).unwrap();
-/// let nd = DirectSolver::analyse_with(a.as_ref(), Factorization::Llt, Ordering::NestedDissection).unwrap();
+/// let nd = DirectSolver::analyze_with(a.as_ref(), Factorization::Llt, Ordering::NestedDissection).unwrap();
 /// let x = nd.factorize(a.as_ref()).unwrap().solve(&vec![1.0; n]).unwrap();
 /// assert_eq!(nd.ordering(), Some(Ordering::NestedDissection));
 /// assert!(x.iter().all(|v| v.is_finite() && *v > 0.0));
@@ -135,8 +135,8 @@ impl std::fmt::Display for Ordering {
 /// AMD fill, in factor entries per unknown, from which
 /// [`Ordering::Automatic`] tries nested dissection for an LLᵀ analysis.
 ///
-/// The rule, by measurement rather than by size: analyse with AMD (cheap);
-/// if the factor stores at least this many entries per unknown, analyse
+/// The rule, by measurement rather than by size: analyze with AMD (cheap);
+/// if the factor stores at least this many entries per unknown, analyze
 /// again with METIS nested dissection and keep whichever factor is smaller.
 /// LDLᵀ and LBLᵀ keep AMD unless asked: unpivoted LDLᵀ and LBLᵀ pivoting
 /// within supernodes are only as stable as their pivot order allows, and

@@ -455,7 +455,7 @@ impl BlockSystem {
         }
         let matrix = self.matrix();
         if self.analysis.as_ref().map(DirectSolver::kind) != Some(kind) {
-            self.analysis = Some(DirectSolver::analyse(matrix.as_ref(), kind)?);
+            self.analysis = Some(DirectSolver::analyze(matrix.as_ref(), kind)?);
             self.analyses += 1;
         }
         let solver = self

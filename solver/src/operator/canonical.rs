@@ -2,7 +2,7 @@
 //! need no assembled matrix.
 
 use super::pattern::{matrix_pattern, Assembly, CellSides, Columns, GatheredPattern, LocalPattern};
-use super::{BlockMetric, CanonicalError};
+use super::{BlockMetric, CanonicalError, IntoIncidence};
 use crate::la::parallel::zeroed;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use rayon::prelude::*;
@@ -64,17 +64,17 @@ fn by_rows(a: Arc<CsMat<i8>>) -> Arc<CsMat<i8>> {
 
 impl Canonical {
     /// Build the operator and its assembly pattern. `incidence` is A
-    /// (rows: metric rows, columns: unknowns), exact integers.
-    pub fn new(
-        incidence: impl Into<Arc<CsMat<i8>>>,
-        metric: BlockMetric,
-    ) -> Result<Self, CanonicalError> {
-        Self::build(incidence.into(), None, metric)
+    /// (rows: metric rows, columns: unknowns), exact integers: the
+    /// complex's own matrix (`k.boundary(n)`, `k.coboundary(0)`, kept
+    /// without a copy), an `Arc` of one, or a matrix built by the caller
+    /// (see [`IntoIncidence`]).
+    pub fn new(incidence: impl IntoIncidence, metric: BlockMetric) -> Result<Self, CanonicalError> {
+        Self::build(incidence.into_incidence(), None, metric)
     }
 
     /// [`Canonical::new`] with A also given in CSC storage, `by_columns`,
     /// which must be the same matrix (a complex keeps ∂ₙ both ways: see
-    /// `Complex::shared_boundary_csc`). A diagonal Ω over every row of A is
+    /// `Complex::boundary_csc`). A diagonal Ω over every row of A is
     /// then assembled from it in place instead of from a copy of A by
     /// columns. Only the shapes are checked, so this stays in the crate.
     pub(crate) fn with_columns(
@@ -107,11 +107,11 @@ impl Canonical {
     /// assert_eq!(m.val(), plain.val());
     /// ```
     pub fn with_cell_blocks(
-        incidence: impl Into<Arc<CsMat<i8>>>,
+        incidence: impl IntoIncidence,
         metric: BlockMetric,
         complex: &hasse_complex::Complex,
     ) -> Result<Self, CanonicalError> {
-        let incidence = incidence.into();
+        let incidence = incidence.into_incidence();
         let n = complex.dim();
         let Ok(vertices) = complex.lar().shared_characteristic(n) else {
             return Self::new(incidence, metric);
@@ -161,7 +161,7 @@ impl Canonical {
     /// let b = Canonical::coupling(
     ///     sprs::CsMat::<i8>::eye(edges),
     ///     BlockMetric::diagonal(&vec![-1.0; edges]),
-    ///     k.shared_boundary(2),
+    ///     k.boundary(2),
     /// )
     /// .unwrap();
     /// let m = b.assemble().to_dense();
@@ -171,11 +171,14 @@ impl Canonical {
     /// }
     /// ```
     pub fn coupling(
-        left: impl Into<Arc<CsMat<i8>>>,
+        left: impl IntoIncidence,
         metric: BlockMetric,
-        right: impl Into<Arc<CsMat<i8>>>,
+        right: impl IntoIncidence,
     ) -> Result<Self, CanonicalError> {
-        let (left, right) = (by_rows(left.into()), by_rows(right.into()));
+        let (left, right) = (
+            by_rows(left.into_incidence()),
+            by_rows(right.into_incidence()),
+        );
         check_sizes(&left, &metric)?;
         check_sizes(&right, &metric)?;
         let assembly = match metric.diagonal_weights() {
@@ -361,7 +364,7 @@ impl Canonical {
     /// use hasse_solver::operator::Canonical;
     /// let k = rectangle(2, 2, [0.0, 1.0], [0.0, 1.0]).unwrap();
     /// let faces = k.cell_count(1);
-    /// let mut op = Canonical::new(k.shared_boundary(2), fd::from_face_values(&vec![1.0; faces])).unwrap();
+    /// let mut op = Canonical::new(k.boundary(2), fd::from_face_values(&vec![1.0; faces])).unwrap();
     /// let last = op.assemble_owned();
     /// // A later assembly builds the same pattern again.
     /// let again = op.assemble();

@@ -26,6 +26,7 @@
 pub mod block;
 mod block_metric;
 mod canonical;
+mod incidence;
 mod pattern;
 #[cfg(test)]
 mod tests;
@@ -33,6 +34,7 @@ mod values;
 
 pub use block_metric::BlockMetric;
 pub use canonical::{metric_from_matrix, Canonical};
+pub use incidence::IntoIncidence;
 pub(crate) use pattern::{clique_pattern, diagonal_pattern};
 
 /// Errors in building a canonical operator.

@@ -123,6 +123,7 @@ use faer::sparse::SparseColMat;
 use faer::{Conj, Mat, Par, Side};
 use hasse_complex::Complex;
 use sprs::CsMat;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A condition on one boundary (n−1)-cell.
@@ -708,7 +709,7 @@ pub fn assemble(
     let coupling = Canonical::coupling(
         CsMat::<i8>::eye(faces),
         BlockMetric::from_weights(vec![-1.0; faces]),
-        complex.shared_boundary(n),
+        Arc::clone(complex.boundary(n)),
     )?;
     let mut fields = vec![faces, cells];
     let mut blocks: Vec<(usize, usize, Block)> =

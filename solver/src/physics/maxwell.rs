@@ -244,7 +244,7 @@ impl Cavity {
         }
 
         // K = (δ₁ E)ᵀ ⋆₂ (δ₁ E): faces × interior edges.
-        let curl = edges.restrict_columns(&complex.coboundary(1));
+        let curl = edges.restrict_columns(complex.coboundary(1));
         let star2 = complex.hodge_star(dual, 2)?;
         for (f, row) in curl.outer_iterator().enumerate() {
             // Faces made only of wall edges do not enter K.
@@ -289,12 +289,12 @@ impl Cavity {
         // Gᵀ M G = (δ₀ restricted to interior vertices)ᵀ Ω (…): a wall edge
         // has both ends on the wall, so its rows of δ₀[:, interior] vanish
         // and the product only sees interior edges.
-        let grad_all = vertices.restrict_columns(&complex.coboundary(0));
+        let grad_all = vertices.restrict_columns(complex.coboundary(0));
         let gram = if vertices.free().is_empty() {
             None
         } else {
             let gram = Canonical::new(grad_all.clone(), metric)?.assemble();
-            let factor = DirectSolver::analyse(gram.as_ref(), Factorization::Llt)
+            let factor = DirectSolver::analyze(gram.as_ref(), Factorization::Llt)
                 .and_then(|s| s.factorize(gram.as_ref()))
                 .map_err(MaxwellError::DependentGradients)?;
             Some(factor)

@@ -108,7 +108,7 @@ pub(super) fn solve_diffusion(
     // With CG the "numeric" phase builds the preconditioner, not a factor.
     let setup = if solution.iterations.is_some() {
         "preconditioner setup"
-    } else if solution.analysed_during_assembly {
+    } else if solution.analyzed_during_assembly {
         // Its analysis overlapped the assembly: the rows add up to more
         // than "assembly + solve".
         "factorisation (analysis beside assembly)"

@@ -50,6 +50,7 @@ use q1::{q1_cell, q1_gradients, q1_load, Q1Memo};
 use rayon::prelude::*;
 use sprs::CsMat;
 use std::rc::Rc;
+use std::sync::Arc;
 use topology::{edge_block, pseudo_inverse_of_key, tensor_order_of};
 pub(crate) use topology::{edge_pseudo_inverse, Topology};
 use vem::vem_stiffness;
@@ -403,7 +404,7 @@ fn dense_stiffness(
     // A 2D cell's sorted edges are its column of ∂₂ by cells: Ω's blocks
     // take their rows from that matrix, shared, and no edge list is
     // written. In 3D the faces' edges are merged per cell.
-    let by_cell = (top.n == 2).then(|| top.complex.shared_boundary_csc(2));
+    let by_cell = (top.n == 2).then(|| Arc::clone(top.complex.boundary_csc(2)));
     let edge_ptr: std::borrow::Cow<[usize]> = match &by_cell {
         Some(by_cell) => by_cell.proper_indptr(),
         None => {

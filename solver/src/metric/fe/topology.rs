@@ -3,6 +3,7 @@
 //! pseudo-inverse A_c⁺ that turns an element matrix into Ω_c.
 
 use super::*;
+use std::sync::Arc;
 
 /// Incidence access shared by the nodal metrics.
 pub(crate) struct Topology<'a> {
@@ -31,8 +32,8 @@ impl<'a> Topology<'a> {
             complex,
             n,
             d: complex.embedding_dim(),
-            delta0: complex.shared_coboundary(0),
-            facets: (2..=n).map(|p| complex.boundary_csc(p)).collect(),
+            delta0: Arc::clone(complex.coboundary(0)),
+            facets: (2..=n).map(|p| &**complex.boundary_csc(p)).collect(),
         })
     }
 

@@ -151,9 +151,10 @@ fn both_ways(
     k: &hasse_complex::Complex,
     omega: BlockMetric,
 ) -> (SparseColMat<usize, f64>, SparseColMat<usize, f64>) {
-    let gathered = Canonical::new(k.shared_coboundary(0), omega.clone()).expect("δ⁰ and Ω fit");
+    let gathered =
+        Canonical::new(Arc::clone(k.coboundary(0)), omega.clone()).expect("δ⁰ and Ω fit");
     let from_cells =
-        Canonical::with_cell_blocks(k.shared_coboundary(0), omega, k).expect("δ⁰ and Ω fit");
+        Canonical::with_cell_blocks(Arc::clone(k.coboundary(0)), omega, k).expect("δ⁰ and Ω fit");
     (gathered.assemble(), from_cells.assemble())
 }
 
@@ -265,7 +266,7 @@ fn a_metric_pushed_to_after_it_was_built_per_cell_uses_its_own_pattern() -> Test
     // −7 on (a, b).
     let (tail, head) = (k.cell_vertices(1, 0)[0], k.cell_vertices(1, 0)[1]);
     let plain = Canonical::new(
-        k.shared_coboundary(0),
+        Arc::clone(k.coboundary(0)),
         crate::metric::fe::stiffness_metric(&k, &[1.0; 4])?,
     )?
     .assemble()

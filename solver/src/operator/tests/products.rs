@@ -355,8 +355,8 @@ fn diagonal_metrics_assemble_like_the_dense_triple_product_and_the_block_path() 
         // With A's CSC form from the complex (used only when every
         // row has its weight) the result is the same.
         let shared = Canonical::with_columns(
-            grid.shared_boundary(2),
-            grid.shared_boundary_csc(2),
+            Arc::clone(grid.boundary(2)),
+            Arc::clone(grid.boundary_csc(2)),
             diagonal.clone(),
         )?
         .assemble();
@@ -403,8 +403,8 @@ fn the_last_assembly_takes_the_pattern_and_a_later_one_rebuilds_it() -> TestResu
     let q1 = crate::metric::fe::stiffness_metric(&grid, &[1.0; 6])?;
     let tpfa = crate::metric::fv::two_point(&grid, &[1.0; 6])?;
     for (a, metric) in [
-        (Arc::new(grid.coboundary(0)), q1),
-        (grid.shared_boundary(2), tpfa),
+        (Arc::clone(grid.coboundary(0)), q1),
+        (Arc::clone(grid.boundary(2)), tpfa),
     ] {
         let mut op = Canonical::new(a, metric)?;
         let before = op.assemble();
@@ -475,7 +475,7 @@ fn a_coupling_block_with_the_identity_and_minus_one_is_minus_the_boundary() -> T
     let b = Canonical::coupling(
         sprs::CsMat::<i8>::eye(edges),
         BlockMetric::diagonal(&vec![-1.0; edges]),
-        k.shared_boundary(2),
+        Arc::clone(k.boundary(2)),
     )?;
     let m = b.assemble().to_dense();
     assert_eq!((m.nrows(), m.ncols()), (7, 2));

@@ -312,7 +312,7 @@ impl Diffusion {
                 || {
                     rayon::join(
                         || complex.shared_vertex_star(n),
-                        || complex.shared_coboundary(0),
+                        || Arc::clone(complex.coboundary(0)),
                     )
                 },
             );
@@ -330,7 +330,7 @@ impl Diffusion {
         let (incidence, metric, unknowns) = match self.method {
             // A source per region is loaded apart ([`Self::source_load`]).
             Method::Fe if self.source_by_region.is_some() => (
-                complex.shared_coboundary(0),
+                Arc::clone(complex.coboundary(0)),
                 fe::stiffness_metric(complex, tensors)?,
                 complex.cell_count(0),
             ),
@@ -339,15 +339,19 @@ impl Diffusion {
                     fe::stiffness_and_load(complex, tensors, &|x| (self.source)(x))
                         .map_err(source_error)?;
                 fe_load = Some(load);
-                (complex.shared_coboundary(0), metric, complex.cell_count(0))
+                (
+                    Arc::clone(complex.coboundary(0)),
+                    metric,
+                    complex.cell_count(0),
+                )
             }
             Method::Dec(kind) => (
-                complex.shared_coboundary(0),
+                Arc::clone(complex.coboundary(0)),
                 dec::hodge_metric(complex, kind, tensors)?,
                 complex.cell_count(0),
             ),
             Method::Fv => (
-                complex.shared_boundary(n),
+                Arc::clone(complex.boundary(n)),
                 match &cell_points {
                     None => fv::two_point(complex, tensors)?,
                     Some(points) => fv::two_point_at(complex, tensors, points)?,
@@ -355,7 +359,7 @@ impl Diffusion {
                 cells,
             ),
             Method::Fd => (
-                complex.shared_boundary(n),
+                Arc::clone(complex.boundary(n)),
                 fd::five_point(complex, tensors)?,
                 cells,
             ),
@@ -441,7 +445,7 @@ impl Diffusion {
         // keeps by columns; a nodal element metric's blocks are the top
         // cells, whose vertex lists the complex keeps.
         let mut canonical = if ghosts.is_empty() && matches!(self.method, Method::Fv | Method::Fd) {
-            Canonical::with_columns(incidence, complex.shared_boundary_csc(n), metric_final)?
+            Canonical::with_columns(incidence, Arc::clone(complex.boundary_csc(n)), metric_final)?
         } else if location == Location::Nodal {
             Canonical::with_cell_blocks(incidence, metric_final, complex)?
         } else {

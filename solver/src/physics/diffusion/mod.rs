@@ -419,7 +419,7 @@ pub struct Solution {
     /// (from the solved matrix's pattern known from topology: two-point
     /// FV/FD, nodal FE), so that its seconds overlap `assembly_seconds`
     /// instead of adding to them.
-    pub analysed_during_assembly: bool,
+    pub analyzed_during_assembly: bool,
     /// Whether the problem was pure Neumann (solution normalised to zero mean).
     pub pure_neumann: bool,
     /// Relative imbalance of pure-Neumann data removed before solving.

@@ -5,6 +5,7 @@
 
 use super::*;
 use crate::la::fixed::FixedSplit;
+use std::sync::Arc;
 
 /// Every connected part of the free unknowns must be tied to a Dirichlet
 /// value or a Robin/ghost row, or M is singular there. On a part C of the
@@ -191,7 +192,7 @@ pub(super) fn solve_fixed(
     let (x, report, iterations) = match iterative {
         None => {
             let (x, report) = match analysis {
-                Some(analysis) => direct::solve_analysed(&analysis, &reduced, &reduced_rhs)?,
+                Some(analysis) => direct::solve_analyzed(&analysis, &reduced, &reduced_rhs)?,
                 None => {
                     let free_points: Option<Vec<f64>> =
                         points.map(|p| points_of(p, free.iter().copied()));
@@ -202,13 +203,13 @@ pub(super) fn solve_fixed(
                             coordinates: c,
                             ..p
                         });
-                    let solver = DirectSolver::analyse_pattern_at(
+                    let solver = DirectSolver::analyze_pattern_at(
                         reduced.symbolic(),
                         factorization,
                         ordering,
                         points,
                     )?;
-                    direct::solve_analysed(&solver, &reduced, &reduced_rhs)?
+                    direct::solve_analyzed(&solver, &reduced, &reduced_rhs)?
                 }
             };
             (x, report, None)
@@ -353,7 +354,7 @@ impl Diffusion {
             dimension: complex.embedding_dim(),
         });
         let (prepared, analysis) = if self.pattern_from_topology(complex) {
-            rayon::join(prepare, || self.analyse_topology(complex, points?))
+            rayon::join(prepare, || self.analyze_topology(complex, points?))
         } else {
             (prepare(), None)
         };
@@ -373,7 +374,7 @@ impl Diffusion {
             ..
         } = system;
         let unknowns = rhs.len();
-        let (mut values, report, iterations, analysed_during_assembly) = solve_fixed(
+        let (mut values, report, iterations, analyzed_during_assembly) = solve_fixed(
             &matrix,
             &rhs,
             &fixed,
@@ -407,7 +408,7 @@ impl Diffusion {
             report,
             iterations,
             assembly_seconds,
-            analysed_during_assembly,
+            analyzed_during_assembly,
             pure_neumann,
             neumann_imbalance,
             cell_points,
@@ -510,7 +511,7 @@ impl Diffusion {
             },
             iterations: None,
             assembly_seconds,
-            analysed_during_assembly: false,
+            analyzed_during_assembly: false,
             pure_neumann,
             neumann_imbalance: 0.0,
             cell_points,
@@ -588,7 +589,7 @@ impl Diffusion {
     /// solve uses it only where it matches entry for entry. `None` when the
     /// analysis fails: the solve then analyses the assembled matrix and
     /// reports the failure itself.
-    pub(super) fn analyse_topology(
+    pub(super) fn analyze_topology(
         &self,
         complex: &Complex,
         points: UnknownPoints<'_>,
@@ -627,8 +628,8 @@ impl Diffusion {
             )
         } else {
             crate::operator::diagonal_pattern(
-                &complex.shared_boundary(n),
-                &complex.shared_boundary_csc(n),
+                &Arc::clone(complex.boundary(n)),
+                &Arc::clone(complex.boundary_csc(n)),
             )
         };
         let points = if self.location() == Location::Nodal {
@@ -639,7 +640,7 @@ impl Diffusion {
         } else {
             points
         };
-        let solver = DirectSolver::analyse_pattern_at(
+        let solver = DirectSolver::analyze_pattern_at(
             pattern.as_ref(),
             self.factorization,
             self.ordering,

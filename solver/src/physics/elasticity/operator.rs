@@ -9,6 +9,7 @@ use hasse_complex::Complex;
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use sprs::{CsMat, TriMat};
+use std::sync::Arc;
 
 /// A = I_d ⊗ δ⁰: row a·|K₁| + e holds edge e's differences of component a,
 /// column a·|K₀| + v is component a at vertex v.
@@ -22,7 +23,7 @@ use sprs::{CsMat, TriMat};
 /// ```
 pub fn incidence(complex: &Complex) -> CsMat<i8> {
     let d = complex.embedding_dim();
-    let delta = complex.shared_coboundary(0);
+    let delta = Arc::clone(complex.coboundary(0));
     let (edges, vertices) = delta.shape();
     let mut tri = TriMat::with_capacity((d * edges, d * vertices), d * delta.nnz());
     for a in 0..d {

@@ -397,7 +397,7 @@ fn tree_cotree(complex: &Complex, relative: bool) -> Result<Vec<Vec<f64>>, Forms
                 }
                 c[p] = -sum / own;
             }
-            if multiply(&d1, &c).iter().any(|&v| v != 0.0) {
+            if multiply(d1, &c).iter().any(|&v| v != 0.0) {
                 return Err(FormsError::Cohomology(
                     "the tree–cotree cochain is not closed: the surface is not orientable (its top cells cannot be oriented coherently)".into(),
                 ));
@@ -463,7 +463,7 @@ impl Forms<'_> {
         roots.iter().for_each(|&r| pinned[r] = true);
         let split = FixedSplit::from_mask(pinned);
         let d0 = complex.coboundary(0);
-        let restricted = split.restrict_columns(&d0);
+        let restricted = split.restrict_columns(d0);
         let star = self.star(1)?;
         let operator = Canonical::new(restricted.clone(), star.clone())?;
         let load = Canonical::coupling(restricted, star, CsMat::<i8>::eye(d0.rows()))?;
@@ -472,7 +472,7 @@ impl Forms<'_> {
             None
         } else {
             Some(
-                DirectSolver::analyse(matrix.as_ref(), Factorization::Llt)?
+                DirectSolver::analyze(matrix.as_ref(), Factorization::Llt)?
                     .factorize(matrix.as_ref())?,
             )
         };
@@ -491,7 +491,7 @@ impl Forms<'_> {
                     None => Vec::new(),
                 };
                 let alpha = split.lift(&free, &[]);
-                let exact = multiply(&d0, &alpha);
+                let exact = multiply(d0, &alpha);
                 Ok(ExactPart {
                     potential: alpha,
                     exact,
@@ -538,7 +538,7 @@ impl Forms<'_> {
             // here, one block per cell), solved as the operator Iᵀ ⋆ I.
             let mass =
                 Canonical::new(CsMat::<i8>::eye(complex.cell_count(n)), self.star(n)?)?.assemble();
-            let factor = DirectSolver::analyse(mass.as_ref(), Factorization::Llt)?
+            let factor = DirectSolver::analyze(mass.as_ref(), Factorization::Llt)?
                 .factorize(mass.as_ref())?;
             top_cycles(complex)
                 .iter()
@@ -567,7 +567,7 @@ impl Forms<'_> {
                 0.0
             } else {
                 let weighted = star.apply(h);
-                let mut divergence = multiply_transpose(&self.d(k - 1)?, &weighted);
+                let mut divergence = multiply_transpose(&*self.d(k - 1)?, &weighted);
                 if relative {
                     // Only interior (k−1)-cells carry the equation.
                     let (ground, _) = wall_masks(complex);

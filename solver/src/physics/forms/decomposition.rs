@@ -96,12 +96,12 @@ impl Forms<'_> {
             BlockMetric::diagonal(&inverse),
         )?;
         let matrix = operator.assemble();
-        let curl = multiply(&complex.coboundary(1), omega);
+        let curl = multiply(complex.coboundary(1), omega);
         let rhs = split.restrict(&curl);
         let free = if split.free().is_empty() {
             Vec::new()
         } else {
-            DirectSolver::analyse(matrix.as_ref(), Factorization::Llt)?
+            DirectSolver::analyze(matrix.as_ref(), Factorization::Llt)?
                 .factorize(matrix.as_ref())?
                 .solve(&rhs)?
         };

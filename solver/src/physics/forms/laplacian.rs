@@ -145,7 +145,7 @@ impl HodgeLaplacian {
         let mut entries: Vec<Triplet<usize, usize, f64>> = Vec::new();
         if k < n {
             let star = forms.star(k + 1)?;
-            let curl = Canonical::new(cells.restrict_columns(&forms.d(k)?), star)?.assemble();
+            let curl = Canonical::new(cells.restrict_columns(&*forms.d(k)?), star)?.assemble();
             push_entries(&mut entries, curl.as_ref());
         }
         if let Some(lower) = &lower {
@@ -154,7 +154,7 @@ impl HodgeLaplacian {
             let b = Canonical::coupling(
                 cells.selection(),
                 BlockMetric::diagonal(&star_k),
-                lower.restrict_columns(&forms.d(k - 1)?),
+                lower.restrict_columns(&*forms.d(k - 1)?),
             )?
             .assemble();
             for (j, &cell) in lower.free().iter().enumerate() {
@@ -187,7 +187,7 @@ impl HodgeLaplacian {
         let star_k = forms.star(k)?;
         let curl = (k < n)
             .then(|| -> Result<Canonical, FormsError> {
-                let d = cells.restrict_columns(&forms.d(k)?);
+                let d = cells.restrict_columns(&*forms.d(k)?);
                 Ok(Canonical::new(d, forms.star(k + 1)?)?)
             })
             .transpose()?;
@@ -217,7 +217,7 @@ impl HodgeLaplacian {
         )?;
         // d_{k−1}ᵀ M_k: (k−1)-cells × k-cells, the σ–u block.
         let coupling = Canonical::coupling(
-            lower.restrict_columns(&forms.d(k - 1)?),
+            lower.restrict_columns(&*forms.d(k - 1)?),
             star_k,
             cells.selection(),
         )?;
@@ -240,7 +240,7 @@ impl HodgeLaplacian {
         let factor = if sigma == 0 {
             None
         } else {
-            let factor = DirectSolver::analyse(gram.as_ref(), Factorization::Llt)?
+            let factor = DirectSolver::analyze(gram.as_ref(), Factorization::Llt)?
                 .factorize(gram.as_ref())?;
             Some((factor, coupling_matrix))
         };
@@ -414,7 +414,7 @@ pub fn relative_betti_numbers(complex: &Complex) -> Vec<usize> {
     let ranks: Vec<usize> = (0..n)
         .map(|p| {
             let d: CsMat<i8> =
-                splits[p + 1].restrict_rows(&splits[p].restrict_columns(&complex.coboundary(p)));
+                splits[p + 1].restrict_rows(&splits[p].restrict_columns(complex.coboundary(p)));
             rank(&d, Field::Rationals)
         })
         .collect();

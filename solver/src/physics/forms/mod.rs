@@ -22,7 +22,7 @@
 //! let k = sphere(1.0, 1).unwrap();
 //! let forms = Forms::new(&k, Star::Diagonal(DualKind::Circumcentric));
 //! // d∘d = 0 exactly, in integers.
-//! let dd = &forms.d(1).unwrap() * &forms.d(0).unwrap();
+//! let dd = &*forms.d(1).unwrap() * &*forms.d(0).unwrap();
 //! assert!(dd.data().iter().all(|&x| x == 0));
 //! // Σ ⋆₀ is the area of the (polyhedral) sphere, a bit below 4π.
 //! let area: f64 = forms.star(0).unwrap().diagonal_weights().unwrap().iter().sum();
@@ -46,6 +46,7 @@ use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use faer::sparse::{SparseColMat, Triplet};
 use hasse_complex::{Complex, ComplexError, DualKind};
 use sprs::CsMat;
+use std::sync::Arc;
 
 /// Which Hodge star the forms get.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -167,13 +168,19 @@ impl<'a> Forms<'a> {
 
     /// d_k = δᵏ = ∂_{k+1}ᵀ ((k+1)-cells × k-cells), exact integers; for
     /// k = n the empty 0 × |K_n| matrix.
-    pub fn d(&self, k: usize) -> Result<CsMat<i8>, FormsError> {
+    /// Shared with the complex (no copy) for k < n.
+    pub fn d(&self, k: usize) -> Result<Arc<CsMat<i8>>, FormsError> {
         self.check(k)?;
         if k == self.complex.dim() {
             let cols = self.complex.cell_count(k);
-            return Ok(CsMat::new((0, cols), vec![0], Vec::new(), Vec::new()));
+            return Ok(Arc::new(CsMat::new(
+                (0, cols),
+                vec![0],
+                Vec::new(),
+                Vec::new(),
+            )));
         }
-        Ok(self.complex.coboundary(k))
+        Ok(Arc::clone(self.complex.coboundary(k)))
     }
 
     /// ⋆_k as a metric over the k-cells: diagonal for [`Star::Diagonal`],

@@ -110,7 +110,7 @@ impl StepSystem {
                 } => {
                     // The pattern of L does not depend on Δt: one analysis.
                     if analysis.is_none() {
-                        *analysis = Some(DirectSolver::analyse_with(
+                        *analysis = Some(DirectSolver::analyze_with(
                             reduced.as_ref(),
                             *factorization,
                             *ordering,

@@ -287,13 +287,13 @@ pub(super) fn iterate(
                 problem, system, &u, &at, time_step,
             )))?;
         let matrix = work.jacobian.assemble();
-        // The pattern never changes: analyse once (LU, since the
+        // The pattern never changes: analyze once (LU, since the
         // derivative of the face weights makes J unsymmetric).
         let solver = match work.analysis.take() {
             Some(solver) => solver,
             None => {
                 work.analyses += 1;
-                DirectSolver::analyse_pattern(
+                DirectSolver::analyze_pattern(
                     matrix.symbolic(),
                     Factorization::Lu,
                     Ordering::Automatic,
@@ -302,7 +302,7 @@ pub(super) fn iterate(
             }
         };
         let minus: Vec<f64> = at.residual.iter().map(|r| -r).collect();
-        let solved = direct::solve_analysed(&solver, &matrix, &minus);
+        let solved = direct::solve_analyzed(&solver, &matrix, &minus);
         work.analysis = Some(solver);
         let (delta, solved) = solved.map_err(|e| stop(Stall::Solve(e), &history))?;
         report = Some(solved);
@@ -374,7 +374,7 @@ pub(super) fn solution(
         flux,
         report,
         assembly_seconds: system.assembly_seconds,
-        analysed_during_assembly: false,
+        analyzed_during_assembly: false,
         pure_neumann: false,
         neumann_imbalance: 0.0,
         cell_points: None,

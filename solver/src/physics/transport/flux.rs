@@ -248,7 +248,7 @@ impl Advection {
     pub(super) fn operator(&self, complex: &Complex) -> Result<Canonical, TransportError> {
         let n = complex.dim();
         Ok(Canonical::coupling(
-            complex.shared_boundary(n),
+            complex.boundary(n),
             BlockMetric::diagonal(&self.flux),
             self.upwind.clone(),
         )?)

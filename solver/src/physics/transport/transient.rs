@@ -335,7 +335,7 @@ impl Transport {
         }
         let stepper = match &self.solver {
             LinearSolver::Lu => Stepper::Lu(
-                DirectSolver::analyse(step_matrix.as_ref(), Factorization::Lu)?
+                DirectSolver::analyze(step_matrix.as_ref(), Factorization::Lu)?
                     .factorize(step_matrix.as_ref())?,
             ),
             LinearSolver::Krylov {
