@@ -37,7 +37,7 @@ use sprs::CsMat;
 /// let (fine, r) = split(&k, &h, None, Default::default()).unwrap();
 /// // Mass 4 splits 1 : 3 by area; the average copies.
 /// assert_eq!(r.extensive(&fine, 2, &[4.0]).unwrap(), vec![1.0, 3.0]);
-/// assert_eq!(r.intensive(2, &[4.0]).unwrap(), vec![4.0, 4.0]);
+/// assert_eq!(r.intensive(&fine, 2, &[4.0]).unwrap(), vec![4.0, 4.0]);
 /// // u = x at the vertices interpolates exactly.
 /// let u: Vec<f64> = (0..4).map(|v| k.vertices().point(v)[0]).collect();
 /// let fine_u = r.nodal(&u).unwrap();
@@ -220,18 +220,42 @@ impl Refinement {
         Ok(())
     }
 
+    /// `fine` is the refined complex this map was made for (its p-cells
+    /// are the rows of ζ_p).
+    fn check_fine(&self, fine: &Complex, p: usize) -> Result<(), SplitError> {
+        let rows = self.zeta[p].rows();
+        if p > fine.dim() || fine.cell_count(p) != rows {
+            return Err(SplitError::LengthMismatch {
+                what: "refined complex",
+                p,
+                expected: rows,
+                found: fine.cell_count(p),
+            });
+        }
+        Ok(())
+    }
+
     /// Intensive values (averages, densities) on coarse p-cells → refined
     /// p-cells: each piece gets ε × its parent's value; new cut cells get 0.
+    /// Takes the same arguments as [`Refinement::extensive`] (the refined
+    /// complex is only checked here), so a caller can pick either by the
+    /// kind of field.
     ///
     /// ```
     /// use hasse_complex::generate::rectangle;
     /// use hasse_complex::split::{split, Hyperplane};
     /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
     /// let (fine, r) = split(&k, &Hyperplane::axis(2, 1, 0.5).unwrap(), None, Default::default()).unwrap();
-    /// assert_eq!(r.intensive(2, &[7.0]).unwrap(), vec![7.0, 7.0]);
+    /// assert_eq!(r.intensive(&fine, 2, &[7.0]).unwrap(), vec![7.0, 7.0]);
     /// ```
-    pub fn intensive(&self, p: usize, coarse: &[f64]) -> Result<Vec<f64>, SplitError> {
+    pub fn intensive(
+        &self,
+        fine: &Complex,
+        p: usize,
+        coarse: &[f64],
+    ) -> Result<Vec<f64>, SplitError> {
         self.check(p, coarse, "intensive field")?;
+        self.check_fine(fine, p)?;
         let z = &self.zeta[p];
         Ok(z.outer_iterator()
             .map(|row| {
@@ -269,15 +293,8 @@ impl Refinement {
         coarse: &[f64],
     ) -> Result<Vec<f64>, SplitError> {
         self.check(p, coarse, "extensive field")?;
+        self.check_fine(fine, p)?;
         let z = &self.zeta[p];
-        if fine.cell_count(p) != z.rows() || p > fine.dim() {
-            return Err(SplitError::LengthMismatch {
-                what: "refined complex",
-                p,
-                expected: z.rows(),
-                found: fine.cell_count(p),
-            });
-        }
         let measure = fine.measure(p);
         let mut total = vec![0.0; z.cols()];
         for (i, row) in z.outer_iterator().enumerate() {

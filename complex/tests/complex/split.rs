@@ -563,7 +563,7 @@ fn bad_input_is_reported() {
     ));
     let cuts = vec![(0, h.clone()), (0, h)];
     assert!(split_cells(&k, &cuts, SplitOptions::default()).is_err());
-    let (_, r) = split(
+    let (fine, r) = split(
         &k,
         &Hyperplane::axis(2, 0, 0.5).unwrap(),
         None,
@@ -571,7 +571,7 @@ fn bad_input_is_reported() {
     )
     .unwrap();
     assert!(matches!(
-        r.intensive(2, &[1.0, 2.0]),
+        r.intensive(&fine, 2, &[1.0, 2.0]),
         Err(SplitError::LengthMismatch { .. })
     ));
     assert!(matches!(
@@ -607,7 +607,7 @@ fn transfers_conserve_and_interpolate() {
         for (b, c) in back.iter().zip(&coarse) {
             assert!(abs_diff_eq!(b, c, epsilon = 1e-14), "p = {p}: {b} vs {c}");
         }
-        let int = r.intensive(p, &coarse).unwrap();
+        let int = r.intensive(&fine, p, &coarse).unwrap();
         for (i, v) in int.iter().enumerate() {
             match r.parent(p, i) {
                 Some((j, s)) => assert_eq!(*v, f64::from(s) * coarse[j]),
