@@ -19,6 +19,16 @@ use hasse_solver::physics::forms::whitney_map::{cell_vectors, de_rham, Field};
 use hasse_solver::physics::forms::{Forms, Star};
 use std::error::Error;
 
+/// Rounding-level checks: an example that prints a wrong number fails
+/// (CI runs every example).
+fn ensure(ok: bool, what: String) -> Result<(), Box<dyn Error>> {
+    if ok {
+        Ok(())
+    } else {
+        Err(what.into())
+    }
+}
+
 fn main() -> Result<(), Box<dyn Error>> {
     let complex = torus(2.0, 0.7, 32, 12)?;
     let forms = Forms::new(&complex, Star::Diagonal(DualKind::Barycentric));
@@ -30,11 +40,20 @@ fn main() -> Result<(), Box<dyn Error>> {
         basis.betti,
         complex.cell_count(1)
     );
+    // The torus has β₁ = 2.
+    ensure(
+        basis.forms.len() == 2,
+        format!("{} harmonic forms, not 2", basis.forms.len()),
+    )?;
     for (j, (closed, coclosed)) in basis.closed.iter().zip(&basis.coclosed).enumerate() {
         println!(
             "  h{}: ‖dh‖/‖h‖ = {closed:.1e}, ‖dᵀ⋆h‖/‖⋆h‖ = {coclosed:.1e}",
             j + 1
         );
+        ensure(
+            *closed < 1e-12 && *coclosed < 1e-12,
+            format!("h{} is not harmonic to rounding", j + 1),
+        )?;
     }
 
     let field = |p: &[f64]| {
@@ -60,11 +79,17 @@ fn main() -> Result<(), Box<dyn Error>> {
             names[j],
             product / total
         );
+        ensure(
+            (product / total).abs() < 1e-12,
+            format!(
+                "the {} and {} parts are not ⋆-orthogonal",
+                names[i], names[j]
+            ),
+        )?;
     }
-    println!(
-        "|‖ω‖² − Σ‖part‖²| / ‖ω‖² = {:.1e}",
-        (total - squares).abs() / total
-    );
+    let pythagoras = (total - squares).abs() / total;
+    println!("|‖ω‖² − Σ‖part‖²| / ‖ω‖² = {pythagoras:.1e}");
+    ensure(pythagoras < 1e-12, "the parts' norms do not add up".into())?;
 
     let vectors = cell_vectors(&complex, 1, &split.harmonic)?;
     for cell in [0, 8, 16] {

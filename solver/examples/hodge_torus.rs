@@ -15,7 +15,18 @@ use hasse_complex::Complex;
 use hasse_solver::physics::forms::{Boundary, Forms, Star};
 use std::error::Error;
 
-fn report(name: &str, complex: &Complex, star: Star) -> Result<(), Box<dyn Error>> {
+/// Rounding-level checks: an example that prints a wrong number fails
+/// (CI runs every example).
+fn ensure(ok: bool, what: String) -> Result<(), Box<dyn Error>> {
+    if ok {
+        Ok(())
+    } else {
+        Err(what.into())
+    }
+}
+
+/// Δ₁'s kernel and lowest eigenvalues; returns the eigenvalues.
+fn report(name: &str, complex: &Complex, star: Star) -> Result<Vec<f64>, Box<dyn Error>> {
     let forms = Forms::new(complex, star);
     let laplacian = forms.hodge_laplacian(1, Boundary::Natural)?;
     let modes = laplacian.modes(4, &laplacian.default_options())?;
@@ -26,6 +37,10 @@ fn report(name: &str, complex: &Complex, star: Star) -> Result<(), Box<dyn Error
         laplacian.betti(),
         modes.eigenvalues
     );
+    ensure(
+        modes.kernel == laplacian.betti(),
+        format!("{name}: dim ker Δ₁ = {} ≠ β₁", modes.kernel),
+    )?;
     let d1 = forms.d(1)?;
     for (j, h) in modes.harmonic.iter().enumerate() {
         // d₁h: integers times values, summed per face.
@@ -40,6 +55,10 @@ fn report(name: &str, complex: &Complex, star: Star) -> Result<(), Box<dyn Error
             .fold(0.0, f64::max);
         let size = h.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         print!("  h{}: max |d₁h| / max |h| = {:.1e}", j + 1, curl / size);
+        ensure(
+            curl / size < 1e-12,
+            format!("{name}: h{} is not closed", j + 1),
+        )?;
         if star.is_diagonal() {
             let delta = forms.codifferential(1)?;
             let mut div = vec![0.0; delta.nrows()];
@@ -57,7 +76,7 @@ fn report(name: &str, complex: &Complex, star: Star) -> Result<(), Box<dyn Error
         }
         println!();
     }
-    Ok(())
+    Ok(modes.eigenvalues.clone())
 }
 
 fn main() -> Result<(), Box<dyn Error>> {
@@ -67,10 +86,17 @@ fn main() -> Result<(), Box<dyn Error>> {
         &torus(2.0, 0.7, 32, 12)?,
         barycentric,
     )?;
-    report(
+    let flat = report(
         "flat torus 16 × 8 squares",
         &torus_flat(16, 8, [0.0, 2.0], [0.0, 1.0], false)?,
         barycentric,
+    )?;
+    // The lowest nonzero eigenvalue of the periodic 5-point Laplacian with
+    // 16 cells of h = 1/8 along x (the longer side): (2/h)² sin²(π/16).
+    let exact = (2.0 * 8.0 * (std::f64::consts::PI / 16.0).sin()).powi(2);
+    ensure(
+        (flat[0] - exact).abs() < 1e-10 * exact,
+        format!("flat torus: λ = {} ≠ (2/h)² sin²(π/16) = {exact}", flat[0]),
     )?;
     report(
         "flat torus 16 × 8 triangles, Whitney",
