@@ -12,7 +12,7 @@
 //! | `/mesh` attrs `dim` (n), `embedding_dim` (d), `complex` (`"minimal"` or `"full"`, see [`ComplexLayout`]) | |
 //! | `/mesh/vertices` | (N, 3) f64, zero-padded when d < 3; attr `embedding_dim` |
 //! | `/mesh/cells/<p>/indptr`, `indices` | CSR characteristic matrix M_p (u64) for p = n and the degrees of the cochains (every p = 0..=n in the full layout); attr `shape` = (rows, cols). Row i lists the sorted vertex ids of p-cell i; p-cell ids everywhere else are these row numbers |
-//! | `/mesh/boundary/<p>/indptr`, `indices` (u64), `data` (i8) | full layout only: signed ∂_p in CSR, rows (p-1)-cells, columns p-cells, p = 1..=n; attr `shape`; chunked and deflated from 1 MiB |
+//! | `/mesh/boundary/<p>/indptr`, `indices` (u64), `data` (i8) | full layout only: signed ∂_p in CSR, rows (p-1)-cells, columns p-cells, p = 1..=n; attr `shape` |
 //! | `/mesh/tags/<name>` | u64 ids of the tagged cells; attr `dim` |
 //! | `/steps/<k>` attr `time` | one group per time level k = 0, 1, … |
 //! | `/steps/<k>/<name>` | f64 cochain, one value per p-cell; attrs `dim`, and `units`, `method`, `description` when given |
@@ -21,6 +21,10 @@
 //! | `/xdmf/<p>/topology` | connectivity of the XDMF grid of the p-cells (i64), see below |
 //! | `/xdmf/<p>/cell_ids` | only when the grid's elements are not the p-cells one to one: the p-cell of each element |
 //! | `/xdmf/<p>/steps/<k>/<name>` | only with `cell_ids`: the cochain expanded to the elements |
+//!
+//! The integer arrays of `cells`, `boundary` and `xdmf` of 1 MiB or more
+//! are chunked and shuffle + deflate compressed (when the HDF5 library has
+//! zlib); readers see ordinary datasets.
 //!
 //! Strings are variable-length UTF-8, so h5py returns attributes as `str`
 //! (string datasets need `.asstr()[()]`).
