@@ -238,7 +238,7 @@ fn large_integer_arrays_are_compressed_and_read_back_exactly() {
     for p in 1..=2 {
         assert_same(
             &read_boundary(&full.hdf5, "mesh", p).unwrap(),
-            &k.boundary(p),
+            k.boundary(p),
         );
     }
 }

@@ -362,6 +362,7 @@ fn mesh_levels<'l>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frontend::output::write_run;
     use hasse_complex::generate::rectangle;
     use hasse_complex::{TopCells, Vertices};
     use hdf5::types::{TypeDescriptor, VarLenUnicode};
