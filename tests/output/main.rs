@@ -9,6 +9,7 @@ mod pyenv;
 #[path = "../common/scratch.rs"]
 mod scratch;
 
+mod complex_layout;
 mod flux_convention;
 mod level_files;
 mod output_files;

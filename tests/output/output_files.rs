@@ -10,8 +10,8 @@ use approx::assert_abs_diff_eq;
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
 use hasse_solver::frontend::output::{
-    write_mesh_series, write_run, Cochain, MeshStep, OutputError, Provenance, RunOutput,
-    SeriesOutput, Step,
+    write_mesh_series, write_mesh_series_with, write_run, write_run_with, Cochain, ComplexLayout,
+    MeshStep, OutputError, OutputFiles, Provenance, RunOutput, SeriesOutput, Step,
 };
 use hdf5::types::VarLenUnicode;
 use sprs::CsMat;
@@ -114,6 +114,17 @@ fn str_attr(loc: &hdf5::Location, name: &str) -> String {
         .to_string()
 }
 
+/// The tests that compare every M_p and ∂_p with the complex write the
+/// full layout (`[output] complex = "full"`); `complex_layout.rs` tests
+/// the default one.
+fn write_full_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputError> {
+    write_run_with(stem, run, ComplexLayout::Full)
+}
+
+fn write_full_series(stem: &Path, series: &SeriesOutput) -> Result<OutputFiles, OutputError> {
+    write_mesh_series_with(stem, series, ComplexLayout::Full)
+}
+
 fn usizes(v: &[u64]) -> Vec<usize> {
     v.iter().map(|&x| x as usize).collect()
 }
@@ -132,6 +143,14 @@ fn check_mesh_at(f: &hdf5::File, group: &str, k: &Complex) {
     assert_eq!(
         mesh.attr("dim").unwrap().read_scalar::<u64>().unwrap(),
         n as u64
+    );
+    assert_eq!(
+        mesh.attr("complex")
+            .unwrap()
+            .read_scalar::<VarLenUnicode>()
+            .unwrap()
+            .as_str(),
+        "full"
     );
     let vertices = f.dataset(&format!("{group}/vertices")).unwrap();
     assert_eq!(vertices.shape(), vec![k.cell_count(0), 3]);
@@ -241,7 +260,7 @@ fn quad_grid_round_trips_exactly() {
         .with_description("x + 2y");
     let q = Cochain::new("flux", 1, index_cochain(&k, 1));
     let c = Cochain::new("cell id", 2, index_cochain(&k, 2));
-    let files = write_run(&dir.join("quad"), &steady(&k, vec![u, q, c])).unwrap();
+    let files = write_full_run(&dir.join("quad"), &steady(&k, vec![u, q, c])).unwrap();
     assert_eq!(files.hdf5, dir.join("quad.h5"));
     assert_eq!(files.xdmf, dir.join("quad.xdmf"));
     assert_eq!(files.extra_xdmf, [dir.join("quad.edges.xdmf")]);
@@ -354,7 +373,7 @@ fn triangles_and_hexes_get_reader_vertex_order() {
     let x = uniform_axis(3, 0.0, 1.5).unwrap();
     let tri = kuhn(&[x.clone(), x]).unwrap();
     let dir = scratch("tri-hex");
-    let files = write_run(
+    let files = write_full_run(
         &dir.join("tri"),
         &steady(&tri, vec![Cochain::new("id", 2, index_cochain(&tri, 2))]),
     )
@@ -381,7 +400,7 @@ fn triangles_and_hexes_get_reader_vertex_order() {
         Cochain::new("face", 2, index_cochain(&hex, 2)),
         Cochain::new("id", 3, index_cochain(&hex, 3)),
     ];
-    let files = write_run(&dir.join("hex"), &steady(&hex, cochains)).unwrap();
+    let files = write_full_run(&dir.join("hex"), &steady(&hex, cochains)).unwrap();
     let f = open(&files.hdf5);
     check_mesh(&f, &hex);
     let h = read_i64(&f, "xdmf/3/topology");
@@ -447,7 +466,7 @@ fn polygons_mix_in_one_topology_array() {
     let cells = TopCells::polygons([vec![0, 1, 2, 3, 4], vec![1, 5, 6, 2], vec![2, 6, 7]]);
     let k = Complex::build(v, cells).unwrap();
     let dir = scratch("polygons");
-    let files = write_run(
+    let files = write_full_run(
         &dir.join("poly"),
         &steady(&k, vec![Cochain::new("id", 2, index_cochain(&k, 2))]),
     )
@@ -835,7 +854,7 @@ fn a_1d_complex_is_one_polyline_grid() {
         Cochain::new("u", 0, linear(&k)),
         Cochain::new("q", 1, index_cochain(&k, 1)),
     ];
-    let files = write_run(&dir.join("line"), &steady(&k, cochains)).unwrap();
+    let files = write_full_run(&dir.join("line"), &steady(&k, cochains)).unwrap();
     let f = open(&files.hdf5);
     check_mesh(&f, &k);
     // (N, 3) with y = z = 0 padding and the embedding dimension kept.
@@ -880,7 +899,7 @@ fn stems_that_cannot_name_the_files_are_rejected() {
 
     // No step at all: the mesh alone, an empty `times`, a grid without attributes.
     let mesh_only = run(&k, vec![]);
-    let files = write_run(&dir.join("mesh"), &mesh_only).unwrap();
+    let files = write_full_run(&dir.join("mesh"), &mesh_only).unwrap();
     let f = open(&files.hdf5);
     assert_eq!(
         f.attr("step_count").unwrap().read_scalar::<u64>().unwrap(),
@@ -1004,7 +1023,7 @@ fn a_refinement_series_stores_each_mesh_with_its_step() {
     let times = [0.0, 0.5, 1.25];
     let levels: Vec<(f64, &Complex)> = times.iter().copied().zip(&grids).collect();
     let dir = scratch("mesh-series");
-    let files = write_mesh_series(&dir.join("refine"), &series(&levels)).unwrap();
+    let files = write_full_series(&dir.join("refine"), &series(&levels)).unwrap();
     assert_eq!(files.hdf5, dir.join("refine.h5"));
     assert_eq!(files.xdmf, dir.join("refine.xdmf"));
     assert_eq!(files.extra_xdmf, [dir.join("refine.edges.xdmf")]);
@@ -1169,7 +1188,7 @@ fn a_series_with_split_polyhedra_keeps_the_expanded_values_with_each_mesh() {
         provenance: Provenance::new(serde_json::Value::Null),
     };
     let dir = scratch("mesh-series-split");
-    let files = write_mesh_series(&dir.join("split"), &out).unwrap();
+    let files = write_full_series(&dir.join("split"), &out).unwrap();
     assert!(files.extra_xdmf.is_empty());
     let f = open(&files.hdf5);
     check_mesh_at(&f, "steps/0/mesh", &prisms);

@@ -9,6 +9,10 @@
 //! level's own files (`<stem>.level-<k>[.edges].xdmf`) with that level's
 //! mesh and fields, and meshio's `TimeSeriesReader` refuses the series.
 //!
+//! The files are written with `[output] complex = "full"`, whose every
+//! M_p and ∂_p the script compares (the default layout is read by
+//! `tests/python/check_run.py` after a `hasse run`).
+//!
 //! Python runs in a private venv at `<target>/pyenv` (see
 //! `tests/common/pyenv.rs`). Without network the test fails under `CI` and is
 //! skipped loudly elsewhere.
@@ -16,7 +20,8 @@
 use hasse_complex::generate::{box3, kuhn, rectangle, uniform_axis};
 use hasse_complex::{Complex, TopCells, Vertices};
 use hasse_solver::frontend::output::{
-    write_mesh_series, write_run, Cochain, MeshStep, Provenance, RunOutput, SeriesOutput, Step,
+    write_mesh_series_with, write_run_with, Cochain, ComplexLayout, MeshStep, Provenance,
+    RunOutput, SeriesOutput, Step,
 };
 use serde_json::{json, Value};
 use std::path::Path;
@@ -98,7 +103,7 @@ fn steady_case(
         }],
         provenance: provenance(),
     };
-    let files = write_run(&dir.join(name), &run).unwrap();
+    let files = write_run_with(&dir.join(name), &run, ComplexLayout::Full).unwrap();
     let mut case = describe(name, k, &files.hdf5, &files.xdmf, &[0.0], cell_counts);
     case["datasets"] = json!({"steps/0/u": u, "steps/0/c": c});
     case["point_data"] = json!({ "u": u });
@@ -230,7 +235,7 @@ fn h5py_and_meshio_read_the_output() {
         steps,
         provenance: provenance(),
     };
-    let files = write_run(&dir.join("series"), &run).unwrap();
+    let files = write_run_with(&dir.join("series"), &run, ComplexLayout::Full).unwrap();
     let mut series = describe(
         "series",
         &quad,
@@ -346,7 +351,7 @@ fn mesh_series_case(dir: &Path) -> Value {
             .collect(),
         provenance: provenance(),
     };
-    let files = write_mesh_series(&dir.join("growing"), &series).unwrap();
+    let files = write_mesh_series_with(&dir.join("growing"), &series, ComplexLayout::Full).unwrap();
     assert_eq!(files.extra_xdmf, [dir.join("growing.edges.xdmf")]);
     // Each level alone: its top cells and its edges.
     let expected_levels: Vec<Vec<_>> = (0..meshes.len())

@@ -226,7 +226,7 @@ impl Default for SolverSpec {
 /// let text = "[mesh]\ngenerator = \"rectangle\"\nn = [2, 2]\n[problem]\nmethod = \"fv\"\n";
 /// // By default the stem is the case file's, in the working directory.
 /// let output = Case::from_text("cases/plate.toml", text, &[]).unwrap().output;
-/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true, quantities: vec![], probes: vec![], fields: None, partial: true });
+/// assert_eq!(output, OutputSpec { directory: PathBuf::from("."), name: "plate".into(), write: true, quantities: vec![], probes: vec![], fields: None, partial: true, complex: Default::default() });
 /// ```
 #[derive(Clone, Debug, PartialEq)]
 pub struct OutputSpec {
@@ -245,6 +245,10 @@ pub struct OutputSpec {
     /// `partial`: whether a transient run writes each level as it
     /// completes to a partial output (default true).
     pub partial: bool,
+    /// `complex`: how much of the complex the h5 file stores, `"minimal"`
+    /// (default: vertices, the cells the fields and grids live on, tags)
+    /// or `"full"` (besides, every M_p and every ∂_p).
+    pub complex: crate::frontend::output::ComplexLayout,
 }
 
 impl OutputSpec {

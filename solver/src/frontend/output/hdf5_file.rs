@@ -2,8 +2,7 @@
 
 use super::topology::GridTopology;
 use super::xdmf::{center, Center};
-use super::{Level, Levels, MeshAt, OutputError};
-use hasse_complex::Complex;
+use super::{ComplexLayout, Level, Levels, MeshAt, OutputError};
 use hdf5::types::VarLenUnicode;
 use hdf5::{Group, H5Type, Location};
 use ndarray::ArrayView2;
@@ -17,6 +16,10 @@ pub(crate) const FORMAT_VERSION: u64 = 1;
 /// Version 2: `write_mesh_series`, one mesh per step under `/steps/<k>/mesh`
 /// (`mesh_changes` = 1), no `/mesh` and no `/xdmf`.
 pub(crate) const FORMAT_VERSION_MESH_SERIES: u64 = 2;
+
+/// Whether every large dataset is compressed (fields and coordinates
+/// too), or only the integer arrays of the grid (see `write_mesh`).
+const COMPRESSION: Compression = Compression::None;
 
 /// Attach the file path to an HDF5 error.
 trait At<T> {
@@ -32,17 +35,67 @@ impl<T> At<T> for hdf5::Result<T> {
     }
 }
 
-struct Writer<'p> {
-    path: &'p Path,
+/// Datasets of at least this many bytes are compressed by a writer that
+/// compresses at all: below it the chunk index and filter headers cost
+/// more than they save.
+const DEFLATE_MIN_BYTES: usize = 1 << 20;
+/// Elements per chunk of a compressed dataset (rows for a matrix are this
+/// over its width): 2 MiB of u64, big enough for deflate to find the
+/// repetitions of an index array, small enough to stay in HDF5's cache.
+const CHUNK_ELEMENTS: usize = 1 << 18;
+/// zlib level of the deflate filter: level 1 already takes the shuffled
+/// index arrays to a fraction of their size; higher levels cost several
+/// times the time for a few per cent more.
+const DEFLATE_LEVEL: u8 = 1;
+
+/// Whether large datasets of a writer go through shuffle + deflate.
+#[derive(Clone, Copy, PartialEq)]
+enum Compression {
+    None,
+    Large,
 }
 
-impl Writer<'_> {
+struct Writer<'p> {
+    path: &'p Path,
+    compression: Compression,
+}
+
+impl<'p> Writer<'p> {
+    /// A writer of `path` that compresses large datasets when `compression`
+    /// asks for it and the HDF5 library in use has the deflate filter (a
+    /// build without zlib writes them uncompressed: same contents, no error).
+    fn new(path: &'p Path, compression: Compression) -> Self {
+        let compression = match compression {
+            Compression::Large if hdf5::filters::deflate_available() => Compression::Large,
+            _ => Compression::None,
+        };
+        Writer { path, compression }
+    }
+
+    /// The same file, with large datasets compressed (if the library can).
+    fn compressing(&self) -> Self {
+        Writer::new(self.path, Compression::Large)
+    }
+
     fn group(&self, parent: &Group, name: &str) -> Result<Group, OutputError> {
         parent.create_group(name).at(self.path)
     }
 
+    /// Rows per chunk for a `rows` × `columns` dataset of `T`, when it is
+    /// to be compressed.
+    fn chunk_rows<T>(&self, rows: usize, columns: usize) -> Option<usize> {
+        let bytes = rows * columns * std::mem::size_of::<T>();
+        (self.compression == Compression::Large && bytes >= DEFLATE_MIN_BYTES)
+            .then(|| (CHUNK_ELEMENTS / columns.max(1)).clamp(1, rows))
+    }
+
     fn vector<T: H5Type>(&self, g: &Group, name: &str, data: &[T]) -> Result<(), OutputError> {
-        g.new_dataset_builder()
+        let builder = g.new_dataset_builder();
+        let builder = match self.chunk_rows::<T>(data.len(), 1) {
+            Some(rows) => builder.chunk(rows).shuffle().deflate(DEFLATE_LEVEL),
+            None => builder,
+        };
+        builder
             .with_data(data)
             .create(name)
             .at(self.path)
@@ -62,7 +115,15 @@ impl Writer<'_> {
                 path: self.path.to_path_buf(),
                 message: format!("dataset {name}: {e}"),
             })?;
-        g.new_dataset_builder()
+        let builder = g.new_dataset_builder();
+        let builder = match self.chunk_rows::<T>(rows, columns) {
+            Some(chunk) => builder
+                .chunk((chunk, columns))
+                .shuffle()
+                .deflate(DEFLATE_LEVEL),
+            None => builder,
+        };
+        builder
             .with_data(view)
             .create(name)
             .at(self.path)
@@ -151,7 +212,8 @@ pub(crate) fn write(
     written_at: &str,
 ) -> Result<(), OutputError> {
     let file = hdf5::File::create(path).at(path)?;
-    write_contents(&Writer { path }, &file, levels, grids, written_at)?;
+    let w = Writer::new(path, COMPRESSION);
+    write_contents(&w, &file, levels, grids, written_at)?;
     file.flush().at(path)?;
     file.close().at(path)
 }
@@ -182,7 +244,7 @@ fn write_contents(
     }
 
     for (mesh, grids) in levels.meshes.iter().zip(grids) {
-        write_mesh(w, &w.group(root, &mesh.group)?, mesh.complex)?;
+        write_mesh(w, &w.group(root, &mesh.group)?, levels, mesh, grids)?;
         write_xdmf_arrays(w, &w.group(root, &mesh.xdmf_group)?, levels, mesh, grids)?;
     }
 
@@ -235,7 +297,7 @@ pub(crate) fn write_level(
     step: &Level,
 ) -> Result<(), OutputError> {
     let file = hdf5::File::create(path).at(path)?;
-    let w = Writer { path };
+    let w = Writer::new(path, COMPRESSION);
     w.string_attr(&file, "format", "hasse-output-level")?;
     w.scalar_attr(&file, "format_version", FORMAT_VERSION)?;
     w.scalar_attr(&file, "step", k as u64)?;
@@ -278,48 +340,85 @@ fn write_expanded(
 }
 
 /// One complex into group `mesh` (`/mesh`, or `/steps/<k>/mesh`): attrs
-/// `dim` and `embedding_dim`, `vertices`, `cells/<p>`, `boundary/<p>`,
-/// `tags/<name>`.
-fn write_mesh(w: &Writer, mesh: &Group, complex: &Complex) -> Result<(), OutputError> {
+/// `dim`, `embedding_dim` and `complex` (the layout's name), `vertices`,
+/// `cells/<p>`, `tags/<name>`; with [`ComplexLayout::Full`] `cells/<p>`
+/// for every p and `boundary/<p>`, otherwise `cells/<p>` only for the top
+/// cells and the degrees of the cochains and XDMF grids on this mesh.
+fn write_mesh(
+    w: &Writer,
+    group: &Group,
+    levels: &Levels,
+    mesh: &MeshAt,
+    grids: &[GridTopology],
+) -> Result<(), OutputError> {
+    let complex = mesh.complex;
     let n = complex.dim();
     let d = complex.embedding_dim();
-    w.scalar_attr(mesh, "dim", n as u64)?;
-    w.scalar_attr(mesh, "embedding_dim", d as u64)?;
+    w.scalar_attr(group, "dim", n as u64)?;
+    w.scalar_attr(group, "embedding_dim", d as u64)?;
+    w.string_attr(group, "complex", levels.layout.name())?;
     let nv = complex.cell_count(0);
     let mut xyz = vec![0.0; nv * 3];
     for v in 0..nv {
         xyz[3 * v..3 * v + d].copy_from_slice(complex.vertices().point(v));
     }
-    w.matrix(mesh, "vertices", &xyz, 3)?;
-    let vertices = mesh.dataset("vertices").at(w.path)?;
+    w.matrix(group, "vertices", &xyz, 3)?;
+    let vertices = group.dataset("vertices").at(w.path)?;
     w.scalar_attr(&vertices, "embedding_dim", d as u64)?;
 
-    let cells = w.group(mesh, "cells")?;
-    let identity = CsMat::new(
-        (nv, nv),
-        (0..=nv).collect(),
-        (0..nv).collect(),
-        vec![1u8; nv],
-    );
-    w.csr(&w.group(&cells, "0")?, &identity, false)?;
-    for p in 1..=n {
+    let full = levels.layout == ComplexLayout::Full;
+    let mut needed = vec![false; n + 1];
+    needed[n] = true;
+    for grid in grids {
+        needed[grid.degree] = true;
+    }
+    for &k in &mesh.steps {
+        for c in levels.steps[k].cochains {
+            needed[c.dim] = true;
+        }
+    }
+    // Integer arrays of a grid (cell vertex lists, ∂_p) are compressed
+    // when large: shuffled, their high bytes are runs of zeros and their
+    // index pointers near-arithmetic, so deflate takes them to about 1/70
+    // at 100³ hexahedra for 0.3 s (cases/OUTPUT.md). Fields and
+    // coordinates are not: f64 values deflate poorly for the same time.
+    let extra = w.compressing();
+    let cells = w.group(group, "cells")?;
+    for (p, &needed) in needed.iter().enumerate() {
+        if !needed && !full {
+            continue;
+        }
+        let w = &extra;
+        let g = w.group(&cells, &p.to_string())?;
+        if p == 0 {
+            let identity = CsMat::new(
+                (nv, nv),
+                (0..=nv).collect(),
+                (0..nv).collect(),
+                vec![1u8; nv],
+            );
+            w.csr(&g, &identity, false)?;
+            continue;
+        }
         let m = complex
             .lar()
             .characteristic(p)
             .map_err(|e| OutputError::Topology {
                 message: e.to_string(),
             })?;
-        w.csr(&w.group(&cells, &p.to_string())?, m, false)?;
+        w.csr(&g, m, false)?;
     }
-    let boundary = w.group(mesh, "boundary")?;
-    for p in 1..=n {
-        w.csr(
-            &w.group(&boundary, &p.to_string())?,
-            complex.boundary(p),
-            true,
-        )?;
+    if full {
+        let boundary = w.group(group, "boundary")?;
+        for p in 1..=n {
+            extra.csr(
+                &w.group(&boundary, &p.to_string())?,
+                complex.boundary(p),
+                true,
+            )?;
+        }
     }
-    let tags = w.group(mesh, "tags")?;
+    let tags = w.group(group, "tags")?;
     for (name, tag) in complex.tags().iter() {
         let ids: Vec<u64> = tag.cells.iter().map(|&c| c as u64).collect();
         w.vector(&tags, name, &ids)?;
@@ -341,16 +440,18 @@ fn write_xdmf_arrays(
     grids: &[GridTopology],
 ) -> Result<(), OutputError> {
     let n = levels.dim();
+    // Connectivity compresses as the vertex lists of `cells` do.
+    let ints = w.compressing();
     for grid in grids {
         let g = w.group(xdmf, &grid.degree.to_string())?;
         match grid.uniform {
-            Some((_, nodes)) => w.matrix(&g, "topology", &grid.connectivity, nodes)?,
-            None => w.vector(&g, "topology", &grid.connectivity)?,
+            Some((_, nodes)) => ints.matrix(&g, "topology", &grid.connectivity, nodes)?,
+            None => ints.vector(&g, "topology", &grid.connectivity)?,
         }
         let Some(cell_ids) = &grid.cell_ids else {
             continue;
         };
-        w.vector(&g, "cell_ids", cell_ids)?;
+        ints.vector(&g, "cell_ids", cell_ids)?;
         let expanded = w.group(&g, "steps")?;
         for &k in &mesh.steps {
             let sg = w.group(&expanded, &k.to_string())?;

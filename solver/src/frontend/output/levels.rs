@@ -162,6 +162,8 @@ pub(crate) struct Levels<'a> {
     pub provenance: &'a Provenance,
     /// Each level has its own mesh under `/steps/<k>/mesh`.
     pub mesh_changes: bool,
+    /// How much of each complex is stored.
+    pub layout: ComplexLayout,
 }
 
 /// A complex and where it goes in the h5 file.
@@ -184,7 +186,7 @@ pub(crate) struct Level<'a> {
 }
 
 impl<'a> Levels<'a> {
-    pub(super) fn of_run(run: &'a RunOutput) -> Self {
+    pub(super) fn of_run(run: &'a RunOutput, layout: ComplexLayout) -> Self {
         Levels {
             meshes: vec![MeshAt {
                 complex: run.complex,
@@ -203,10 +205,11 @@ impl<'a> Levels<'a> {
                 .collect(),
             provenance: &run.provenance,
             mesh_changes: false,
+            layout,
         }
     }
 
-    pub(super) fn of_series(series: &'a SeriesOutput) -> Self {
+    pub(super) fn of_series(series: &'a SeriesOutput, layout: ComplexLayout) -> Self {
         let meshes = series
             .steps
             .iter()
@@ -232,6 +235,7 @@ impl<'a> Levels<'a> {
                 .collect(),
             provenance: &series.provenance,
             mesh_changes: true,
+            layout,
         }
     }
 

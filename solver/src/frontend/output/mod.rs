@@ -9,10 +9,10 @@
 //! | path | content |
 //! | --- | --- |
 //! | `/` attrs `step_count` (u64), `times` (f64 array), `format` = `"hasse-output"`, `format_version` (u64: 1, or 2 for a mesh series), `mesh_changes` (u64: 0, or 1 for a mesh series) | |
-//! | `/mesh` attrs `dim` (n), `embedding_dim` (d) | |
+//! | `/mesh` attrs `dim` (n), `embedding_dim` (d), `complex` (`"minimal"` or `"full"`, see [`ComplexLayout`]) | |
 //! | `/mesh/vertices` | (N, 3) f64, zero-padded when d < 3; attr `embedding_dim` |
-//! | `/mesh/cells/<p>/indptr`, `indices` | CSR characteristic matrix M_p (u64), p = 0..=n; attr `shape` = (rows, cols). Row i lists the sorted vertex ids of p-cell i; p-cell ids everywhere else are these row numbers |
-//! | `/mesh/boundary/<p>/indptr`, `indices` (u64), `data` (i8) | signed ∂_p in CSR, rows (p-1)-cells, columns p-cells, p = 1..=n; attr `shape` |
+//! | `/mesh/cells/<p>/indptr`, `indices` | CSR characteristic matrix M_p (u64) for p = n and the degrees of the cochains (every p = 0..=n in the full layout); attr `shape` = (rows, cols). Row i lists the sorted vertex ids of p-cell i; p-cell ids everywhere else are these row numbers |
+//! | `/mesh/boundary/<p>/indptr`, `indices` (u64), `data` (i8) | full layout only: signed ∂_p in CSR, rows (p-1)-cells, columns p-cells, p = 1..=n; attr `shape` |
 //! | `/mesh/tags/<name>` | u64 ids of the tagged cells; attr `dim` |
 //! | `/steps/<k>` attr `time` | one group per time level k = 0, 1, … |
 //! | `/steps/<k>/<name>` | f64 cochain, one value per p-cell; attrs `dim`, and `units`, `method`, `description` when given |
@@ -22,6 +22,10 @@
 //! | `/xdmf/<p>/cell_ids` | only when the grid's elements are not the p-cells one to one: the p-cell of each element |
 //! | `/xdmf/<p>/steps/<k>/<name>` | only with `cell_ids`: the cochain expanded to the elements |
 //!
+//! The integer arrays of `cells`, `boundary` and `xdmf` of 1 MiB or more
+//! are chunked and shuffle + deflate compressed (when the HDF5 library has
+//! zlib); readers see ordinary datasets.
+//!
 //! Strings are variable-length UTF-8, so h5py returns attributes as `str`
 //! (string datasets need `.asstr()[()]`).
 //!
@@ -30,7 +34,7 @@
 //! Root attr `mesh_changes` = 1, `format_version` = 2; there is no `/mesh`
 //! and no `/xdmf`. Instead each level k has its own mesh inside its step:
 //! `/steps/<k>/mesh` holds what `/mesh` holds above (attrs, `vertices`,
-//! `cells/<p>`, `boundary/<p>`, `tags/<name>`, with that step's cell ids),
+//! `cells/<p>`, `boundary/<p>` in the full layout, `tags/<name>`, with that step's cell ids),
 //! and `/steps/<k>/mesh/xdmf` what `/xdmf` holds, for level k only
 //! (`<p>/topology`, `<p>/cell_ids`, `<p>/steps/<k>/<name>`). The cochains
 //! stay in `/steps/<k>/<name>`, so no cochain of a series may be named
@@ -84,6 +88,7 @@
 
 pub(crate) mod atomic;
 mod hdf5_file;
+mod layout;
 mod levels;
 mod partial;
 pub mod study;
@@ -92,6 +97,7 @@ mod tests;
 mod topology;
 mod xdmf;
 
+pub use layout::{read_boundary, ComplexLayout};
 pub use partial::{remove_partial, PartialOutput};
 
 use levels::write_levels;
@@ -459,6 +465,15 @@ pub enum OutputError {
         /// How the run differs from it.
         reason: String,
     },
+    /// An output file does not hold what a reader asked of it: the
+    /// boundary matrices of a file written with the minimal layout.
+    #[error("{path}: {message}")]
+    Layout {
+        /// The h5 file.
+        path: PathBuf,
+        /// What is missing, and how to get it.
+        message: String,
+    },
     /// The reader-order connectivity of some cell could not be rebuilt.
     #[error("cannot write the XDMF cells: {message}")]
     Topology {
@@ -496,7 +511,18 @@ pub enum OutputError {
 /// std::fs::remove_dir_all(&dir).unwrap();
 /// ```
 pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputError> {
-    write_levels(stem, &Levels::of_run(run))
+    write_run_with(stem, run, ComplexLayout::default())
+}
+
+/// [`write_run`] with the complex stored in `layout`: the default
+/// [`ComplexLayout::Minimal`] (what `write_run` writes), or
+/// [`ComplexLayout::Full`], which adds every M_p and every ∂_p.
+pub fn write_run_with(
+    stem: &Path,
+    run: &RunOutput,
+    layout: ComplexLayout,
+) -> Result<OutputFiles, OutputError> {
+    write_levels(stem, &Levels::of_run(run, layout))
 }
 
 /// Writes `<stem>.h5`, `<stem>.xdmf` and one `<stem>.<grid>.xdmf` per
@@ -546,7 +572,16 @@ pub fn write_run(stem: &Path, run: &RunOutput) -> Result<OutputFiles, OutputErro
 /// std::fs::remove_dir_all(&dir).unwrap();
 /// ```
 pub fn write_mesh_series(stem: &Path, series: &SeriesOutput) -> Result<OutputFiles, OutputError> {
-    write_levels(stem, &Levels::of_series(series))
+    write_mesh_series_with(stem, series, ComplexLayout::default())
+}
+
+/// [`write_mesh_series`] with each step's complex stored in `layout`.
+pub fn write_mesh_series_with(
+    stem: &Path,
+    series: &SeriesOutput,
+    layout: ComplexLayout,
+) -> Result<OutputFiles, OutputError> {
+    write_levels(stem, &Levels::of_series(series, layout))
 }
 
 /// Check, before any long computation, that output can be written under

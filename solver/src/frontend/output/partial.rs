@@ -6,8 +6,8 @@ use super::atomic::{create_dir, is_temporary, remove_if_present, write_atomicall
 use super::levels::{check_level, rfc3339_now};
 use super::topology::GridTopology;
 use super::{
-    hdf5_file, split_stem, write_run, xdmf, Cochain, Level, Levels, MeshAt, OutputError,
-    OutputFiles, Provenance, RunOutput, Step,
+    hdf5_file, split_stem, write_run_with, xdmf, Cochain, ComplexLayout, Level, Levels, MeshAt,
+    OutputError, OutputFiles, Provenance, RunOutput, Step,
 };
 use hasse_complex::Complex;
 use std::path::{Path, PathBuf};
@@ -115,7 +115,7 @@ pub fn remove_partial(stem: &Path) -> Result<bool, OutputError> {
 /// run that is killed, interrupted or fails keeps its completed levels.
 ///
 /// [`create`](Self::create) removes the partial output of an earlier run
-/// under the same stem and writes `<stem>.partial/mesh.h5` (a [`write_run`]
+/// under the same stem and writes `<stem>.partial/mesh.h5` (a [`write_run`](super::write_run)
 /// file without steps: the `/mesh` and `/xdmf` groups, the provenance);
 /// each [`push`](Self::push) writes `<stem>.partial/level-<k>.h5` (root
 /// attrs `step` and `time`, the group `/steps/<k>` of a run file) and then
@@ -127,7 +127,7 @@ pub fn remove_partial(stem: &Path) -> Result<bool, OutputError> {
 /// groups appended to one, because a kill while HDF5 writes into a file
 /// can leave its metadata unreadable and so lose every level.
 ///
-/// [`finish`](Self::finish) writes the final output with [`write_run`] and
+/// [`finish`](Self::finish) writes the final output with [`write_run`](super::write_run) and
 /// only then removes the partial files. Dropping the writer without
 /// finishing keeps them: that is what an interrupted run leaves.
 ///
@@ -200,7 +200,7 @@ impl<'a> PartialOutput<'a> {
 
     /// Writes the next level (its index is [`len`](Self::len) before the
     /// call) and then the document listing it. The checks are those of
-    /// [`write_run`] for this level, times increasing over the pushes; on
+    /// [`write_run`](super::write_run) for this level, times increasing over the pushes; on
     /// an error nothing of this level is written and the completed levels
     /// stay as they were.
     pub fn push(&mut self, step: &Step) -> Result<(), OutputError> {
@@ -257,15 +257,25 @@ impl<'a> PartialOutput<'a> {
         xdmf::document(&levels, &self.grids, 0, &files)
     }
 
-    /// Writes the final output with [`write_run`] and then removes the
+    /// Writes the final output with [`write_run`](super::write_run) and then removes the
     /// partial files. `run` must hold the pushed levels (same times, in
     /// order) on the same complex: the final output replaces the partial
     /// one and must not lose or invent a level ([`OutputError::Partial`]
     /// otherwise, before anything is written). On an error of the final
     /// write the partial output stays.
     pub fn finish(self, run: &RunOutput) -> Result<OutputFiles, OutputError> {
+        self.finish_with(run, ComplexLayout::default())
+    }
+
+    /// [`finish`](Self::finish) with the final output's complex stored in
+    /// `layout` (see [`write_run_with`](super::write_run_with)).
+    pub fn finish_with(
+        self,
+        run: &RunOutput,
+        layout: ComplexLayout,
+    ) -> Result<OutputFiles, OutputError> {
         self.check_run(run)?;
-        let files = write_run(&self.stem, run)?;
+        let files = write_run_with(&self.stem, run, layout)?;
         remove_partial(&self.stem)?;
         Ok(files)
     }
@@ -327,7 +337,7 @@ impl<'a> PartialOutput<'a> {
     }
 }
 
-/// The one-mesh view of `complex` with `steps`, as [`write_run`] sees it.
+/// The one-mesh view of `complex` with `steps`, as [`write_run`](super::write_run) sees it.
 fn mesh_levels<'l>(
     complex: &'l Complex,
     provenance: &'l Provenance,
@@ -343,12 +353,16 @@ fn mesh_levels<'l>(
         steps,
         provenance,
         mesh_changes: false,
+        // The partial mesh file is for viewing the levels while the run
+        // goes on; the final output has the layout the run asked for.
+        layout: ComplexLayout::Minimal,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::frontend::output::write_run;
     use hasse_complex::generate::rectangle;
     use hasse_complex::{TopCells, Vertices};
     use hdf5::types::{TypeDescriptor, VarLenUnicode};

@@ -307,7 +307,9 @@ impl Grid<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::frontend::output::{MeshStep, Provenance, RunOutput, SeriesOutput, Step};
+    use crate::frontend::output::{
+        ComplexLayout, MeshStep, Provenance, RunOutput, SeriesOutput, Step,
+    };
 
     #[test]
     fn a_time_series_gives_one_temporal_collection_per_grid_document() {
@@ -324,7 +326,7 @@ mod tests {
             steps: vec![step(0.0), step(0.25)],
             provenance: Provenance::new(serde_json::Value::Null),
         };
-        let levels = Levels::of_run(&run);
+        let levels = Levels::of_run(&run, ComplexLayout::Minimal);
         let degrees = degrees(&levels);
         assert_eq!(degrees, [2, 1]);
         let grids = grids(&levels, &degrees).unwrap();
@@ -383,7 +385,7 @@ mod tests {
             }],
             provenance: Provenance::new(serde_json::Value::Null),
         };
-        let levels = Levels::of_run(&run);
+        let levels = Levels::of_run(&run, ComplexLayout::Minimal);
         let grids = grids(&levels, &degrees(&levels)).unwrap();
         let text = document(&levels, &grids, 0, &Files::one("r.h5"));
         assert_eq!(text.matches("<Grid ").count(), 1);
@@ -411,7 +413,7 @@ mod tests {
             }],
             provenance: Provenance::new(serde_json::Value::Null),
         };
-        let levels = Levels::of_series(&one);
+        let levels = Levels::of_series(&one, ComplexLayout::Minimal);
         let meshes = grids(&levels, &degrees(&levels)).unwrap();
         let text = document(&levels, &meshes, 0, &Files::one("s.h5"));
         // One step: a plain uniform grid, still on the step's own mesh.
@@ -436,7 +438,7 @@ mod tests {
             ],
             provenance: Provenance::new(serde_json::Value::Null),
         };
-        let levels = Levels::of_series(&two);
+        let levels = Levels::of_series(&two, ComplexLayout::Minimal);
         let meshes = grids(&levels, &degrees(&levels)).unwrap();
         assert_eq!(meshes.len(), 2);
         let text = document(&levels, &meshes, 0, &Files::one("s.h5"));

@@ -8,8 +8,10 @@ use crate::frontend::mesh_spec::human_bytes;
 use hasse_complex::Complex;
 use std::path::Path;
 
-/// A lower bound on the bytes a run writes: the mesh (vertices,
-/// characteristic and boundary matrices, XDMF topologies) and 8 bytes per
+/// A lower bound on the bytes a run writes: the mesh (vertices, the top
+/// cells' characteristic matrix and XDMF topology, which every layout
+/// writes uncompressed; `[output] complex = "full"` adds more, compressed)
+/// and 8 bytes per
 /// value of every field of every saved level, twice for a transient run
 /// with a partial output (the partial output and the final file exist side
 /// by side before the partial one is removed).
@@ -39,12 +41,10 @@ impl OutputEstimate {
         let d = complex.embedding_dim() as f64;
         let count = |p: usize| complex.cell_count(p) as f64;
         let mut mesh = count(0) * 24.0;
-        for p in 1..=n {
-            let vertex_lists = complex.lar().characteristic(p).map_or(0, |m| m.nnz()) as f64;
-            // M_p (indices and indptr), its XDMF topology, and ∂_p (indices,
-            // indptr, one-byte signs).
-            mesh += 2.0 * vertex_lists * 8.0 + (count(p) + 1.0) * 8.0;
-            mesh += complex.boundary(p).nnz() as f64 * 9.0 + (count(p - 1) + 1.0) * 8.0;
+        if n > 0 {
+            let vertex_lists = complex.lar().characteristic(n).map_or(0, |m| m.nnz()) as f64;
+            // M_n (indices and indptr) and its XDMF topology.
+            mesh += 2.0 * vertex_lists * 8.0 + (count(n) + 1.0) * 8.0;
         }
         let unknowns = match case.method().map(|m| m.location()) {
             Some(crate::metric::Location::Nodal) => count(0),

@@ -92,7 +92,11 @@ pub fn write_output(
     result: &RunResult,
     stem: &std::path::Path,
 ) -> Result<crate::frontend::output::OutputFiles, crate::frontend::output::OutputError> {
-    crate::frontend::output::write_run(stem, &run_output(case, complex, result))
+    crate::frontend::output::write_run_with(
+        stem,
+        &run_output(case, complex, result),
+        case.output.complex,
+    )
 }
 
 /// Write a refinement study as a time series whose mesh changes: level k
@@ -114,12 +118,13 @@ pub fn write_levels(
             cochains: cochains(case, fields, method),
         })
         .collect();
-    crate::frontend::output::write_mesh_series(
+    crate::frontend::output::write_mesh_series_with(
         stem,
         &SeriesOutput {
             steps,
             provenance: provenance(case, report),
         },
+        case.output.complex,
     )
 }
 
@@ -302,7 +307,8 @@ impl<'a> LevelStream<'a> {
             // have the same.
             partial.check_run(&run)?;
         }
-        let files = crate::frontend::output::write_run(&self.stem, &run)?;
+        let files =
+            crate::frontend::output::write_run_with(&self.stem, &run, self.case.output.complex)?;
         if let Err(e) = crate::frontend::output::remove_partial(&self.stem) {
             result.warnings.push(format!(
                 "the output is complete, but the partial output could not be removed: {e}"

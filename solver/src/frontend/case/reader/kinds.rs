@@ -242,9 +242,26 @@ impl Reader {
         header: Option<Range<usize>>,
         default: Option<T>,
     ) -> Option<T> {
+        self.choice_in(table, "problem", key, values, name, what, header, default)
+    }
+
+    /// [`choice`](Self::choice) for the key `<prefix>.<key>` of any table
+    /// (e.g. `output.complex`).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn choice_in<T: Copy>(
+        &mut self,
+        table: &dyn TableLike,
+        prefix: &str,
+        key: &str,
+        values: &[T],
+        name: impl Fn(&T) -> &'static str,
+        what: &str,
+        header: Option<Range<usize>>,
+        default: Option<T>,
+    ) -> Option<T> {
         let names: Vec<&str> = values.iter().map(&name).collect();
-        let entry_name = join("problem", key);
-        let Some(entry) = self.entry(table, "problem", key) else {
+        let entry_name = join(prefix, key);
+        let Some(entry) = self.entry(table, prefix, key) else {
             if default.is_none() {
                 self.error(
                     header,

@@ -147,6 +147,7 @@ pub(super) const OUTPUT_KEYS: &[&str] = &[
     "probe",
     "fields",
     "partial",
+    "complex",
 ];
 pub(super) const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "tolerance"];
 pub(super) const STRATEGIES: &[&str] = &[

@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::frontend::case::NonlinearSolverSpec;
+use crate::frontend::output::ComplexLayout;
 use crate::physics::nonlinear::Iteration;
 
 impl Reader {
@@ -553,6 +554,7 @@ impl Reader {
             probes: Vec::new(),
             fields: None,
             partial: true,
+            complex: ComplexLayout::default(),
         };
         let Some((table, _)) = self.subtable(root, "", "output") else {
             return spec;
@@ -598,6 +600,18 @@ impl Reader {
                     "a non-empty array of field names, e.g. [\"u\", \"flux\"]",
                 ),
             }
+        }
+        if let Some(layout) = self.choice_in(
+            table,
+            "output",
+            "complex",
+            &ComplexLayout::ALL,
+            ComplexLayout::name,
+            "layout of the complex",
+            None,
+            Some(ComplexLayout::default()),
+        ) {
+            spec.complex = layout;
         }
         spec.quantities = self.quantities(table);
         spec.probes = self.probes(table);
