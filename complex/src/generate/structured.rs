@@ -153,6 +153,18 @@ impl Grid {
             .fold(0, |class, a| class | 1 << a)
     }
 
+    /// Where `at` lies on each axis: bit 2a set on the first index, bit
+    /// 2a + 1 on the last (a one-coordinate axis has both). Which cofaces
+    /// a cell has, and where they sit relative to it, depend on nothing
+    /// else.
+    fn position(&self, at: [usize; 3]) -> usize {
+        (0..3).fold(0, |position, a| {
+            position
+                | usize::from(at[a] == 0) << (2 * a)
+                | usize::from(at[a] + 1 == self.counts[a]) << (2 * a + 1)
+        })
+    }
+
     fn vertex(&self, at: [usize; 3]) -> usize {
         at[0] + at[1] * self.strides[1] + at[2] * self.strides[2]
     }
@@ -365,20 +377,19 @@ impl Level {
         self.line_start.last().copied().unwrap_or(0)
     }
 
-    /// Number of the cell of `kind` whose lowest vertex is `at` (it must fit).
-    fn index(&self, grid: &Grid, at: [usize; 3], kind: usize) -> usize {
-        let class = grid.class(at);
-        let line = at[1] + grid.counts[1] * at[2];
-        self.line_start[line] + at[0] * self.fitting[class & !1].len() + self.rank[class][kind]
-    }
-
     /// `visit(lowest vertex, kind)` for the cells of one x-line, in order.
     fn for_each_on_line(&self, grid: &Grid, line: usize, mut visit: impl FnMut([usize; 3], usize)) {
         let (j, k) = (line % grid.counts[1], line / grid.counts[1]);
+        // Only the last i changes the class along the line.
+        let inner = grid.class([0, j, k]);
         for i in 0..grid.counts[0] {
-            let at = [i, j, k];
-            for &kind in &self.fitting[grid.class(at)] {
-                visit(at, kind);
+            let class = if i + 1 == grid.counts[0] {
+                inner | 1
+            } else {
+                inner
+            };
+            for &kind in &self.fitting[class] {
+                visit([i, j, k], kind);
             }
         }
     }
@@ -433,41 +444,101 @@ fn characteristic_matrix(grid: &Grid, level: &Level) -> Result<CsMat<u8>> {
         .map_err(|e| internal("characteristic matrix", e.3))
 }
 
+/// One entry of a row of ∂_p, relative to the row's cell: the coface's
+/// lowest vertex is `lines_back` x-lines and `steps_back` steps along x
+/// before the cell's, where `per_vertex` upper cells start at each inner
+/// vertex, and the coface is the `rank`-th cell at its vertex.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    lines_back: usize,
+    steps_back: usize,
+    per_vertex: usize,
+    rank: usize,
+    sign: i8,
+}
+
+/// For every [`Grid::position`] and lower kind, the entries of the row of
+/// a cell of that kind there, in increasing column order. Columns grow
+/// with the coface's x-line, then its x index, then its rank, so the order
+/// is fixed by the stencil and no row needs sorting.
+fn stencils(grid: &Grid, upper: &Level, cofaces: &[Vec<Coface>]) -> Vec<Vec<Vec<Entry>>> {
+    (0..64)
+        .map(|position: usize| {
+            let first = |a: usize| position >> (2 * a) & 1 == 1;
+            let last = |a: usize| position >> (2 * a + 1) & 1 == 1;
+            cofaces
+                .iter()
+                .map(|list| {
+                    let mut entries: Vec<Entry> = list
+                        .iter()
+                        .filter(|c| {
+                            let span = upper.kinds[c.kind].span;
+                            (0..3).all(|a| {
+                                let shifted = c.shift >> a & 1 == 1;
+                                // Stepping back needs room before; extending
+                                // from the cell's own index needs room after.
+                                !(shifted && first(a) || span >> a & 1 == 1 && !shifted && last(a))
+                            })
+                        })
+                        .map(|c| {
+                            let shifted = |a: usize| usize::from(c.shift >> a & 1);
+                            // The coface's vertex is never last where it
+                            // stepped back; elsewhere it is where the cell is.
+                            let class = (0..3)
+                                .filter(|&a| shifted(a) == 0 && last(a))
+                                .fold(0, |class, a| class | 1 << a);
+                            Entry {
+                                lines_back: shifted(1) + shifted(2) * grid.counts[1],
+                                steps_back: shifted(0),
+                                per_vertex: upper.fitting[class & !1].len(),
+                                rank: upper.rank[class][c.kind],
+                                sign: c.sign,
+                            }
+                        })
+                        .collect();
+                    entries.sort_unstable_by_key(|e| {
+                        (
+                            std::cmp::Reverse(e.lines_back),
+                            std::cmp::Reverse(e.steps_back),
+                            e.rank,
+                        )
+                    });
+                    entries
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// ∂_p: row r lists the p-cells having (p−1)-cell r as a facet, in
 /// increasing order, with their signs. Two passes over the x-lines, both
 /// in parallel: count each line's entries, then write each line's rows
-/// into its slice of the arrays.
+/// into its slice of the arrays, each entry by the stencil of the row's
+/// position.
 fn boundary_matrix(
     grid: &Grid,
     lower: &Level,
     upper: &Level,
     cofaces: &[Vec<Coface>],
 ) -> Result<CsMat<i8>> {
-    // The lowest vertex of the coface, when the coface is in the grid.
-    let place = |at: [usize; 3], c: &Coface| -> Option<[usize; 3]> {
-        let span = upper.kinds[c.kind].span;
-        let mut origin = at;
-        for a in 0..3 {
-            if c.shift >> a & 1 == 1 {
-                origin[a] = origin[a].checked_sub(1)?;
-            }
-            if span >> a & 1 == 1 && origin[a] + 1 >= grid.counts[a] {
-                return None;
-            }
-        }
-        Some(origin)
-    };
+    let stencils = stencils(grid, upper, cofaces);
+    let class_of = |position: usize| (0..3).fold(0, |c, a| c | (position >> (2 * a + 1) & 1) << a);
+    // Entries of all rows whose cells start at a vertex of each position.
+    let vertex_entries: Vec<usize> = (0..64)
+        .map(|position| {
+            lower.fitting[class_of(position)]
+                .iter()
+                .map(|&kind| stencils[position][kind].len())
+                .sum()
+        })
+        .collect();
     let line_entries: Vec<usize> = (0..grid.lines)
         .into_par_iter()
         .map(|line| {
-            let mut entries = 0;
-            lower.for_each_on_line(grid, line, |at, kind| {
-                entries += cofaces[kind]
-                    .iter()
-                    .filter(|c| place(at, c).is_some())
-                    .count();
-            });
-            entries
+            let (j, k) = (line % grid.counts[1], line / grid.counts[1]);
+            (0..grid.counts[0])
+                .map(|i| vertex_entries[grid.position([i, j, k])])
+                .sum()
         })
         .collect();
     let mut entry_start = Vec::with_capacity(grid.lines + 1);
@@ -490,22 +561,22 @@ fn boundary_matrix(
         .zip(signs)
         .enumerate()
         .for_each(|(line, ((pointers, columns), signs))| {
-            let mut row_entries: Vec<(usize, i8)> = Vec::new();
+            let (j, k) = (line % grid.counts[1], line / grid.counts[1]);
             let (mut written, mut row) = (0, 0);
-            lower.for_each_on_line(grid, line, |at, kind| {
-                row_entries.clear();
-                row_entries.extend(cofaces[kind].iter().filter_map(|c| {
-                    place(at, c).map(|origin| (upper.index(grid, origin, c.kind), c.sign))
-                }));
-                row_entries.sort_unstable_by_key(|&(column, _)| column);
-                for &(column, sign) in &row_entries {
-                    columns[written] = column;
-                    signs[written] = sign;
-                    written += 1;
+            for i in 0..grid.counts[0] {
+                let position = grid.position([i, j, k]);
+                let row_stencils = &stencils[position];
+                for &kind in &lower.fitting[class_of(position)] {
+                    for e in &row_stencils[kind] {
+                        let line_start = upper.line_start[line - e.lines_back];
+                        columns[written] = line_start + (i - e.steps_back) * e.per_vertex + e.rank;
+                        signs[written] = e.sign;
+                        written += 1;
+                    }
+                    pointers[row] = entry_start[line] + written;
+                    row += 1;
                 }
-                pointers[row] = entry_start[line] + written;
-                row += 1;
-            });
+            }
         });
     CsMat::try_new((rows, upper.count()), indptr, indices, data)
         .map_err(|e| internal("boundary matrix", e.3))
