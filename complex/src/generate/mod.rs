@@ -36,6 +36,7 @@ mod delaunay;
 mod grid;
 mod periodic;
 mod perturb;
+mod structured;
 mod surfaces;
 mod voronoi;
 
