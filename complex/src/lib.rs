@@ -24,6 +24,7 @@ mod frame;
 pub mod generate;
 pub mod geometry;
 pub mod gmsh;
+pub mod hasse_transform;
 pub mod homology;
 pub mod json;
 pub mod lar;
