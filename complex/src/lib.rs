@@ -27,6 +27,7 @@ pub mod gmsh;
 pub mod hasse_transform;
 pub mod homology;
 pub mod json;
+pub mod kill;
 pub mod lar;
 pub mod lar_json;
 mod nonconvex;
