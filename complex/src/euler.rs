@@ -19,6 +19,10 @@
 //! ∂∂c = 0 alone. The subdivision chain map ζ is the identity on old cells
 //! except ζ_p(c) = c + c′; new cells have zero rows. ∂̃ζ = ζ∂ holds because
 //! ∂̃(c + c′) = ∂c.
+//!
+//! The same operator as matrices acting on the coboundaries and on the
+//! Hasse matrix is in [`crate::hasse_transform`]; its inverse, the kill
+//! operator, in [`crate::kill`].
 
 use crate::error::SplitError;
 use sprs::{CsMat, TriMat};
