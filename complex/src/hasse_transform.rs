@@ -36,7 +36,10 @@
 //! K_3, …, columns K_0, K_2, …; [`hasse_matrix`]): each block is
 //! transformed by the matrices above (the paper's β^p(H) = β^p(H_1) +
 //! β^p(H_2), the diagonal and the upper blocks separately) and H grows by
-//! one row and one column, so χ = columns − rows does not change.
+//! one row and one column, so χ = columns − rows does not change. The
+//! upper blocks of H hold transposes, δ_jᵀ, so there a row gained is
+//! Cᵀ δ_jᵀ and a column gained δ_jᵀ Rᵀ: the paper's Remark 1 writes these
+//! as "R[δ1]ᵀ" (β0) and "[δ1]ᵀC" (β2).
 
 use crate::error::SplitError;
 use crate::euler::{hasse_matrix, plan};
