@@ -84,8 +84,8 @@ pub enum ComplexError {
 /// Shorthand used throughout the crate.
 pub type Result<T, E = ComplexError> = std::result::Result<T, E>;
 
-/// Why an Euler make operator, a SPLIT or a field transfer was refused.
-/// Each variant names the offending cell, plane or array.
+/// Why an Euler make or kill operator, a SPLIT or a field transfer was
+/// refused. Each variant names the offending cell, plane or array.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SplitError {
     #[error("cell dimension {p} is out of range for this operation: expected 1..={dim}")]
@@ -126,4 +126,34 @@ pub enum SplitError {
     Invalid(String),
     #[error(transparent)]
     Complex(#[from] ComplexError),
+    #[error("{what} is {found:?} but the operator expects {expected:?}")]
+    Shape {
+        what: String,
+        expected: (usize, usize),
+        found: (usize, usize),
+    },
+    #[error("{p}-cell {cell} cannot be merged with itself")]
+    SameCell { p: usize, cell: usize },
+    #[error("{p}-cells {a} and {b} share the {count} facets {shared:?}; a kill merges two cells across exactly one", count = shared.len())]
+    NotAdjacent {
+        p: usize,
+        a: usize,
+        b: usize,
+        shared: Vec<usize>,
+    },
+    #[error("the facet {facet} between {p}-cells {a} and {b} also bounds {p}-cell {other}, so it cannot be removed")]
+    FacetHasOtherCofaces {
+        p: usize,
+        facet: usize,
+        a: usize,
+        b: usize,
+        other: usize,
+    },
+    #[error("merging {p}-cells {a} and {b} would not give a cell: {reason}")]
+    NotACell {
+        p: usize,
+        a: usize,
+        b: usize,
+        reason: String,
+    },
 }

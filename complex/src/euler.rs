@@ -8,7 +8,9 @@
 //! - ∂_{p−1} gains the column of N, ∂N = ∂R, where R is the part of ∂c that
 //!   moves to the new piece c′ (for p = 1, N is a vertex and has no column);
 //! - ∂_p gains the row of N and the column of c′:
-//!   ∂c ← (∂c − R) + N, ∂c′ = R − N;
+//!   ∂c ← (∂c − R) + N, ∂c′ = R − N (for p = 1, R = ±v is one endpoint
+//!   and N enters with R's sign, ∂c ← (∂c − R) ± N, so that each edge
+//!   still runs from one vertex to another);
 //! - ∂_{p+1} gains the row of c′, a copy of the row of c (every coface of c
 //!   now has both pieces on its boundary with the sign c had).
 //!
@@ -17,6 +19,10 @@
 //! ∂∂c = 0 alone. The subdivision chain map ζ is the identity on old cells
 //! except ζ_p(c) = c + c′; new cells have zero rows. ∂̃ζ = ζ∂ holds because
 //! ∂̃(c + c′) = ∂c.
+//!
+//! The same operator as matrices acting on the coboundaries and on the
+//! Hasse matrix is in [`crate::hasse_transform`]; its inverse, the kill
+//! operator, in [`crate::kill`].
 
 use crate::error::SplitError;
 use sprs::{CsMat, TriMat};
@@ -101,7 +107,8 @@ pub fn hasse_matrix(boundaries: &[CsMat<i8>]) -> CsMat<i8> {
 /// `moved` lists the facets of `cell` (rows of ∂_p) that go to the new
 /// piece c′; the rest stay with `cell`. For p = 1 it is the one endpoint
 /// that the appended half keeps (the thesis keeps the tail in the old edge:
-/// pass the head). For p ≥ 2 the moved facets must have a non-zero
+/// pass the head); both halves keep the edge's direction whichever end
+/// moves. For p ≥ 2 the moved facets must have a non-zero
 /// boundary, which becomes the boundary of the new (p−1)-cell; the new cell
 /// is appended last in K_{p−1} and the new piece last in K_p.
 ///
@@ -133,6 +140,100 @@ pub fn make(
     moved: &[usize],
 ) -> Result<Make, SplitError> {
     let n = boundaries.len();
+    let SplitPlan {
+        counts,
+        moving,
+        nu,
+        new_face_boundary,
+    } = plan(boundaries, p, cell, moved)?;
+    let moved_sorted: Vec<usize> = moving.iter().map(|&(f, _)| f).collect();
+    let new_face = counts[p - 1];
+    let new_piece = counts[p];
+
+    let mut out = Vec::with_capacity(n);
+    for (k, b) in boundaries.iter().enumerate() {
+        let q = k + 1;
+        let (mut rows, mut cols) = b.shape();
+        let mut entries: Vec<(usize, usize, i8)> = b.iter().map(|(&v, (i, j))| (i, j, v)).collect();
+        if q + 1 == p {
+            // ∂_{p−1}: a new column for N.
+            cols += 1;
+            for &(g, v) in &new_face_boundary {
+                entries.push((g, new_face, v as i8));
+            }
+        } else if q == p {
+            rows += 1;
+            cols += 1;
+            entries.retain(|&(i, j, _)| j != cell || moved_sorted.binary_search(&i).is_err());
+            for &(f, s) in &moving {
+                entries.push((f, new_piece, s));
+            }
+            entries.push((new_face, cell, nu));
+            entries.push((new_face, new_piece, -nu));
+        } else if q == p + 1 {
+            rows += 1;
+            let copies: Vec<(usize, usize, i8)> = entries
+                .iter()
+                .filter(|&&(i, _, _)| i == cell)
+                .map(|&(_, j, v)| (new_piece, j, v))
+                .collect();
+            entries.extend(copies);
+        }
+        let mut tri = TriMat::with_capacity((rows, cols), entries.len());
+        for (i, j, v) in entries {
+            tri.add_triplet(i, j, v);
+        }
+        out.push(tri.to_csr());
+    }
+
+    let zeta = (0..=n)
+        .map(|q| {
+            let old = counts[q];
+            let grown = old + usize::from(q == p || q + 1 == p);
+            let mut t = TriMat::with_capacity((grown, old), old + 1);
+            for i in 0..old {
+                t.add_triplet(i, i, 1i8);
+            }
+            if q == p {
+                t.add_triplet(new_piece, cell, 1);
+            }
+            t.to_csr()
+        })
+        .collect();
+    Ok(Make {
+        boundaries: out,
+        zeta,
+    })
+}
+
+/// What a make operator β^{p−1} on `cell` with the facets `moved` does,
+/// checked once and shared by [`make`] and the matrix form
+/// ([`crate::hasse_transform::MakeMatrices`]).
+pub(crate) struct SplitPlan {
+    /// (|K_0|, …, |K_n|) before the operator.
+    pub counts: Vec<usize>,
+    /// ρ: the moved facets, sorted, with the sign they have in ∂c.
+    pub moving: Vec<(usize, i8)>,
+    /// The coefficient ν of the new (p−1)-cell N in ∂c̃ (and −ν in ∂c′).
+    /// For p ≥ 2 it is 1 (N is oriented by ∂N = ∂ρ). For p = 1, N is a
+    /// vertex, which has no orientation to choose, so the sign goes into
+    /// ∂: ν = the sign of the moved endpoint, which keeps the sum of the
+    /// coefficients of each edge's boundary zero (the augmentation
+    /// ε∂ = 0). Moving the head gives ν = 1, the thesis's convention.
+    pub nu: i8,
+    /// ∂N = ∂ρ as a sorted (p−2)-chain (empty for p = 1).
+    pub new_face_boundary: Vec<(usize, i32)>,
+}
+
+/// Validates a make operator and computes ρ, ν and ∂N (see [`make`] for
+/// the errors).
+pub(crate) fn plan(
+    boundaries: &[CsMat<i8>],
+    p: usize,
+    cell: usize,
+    moved: &[usize],
+) -> Result<SplitPlan, SplitError> {
+    let n = boundaries.len();
     if p == 0 || p > n {
         return Err(SplitError::DimensionOutOfRange { p, dim: n });
     }
@@ -158,7 +259,7 @@ pub fn make(
             facets.len()
         )));
     }
-    // R = the moved part of ∂c, with the signs it has in ∂c.
+    // ρ = the moved part of ∂c, with the signs it has in ∂c.
     let mut moving = Vec::with_capacity(moved_sorted.len());
     for &f in &moved_sorted {
         let sign = facets
@@ -168,7 +269,12 @@ pub fn make(
             .ok_or_else(|| bad(format!("{}-cell {f} is not on its boundary", p - 1)))?;
         moving.push((f, sign));
     }
-    // ∂N = ∂R (a (p−2)-chain), needed for p ≥ 2.
+    if p == 1 && moving.len() != 1 {
+        return Err(bad(
+            "an edge is split by moving exactly one of its two endpoints".into(),
+        ));
+    }
+    // ∂N = ∂ρ (a (p−2)-chain), needed for p ≥ 2.
     let new_face_boundary: Vec<(usize, i32)> = if p >= 2 {
         let lower = boundaries[p - 2].to_csc();
         let mut acc: Vec<(usize, i32)> = Vec::new();
@@ -203,61 +309,11 @@ pub fn make(
     } else {
         Vec::new()
     };
-    let new_face = counts[p - 1];
-    let new_piece = counts[p];
-
-    let mut out = Vec::with_capacity(n);
-    for (k, b) in boundaries.iter().enumerate() {
-        let q = k + 1;
-        let (mut rows, mut cols) = b.shape();
-        let mut entries: Vec<(usize, usize, i8)> = b.iter().map(|(&v, (i, j))| (i, j, v)).collect();
-        if q + 1 == p {
-            // ∂_{p−1}: a new column for N.
-            cols += 1;
-            for &(g, v) in &new_face_boundary {
-                entries.push((g, new_face, v as i8));
-            }
-        } else if q == p {
-            rows += 1;
-            cols += 1;
-            entries.retain(|&(i, j, _)| j != cell || moved_sorted.binary_search(&i).is_err());
-            for &(f, s) in &moving {
-                entries.push((f, new_piece, s));
-            }
-            entries.push((new_face, cell, 1));
-            entries.push((new_face, new_piece, -1));
-        } else if q == p + 1 {
-            rows += 1;
-            let copies: Vec<(usize, usize, i8)> = entries
-                .iter()
-                .filter(|&&(i, _, _)| i == cell)
-                .map(|&(_, j, v)| (new_piece, j, v))
-                .collect();
-            entries.extend(copies);
-        }
-        let mut tri = TriMat::with_capacity((rows, cols), entries.len());
-        for (i, j, v) in entries {
-            tri.add_triplet(i, j, v);
-        }
-        out.push(tri.to_csr());
-    }
-
-    let zeta = (0..=n)
-        .map(|q| {
-            let old = counts[q];
-            let grown = old + usize::from(q == p || q + 1 == p);
-            let mut t = TriMat::with_capacity((grown, old), old + 1);
-            for i in 0..old {
-                t.add_triplet(i, i, 1i8);
-            }
-            if q == p {
-                t.add_triplet(new_piece, cell, 1);
-            }
-            t.to_csr()
-        })
-        .collect();
-    Ok(Make {
-        boundaries: out,
-        zeta,
+    let nu = if p == 1 { moving[0].1 } else { 1 };
+    Ok(SplitPlan {
+        counts,
+        moving,
+        nu,
+        new_face_boundary,
     })
 }
