@@ -54,7 +54,7 @@ fn is_zero(m: &CsMat<i8>) -> bool {
 
 /// ∂_1 … ∂_n of a generated complex (the one place that reads them).
 fn boundaries_of(k: &Complex) -> Vec<CsMat<i8>> {
-    (1..=k.dim()).map(|p| k.boundary(p).clone()).collect()
+    (1..=k.dim()).map(|p| (**k.boundary(p)).clone()).collect()
 }
 
 fn betti(b: &[CsMat<i8>]) -> Vec<usize> {

@@ -134,7 +134,7 @@ fn face_axis(complex: &Complex, face: usize, b: &Box3) -> Option<usize> {
 /// // the diagonal and −|K|/hx², −|K|/hy² to the neighbours.
 /// let k = rectangle(3, 3, [0.0, 1.5], [0.0, 0.75]).unwrap();
 /// let omega = fd::five_point(&k, &[isotropic(1.0); 9]).unwrap();
-/// let m = Canonical::new(k.boundary(2).clone(), omega).unwrap().assemble().to_dense();
+/// let m = Canonical::new(k.boundary(2), omega).unwrap().assemble().to_dense();
 /// let volume = 0.5 * 0.25;
 /// assert!((m[(4, 4)] - volume * (2.0 / 0.25 + 2.0 / 0.0625)).abs() < 1e-12);
 /// assert!((m[(4, 5)] + volume / 0.25).abs() < 1e-12);
