@@ -583,5 +583,4 @@ fn boundary_matrix(
 }
 
 #[cfg(test)]
-#[path = "structured_tests.rs"]
 mod tests;

@@ -8,29 +8,16 @@
 //! on the code: ∂∂ = 0, χ and the Betti numbers of known shapes, chain-map
 //! identities, and κ ∘ β = id.
 
+use crate::split::from_rows;
 use hasse_complex::euler::{cell_counts, hasse_matrix, make};
 use hasse_complex::generate::{annulus, box3, interval, kuhn, rectangle, uniform_axis};
 use hasse_complex::hasse_transform::{eta, hasse_blocks, MakeMatrices};
 use hasse_complex::homology::{betti_numbers, euler_characteristic};
 use hasse_complex::kill::kill;
 use hasse_complex::{Complex, Field, SplitError};
-use sprs::{CsMat, TriMat};
+use sprs::CsMat;
 
 type TestResult = Result<(), Box<dyn std::error::Error>>;
-
-fn from_rows(rows: &[&[i8]]) -> CsMat<i8> {
-    let cols = rows.first().map_or(0, |r| r.len());
-    let mut t = TriMat::new((rows.len(), cols));
-    for (i, r) in rows.iter().enumerate() {
-        assert_eq!(r.len(), cols);
-        for (j, &v) in r.iter().enumerate() {
-            if v != 0 {
-                t.add_triplet(i, j, v);
-            }
-        }
-    }
-    t.to_csr()
-}
 
 fn dense(m: &CsMat<i8>) -> Vec<Vec<i8>> {
     let mut out = vec![vec![0; m.cols()]; m.rows()];

@@ -9,7 +9,8 @@ use approx::{abs_diff_eq, assert_abs_diff_eq, assert_relative_eq};
 use hasse_complex::euler::{cell_counts, hasse_matrix, make};
 use sprs::{CsMat, TriMat};
 
-fn from_rows(rows: &[&[i8]]) -> CsMat<i8> {
+/// A signed matrix written row by row (also used by the Euler tests).
+pub(crate) fn from_rows(rows: &[&[i8]]) -> CsMat<i8> {
     let cols = rows.first().map_or(0, |r| r.len());
     let mut t = TriMat::new((rows.len(), cols));
     for (i, r) in rows.iter().enumerate() {
