@@ -11,7 +11,8 @@ use hasse_complex::dual::DualKind;
 use hasse_complex::{generate, Complex};
 use hasse_solver::metric::Method;
 use hasse_solver::physics::diffusion::{
-    conservation_residual, errors, flux_error, CellPoints, Diffusion, DiffusionError,
+    conservation_residual, errors, flux_error, reconstruct_gradient, CellPoints, Diffusion,
+    DiffusionError,
 };
 use hasse_solver::physics::BoundaryKind;
 use hasse_solver::physics::Conductivity;
@@ -986,4 +987,73 @@ fn nodal_gradients_on_a_surface_are_the_p1_tangent_gradients() {
     // Both are sums of three terms of size |u|/h: rounding is ~1e-15 of
     // that scale; 1e-12 leaves room for the QR in the library's version.
     assert!(worst <= 1e-12 * scale, "worst {worst:e} of {scale:e}");
+}
+
+/// The quadrature error norms of a cell-centred field equal the exact
+/// integrals when the exact solution is quadratic: each cell's field
+/// u_c + g_c·(x − x_c) differs from it by a quadratic, whose square is a
+/// quartic, integrated here independently by the 3 × 3 × 3 Gauss product
+/// on each box (exact to degree 5 per axis). Hexahedra take the library's
+/// 14-point rule, exact to total degree 5, so the two agree to rounding.
+#[test]
+fn cell_centred_error_norms_are_exact_for_quadratic_solutions() {
+    let mesh = generate::box3(4, 3, 5, [0.0, 1.0], [0.0, 0.75], [0.0, 1.25]).unwrap();
+    let exact = scalar(|x| x[0] * x[0] + 0.5 * x[1] * x[2] - x[2] * x[2] + x[0]);
+    let gradient = vector(|x| [2.0 * x[0] + 1.0, 0.5 * x[2], 0.5 * x[1] - 2.0 * x[2]]);
+    // −Δu = −(2 − 2) = 0.
+    let problem = Diffusion::new(
+        Method::Fv,
+        Conductivity::Scalar(scalar(|_| 1.0)),
+        scalar(|_| 0.0),
+    )
+    .with_boundary("boundary", BoundaryKind::Dirichlet(exact.clone()));
+    let solution = problem.solve(&mesh).unwrap();
+    let got = errors(&mesh, &solution, &exact, Some(&gradient));
+    assert!(got.quadrature);
+
+    let g = reconstruct_gradient(&mesh, &solution);
+    let centre = solution.cell_points.as_deref().unwrap_or(mesh.centroid(3));
+    let gauss = [
+        (-(0.6f64).sqrt(), 5.0 / 9.0),
+        (0.0, 8.0 / 9.0),
+        ((0.6f64).sqrt(), 5.0 / 9.0),
+    ];
+    let (mut square, mut gradient_square) = (0.0, 0.0);
+    for c in 0..mesh.cell_count(3) {
+        let vertices = mesh.cell_vertices(3, c);
+        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+        for &v in vertices {
+            for a in 0..3 {
+                lo[a] = lo[a].min(mesh.vertices().point(v)[a]);
+                hi[a] = hi[a].max(mesh.vertices().point(v)[a]);
+            }
+        }
+        let half: Vec<f64> = (0..3).map(|a| 0.5 * (hi[a] - lo[a])).collect();
+        for &(p, wp) in &gauss {
+            for &(q, wq) in &gauss {
+                for &(r, wr) in &gauss {
+                    let xi = [p, q, r];
+                    let x: Vec<f64> = (0..3).map(|a| lo[a] + half[a] * (1.0 + xi[a])).collect();
+                    let w = wp * wq * wr * half[0] * half[1] * half[2];
+                    let uh = solution.values[c]
+                        + (0..3)
+                            .map(|a| g[c][a] * (x[a] - centre[3 * c + a]))
+                            .sum::<f64>();
+                    square += w * (uh - exact(&x)).powi(2);
+                    let e = gradient(&x);
+                    gradient_square += w * (0..3).map(|a| (g[c][a] - e[a]).powi(2)).sum::<f64>();
+                }
+            }
+        }
+    }
+    // Both sums add about 10³ positive terms of similar size: relative
+    // rounding stays near 1e-14.
+    approx::assert_relative_eq!(got.l2, square.sqrt(), max_relative = 1e-11);
+    approx::assert_relative_eq!(
+        got.gradient_l2,
+        gradient_square.sqrt(),
+        max_relative = 1e-11
+    );
+    // A field that is not exact: the figure is a real error, not rounding.
+    assert!(got.l2 > 1e-6, "{}", got.l2);
 }

@@ -10,14 +10,18 @@
 //! cell (and of each face in 3D), whose value is the average of the
 //! vertex values there, so that linear fields are reproduced exactly.
 //!
-//! The rules integrate polynomials exactly up to degree 6 (2D) or 5 (3D)
-//! on simplices, through the collapsed (Duffy) product of 4-point
-//! Gauss–Legendre rules, and up to degree 7 per axis on the Q1 reference
-//! cell: the square of an O(h²) error is then integrated with a relative
-//! error O(h²) or better, far below the digits a convergence table shows.
+//! Cell-centred fields (a value and a reconstructed gradient per cell) are
+//! integrated with the same points: the Q1 cell's rule where the cell is a
+//! quadrilateral or hexahedron filling its space, the fan's elsewhere.
+//!
+//! The rules ([`super::rules`]) integrate polynomials exactly up to degree
+//! 6 (triangles), 7 per axis (quadrilaterals) or 5 (tetrahedra and
+//! hexahedra): the square of an O(h²) error is then integrated with a
+//! relative error O(h²) or better, far below the digits a convergence
+//! table shows.
 
+use super::rules::{q1_rule, simplex_rule};
 use super::{simplex_gradients, Point, Topology};
-use std::sync::OnceLock;
 
 /// One quadrature point of a cell: its weight (physical measure), its
 /// position, and the nodal shape functions of the cell's sorted vertex
@@ -28,63 +32,6 @@ pub(crate) struct FieldPoint {
     pub(crate) x: Point,
     pub(crate) values: Vec<f64>,
     pub(crate) gradients: Vec<Point>,
-}
-
-/// Gauss–Legendre on [0, 1], 4 points: exact to degree 7.
-fn gauss4() -> &'static [(f64, f64); 4] {
-    static RULE: OnceLock<[(f64, f64); 4]> = OnceLock::new();
-    RULE.get_or_init(|| {
-        let (a, b) = (0.339_981_043_584_856_3, 0.861_136_311_594_052_6);
-        let (wa, wb) = (0.652_145_154_862_546_1, 0.347_854_845_137_453_9);
-        [
-            (0.5 * (1.0 - b), 0.5 * wb),
-            (0.5 * (1.0 - a), 0.5 * wa),
-            (0.5 * (1.0 + a), 0.5 * wa),
-            (0.5 * (1.0 + b), 0.5 * wb),
-        ]
-    })
-}
-
-/// Barycentric coordinates (λ₀ … λ_n) and weights (summing to 1) of the
-/// collapsed Gauss rule on the n-simplex, n = 1, 2, 3.
-fn simplex_rule(n: usize) -> &'static [([f64; 4], f64)] {
-    type Rule = Vec<([f64; 4], f64)>;
-    static RULES: [OnceLock<Rule>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
-    RULES[n.clamp(1, 3) - 1].get_or_init(|| {
-        let g = gauss4();
-        let factorial: f64 = (1..=n).map(|k| k as f64).product();
-        let mut rule = Vec::new();
-        match n {
-            1 => {
-                for &(u, wu) in g {
-                    rule.push(([1.0 - u, u, 0.0, 0.0], wu));
-                }
-            }
-            2 => {
-                for &(u, wu) in g {
-                    for &(v, wv) in g {
-                        let (l1, l2) = (u, (1.0 - u) * v);
-                        let w = wu * wv * (1.0 - u) * factorial;
-                        rule.push(([1.0 - l1 - l2, l1, l2, 0.0], w));
-                    }
-                }
-            }
-            _ => {
-                for &(u, wu) in g {
-                    for &(v, wv) in g {
-                        for &(s, ws) in g {
-                            let l1 = u;
-                            let l2 = (1.0 - u) * v;
-                            let l3 = (1.0 - u) * (1.0 - v) * s;
-                            let w = wu * wv * ws * (1.0 - u).powi(2) * (1.0 - v) * factorial;
-                            rule.push(([1.0 - l1 - l2 - l3, l1, l2, l3], w));
-                        }
-                    }
-                }
-            }
-        }
-        rule
-    })
 }
 
 /// A simplex of the rule: its corners, and each corner as weights over the
@@ -117,9 +64,25 @@ pub(crate) fn nodal_rule(top: &Topology, c: usize) -> Vec<FieldPoint> {
 }
 
 /// Quadrature points and weights of top cell `c` for a field of its own
-/// (cell-centred methods): the points of its fan of simplices, or of the
-/// cell itself when it is a simplex.
+/// (cell-centred methods): the Q1 rule of a quadrilateral or hexahedron
+/// that fills its space, the cell's own rule when it is a simplex, and the
+/// points of its fan of simplices otherwise.
 pub(crate) fn cell_rule(top: &Topology, c: usize) -> Vec<(f64, Point)> {
+    if !top.is_simplex(c) && top.n == top.d {
+        if let Some(order) = top.element_order(c) {
+            let points: Vec<(f64, Point)> = q1_map(top, c, &order)
+                .map(|(weight, x, _)| (weight, x))
+                .collect();
+            // A map that folds over (a non-convex quadrilateral: the
+            // Jacobian changes sign) or degenerates at a point leaves the
+            // cell to its fan.
+            let positive = points.iter().all(|p| p.0 > 0.0);
+            let negative = points.iter().all(|p| p.0 < 0.0);
+            if points.len() == q1_rule(top.n).len() && (positive || negative) {
+                return points.into_iter().map(|(w, x)| (w.abs(), x)).collect();
+            }
+        }
+    }
     let pieces = if top.is_simplex(c) {
         vec![Piece {
             corners: top.points(c),
@@ -242,27 +205,22 @@ fn fan(top: &Topology, c: usize) -> Vec<Piece> {
     }
 }
 
-/// The tensor Gauss points of a Q1 cell with its isoparametric shape
-/// functions, in the cell's sorted vertex order.
-fn q1_points(top: &Topology, c: usize, order: &[usize]) -> Vec<FieldPoint> {
+/// The isoparametric map of a Q1 cell at the points of its reference rule:
+/// for each point its physical weight (signed: the Jacobian's determinant
+/// times the reference weight), position and the map's data there
+/// (shape functions in tensor order, their reference gradients, the inverse
+/// Jacobian). A degenerate map (zero or non-finite Jacobian) ends the list
+/// early; [`q1_points`] and [`cell_rule`] then give no points for the cell,
+/// which the metric refuses first.
+fn q1_map<'a>(
+    top: &'a Topology,
+    c: usize,
+    order: &'a [usize],
+) -> impl Iterator<Item = (f64, Point, Q1Point)> + 'a {
     let n = top.n;
-    let m = 1usize << n;
     let vertices = top.complex.cell_vertices(n, c);
     let corners: Vec<Point> = order.iter().map(|&o| top.point(vertices[o])).collect();
-    let g = gauss4();
-    let mut out = Vec::new();
-    let total = g.len().pow(n as u32);
-    for k in 0..total {
-        // ξ ∈ [−1, 1]ⁿ and its weight from the [0, 1] rule (×2 per axis).
-        let mut xi = [0.0; 3];
-        let mut weight = 1.0;
-        let mut rest = k;
-        for x in xi.iter_mut().take(n) {
-            let (t, w) = g[rest % g.len()];
-            rest /= g.len();
-            *x = 2.0 * t - 1.0;
-            weight *= 2.0 * w;
-        }
+    q1_rule(n).iter().map_while(move |(xi, weight)| {
         let (shape, reference) = super::q1::q1_shape(&xi[..n], n);
         let mut jacobian = [[0.0; 3]; 3];
         let mut x = [0.0; 3];
@@ -275,32 +233,63 @@ fn q1_points(top: &Topology, c: usize, order: &[usize]) -> Vec<FieldPoint> {
             }
         }
         let (det, inverse) = super::q1::determinant_and_inverse(&jacobian, n);
-        if !(det.is_finite() && det != 0.0) {
-            return Vec::new();
-        }
-        let mut values = vec![0.0; m];
-        let mut gradients = vec![[0.0; 3]; m];
-        for (l, &o) in order.iter().enumerate() {
-            values[o] = shape[l];
-            for i in 0..n {
-                gradients[o][i] = (0..n).map(|a| inverse[a][i] * reference[l][a]).sum();
+        (det.is_finite() && det != 0.0).then(|| {
+            let data = Q1Point {
+                shape,
+                reference,
+                inverse,
+            };
+            (weight * det, x, data)
+        })
+    })
+}
+
+/// The isoparametric data at one point of a Q1 cell's rule.
+struct Q1Point {
+    shape: Vec<f64>,
+    reference: Vec<[f64; 3]>,
+    inverse: [[f64; 3]; 3],
+}
+
+/// The reference rule's points of a Q1 cell with its isoparametric shape
+/// functions, in the cell's sorted vertex order.
+fn q1_points(top: &Topology, c: usize, order: &[usize]) -> Vec<FieldPoint> {
+    let n = top.n;
+    let m = 1usize << n;
+    let total = q1_rule(n).len();
+    let points: Vec<FieldPoint> = q1_map(top, c, order)
+        .map(|(weight, x, data)| {
+            let mut values = vec![0.0; m];
+            let mut gradients = vec![[0.0; 3]; m];
+            for (l, &o) in order.iter().enumerate() {
+                values[o] = data.shape[l];
+                for i in 0..n {
+                    gradients[o][i] = (0..n)
+                        .map(|a| data.inverse[a][i] * data.reference[l][a])
+                        .sum();
+                }
             }
-        }
-        out.push(FieldPoint {
-            weight: weight * det.abs(),
-            x,
-            values,
-            gradients,
-        });
+            FieldPoint {
+                weight: weight.abs(),
+                x,
+                values,
+                gradients,
+            }
+        })
+        .collect();
+    // All points or none: a map degenerate at one point is no element.
+    if points.len() == total {
+        points
+    } else {
+        Vec::new()
     }
-    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
-    use hasse_complex::generate::{rectangle, voronoi};
+    use hasse_complex::generate::{box3, perturb, rectangle, voronoi};
     use hasse_complex::{Complex, TopCells, Vertices};
 
     /// ∫ over the mesh of a polynomial, through the nodal rules.
@@ -324,6 +313,39 @@ mod tests {
         let t = Complex::build(v, TopCells::simplices([[0, 1, 2]])).unwrap();
         let g = |x: &Point| x[0].powi(2) * x[1].powi(2);
         assert_relative_eq!(integrate(&t, g), 1.0 / 180.0, max_relative = 1e-13);
+    }
+
+    #[test]
+    fn cell_rule_integrates_quintics_on_boxes_and_measures_every_cell() {
+        // ∫ over [0,1]×[0,2]×[0,1] of x²y²z = (1/3)(8/3)(1/2) = 4/9 (degree
+        // 5: the hexahedra's 14-point rule is exact for it).
+        let boxes = box3(2, 3, 2, [0.0, 1.0], [0.0, 2.0], [0.0, 1.0]).unwrap();
+        let top = Topology::new(&boxes, "test").unwrap();
+        let mut integral = 0.0;
+        for c in 0..boxes.cell_count(3) {
+            let rule = cell_rule(&top, c);
+            assert_eq!(rule.len(), 14);
+            integral += rule
+                .iter()
+                .map(|(w, x)| w * x[0].powi(2) * x[1].powi(2) * x[2])
+                .sum::<f64>();
+        }
+        assert_relative_eq!(integral, 4.0 / 9.0, max_relative = 1e-13);
+        // On randomly perturbed quadrilaterals (Q1 maps that are not affine)
+        // and on Voronoi polygons (fans), the weights of each cell add up to
+        // its measure, computed by the complex from its own geometry.
+        let perturbed =
+            perturb(&rectangle(6, 5, [0.0, 1.0], [0.0, 1.0]).unwrap(), 0.3, 11).unwrap();
+        for k in [
+            perturbed,
+            voronoi(30, [0.0, 1.0], [0.0, 1.0], 7, 0).unwrap(),
+        ] {
+            let top = Topology::new(&k, "test").unwrap();
+            for c in 0..k.cell_count(2) {
+                let area: f64 = cell_rule(&top, c).iter().map(|(w, _)| w).sum();
+                assert_relative_eq!(area, k.measure(2)[c], max_relative = 1e-12);
+            }
+        }
     }
 
     #[test]

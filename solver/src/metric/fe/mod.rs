@@ -33,6 +33,7 @@ pub(crate) mod field;
 mod load;
 mod p1;
 mod q1;
+mod rules;
 #[cfg(test)]
 mod tests;
 mod topology;

@@ -28,13 +28,16 @@ impl std::ops::Add for Sums {
     }
 }
 
-/// (L², gradient L²) of u_h − u by quadrature; the gradient figure is NaN
+/// (L², gradient L²) of u_h − u by quadrature, with `cell_gradients` the
+/// reconstructed gradient of a field that is not nodal (unused for nodal
+/// fields, which carry their own); the gradient figure is NaN
 /// without `exact_gradient`. `remove_mean`: measure u_h − u − mean (a pure
 /// Neumann solution is defined up to a constant). `None` for a complex
 /// without edges.
 pub(super) fn quadrature_errors(
     complex: &Complex,
     solution: &Solution,
+    cell_gradients: &[[f64; 3]],
     exact: &ScalarFn,
     exact_gradient: Option<&VectorFn>,
     remove_mean: bool,
@@ -43,10 +46,6 @@ pub(super) fn quadrature_errors(
     let n = complex.dim();
     let d = complex.embedding_dim();
     let field = solution.field(complex);
-    let cell_gradients = match solution.location {
-        Location::Nodal => Vec::new(),
-        _ => reconstruct_gradient(complex, solution),
-    };
     let centre = post::cell_centres(complex, solution);
     let gradient_error = |x: &[f64], g: &[f64; 3]| -> f64 {
         exact_gradient.map_or(0.0, |grad| {

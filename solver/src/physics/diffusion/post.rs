@@ -37,9 +37,16 @@ pub fn gradient_of(
     let face_centre = complex.centroid(n - 1);
     let by_cell = complex.boundary_csc(n);
     let top = complex.boundary(n);
+    let at = |x: &[f64]| -> [f64; 3] {
+        let mut p = [0.0; 3];
+        p[..d].copy_from_slice(&x[..d]);
+        p
+    };
+    // Cells are independent; each worker keeps one point buffer.
     (0..cells)
-        .map(|c| {
-            let mut points: Vec<(Vec<f64>, f64)> = Vec::new();
+        .into_par_iter()
+        .map_init(Vec::new, |points: &mut Vec<([f64; 3], f64)>, c| {
+            points.clear();
             let xc = &centre[c * d..(c + 1) * d];
             match location {
                 Location::Nodal => {
@@ -53,28 +60,25 @@ pub fn gradient_of(
                         }
                     }
                     for &v in vertices {
-                        points.push((complex.vertices().point(v).to_vec(), values[v]));
+                        points.push((at(complex.vertices().point(v)), values[v]));
                     }
                 }
                 Location::Hybrid => {
                     if let Some(col) = by_cell.outer_view(c) {
                         for (f, _) in col.iter() {
-                            points.push((
-                                face_centre[f * d..(f + 1) * d].to_vec(),
-                                values[cells + f],
-                            ));
+                            points.push((at(&face_centre[f * d..(f + 1) * d]), values[cells + f]));
                         }
                     }
                 }
                 Location::CellCentred => {
-                    points.push((xc.to_vec(), values[c]));
+                    points.push((at(xc), values[c]));
                     if let Some(col) = by_cell.outer_view(c) {
                         for (f, _) in col.iter() {
                             if let Some(row) = top.outer_view(f) {
                                 for (other, _) in row.iter() {
                                     if other != c {
                                         points.push((
-                                            centre[other * d..(other + 1) * d].to_vec(),
+                                            at(&centre[other * d..(other + 1) * d]),
                                             values[other],
                                         ));
                                     }
@@ -84,7 +88,7 @@ pub fn gradient_of(
                     }
                 }
             }
-            least_squares_gradient(&points, d)
+            least_squares_gradient(points, d)
         })
         .collect()
 }
@@ -124,9 +128,16 @@ fn p1_gradient(complex: &Complex, vertices: &[usize], values: &[f64]) -> Option<
     Some(g)
 }
 
-pub(super) fn least_squares_gradient(points: &[(Vec<f64>, f64)], d: usize) -> [f64; 3] {
+/// The gradient g minimising Σ (u_i − ū − g·(x_i − x̄))² over `points`
+/// (coordinates padded to three, the first `d` used), on the stack. The
+/// normal equations' matrix is symmetric positive semidefinite, so its
+/// pseudo-inverse comes from its eigenvalues, with those below 1e-14 of its
+/// Frobenius norm dropped: a rank-deficient fit (too few points, or points
+/// on an embedded surface) gets the minimum-norm solution. Below three
+/// dimensions the unused rows are zero, whose eigenvalues are dropped too.
+pub(super) fn least_squares_gradient(points: &[([f64; 3], f64)], d: usize) -> [f64; 3] {
     let m = points.len() as f64;
-    let mut mean_x = vec![0.0; d];
+    let mut mean_x = nalgebra::Vector3::<f64>::zeros();
     let mut mean_u = 0.0;
     for (x, u) in points {
         for a in 0..d {
@@ -134,8 +145,8 @@ pub(super) fn least_squares_gradient(points: &[(Vec<f64>, f64)], d: usize) -> [f
         }
         mean_u += u / m;
     }
-    let mut normal = nalgebra::DMatrix::<f64>::zeros(d, d);
-    let mut right = nalgebra::DVector::<f64>::zeros(d);
+    let mut normal = nalgebra::Matrix3::<f64>::zeros();
+    let mut right = nalgebra::Vector3::<f64>::zeros();
     for (x, u) in points {
         for a in 0..d {
             for b in 0..d {
@@ -144,17 +155,17 @@ pub(super) fn least_squares_gradient(points: &[(Vec<f64>, f64)], d: usize) -> [f
             right[a] += (x[a] - mean_x[a]) * (u - mean_u);
         }
     }
-    let mut g = [0.0; 3];
-    // A rank-deficient fit (too few points, e.g. on an embedded surface)
-    // falls back to the minimum-norm solution.
-    let solution = normal
-        .clone()
-        .pseudo_inverse(1e-14 * normal.norm().max(f64::MIN_POSITIVE))
-        .map(|p| p * right)
-        .unwrap_or_else(|_| nalgebra::DVector::zeros(d));
-    for a in 0..d {
-        g[a] = solution[a];
+    let cutoff = 1e-14 * normal.norm().max(f64::MIN_POSITIVE);
+    let eigen = normal.symmetric_eigen();
+    let mut solution = nalgebra::Vector3::<f64>::zeros();
+    for (k, &lambda) in eigen.eigenvalues.iter().enumerate() {
+        if lambda > cutoff {
+            let v = eigen.eigenvectors.column(k);
+            solution += v * (v.dot(&right) / lambda);
+        }
     }
+    let mut g = [0.0; 3];
+    g[..d].copy_from_slice(&solution.as_slice()[..d]);
     g
 }
 
@@ -242,14 +253,18 @@ pub fn errors(
         .sum::<f64>()
         .sqrt();
     let max = diff.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    // One reconstruction serves the sampled figure and the quadrature.
+    let cell_gradients = match (solution.location, exact_gradient) {
+        (Location::Nodal, None) => Vec::new(),
+        _ => reconstruct_gradient(complex, solution),
+    };
     let gradient_l2 = exact_gradient.map_or(f64::NAN, |grad| {
-        let g = reconstruct_gradient(complex, solution);
         let volume = complex.measure(n);
         let centre = complex.centroid(n);
         (0..complex.cell_count(n))
             .map(|c| {
                 let e = grad(&centre[c * d..(c + 1) * d]);
-                let s: f64 = (0..d).map(|a| (g[c][a] - e[a]).powi(2)).sum();
+                let s: f64 = (0..d).map(|a| (cell_gradients[c][a] - e[a]).powi(2)).sum();
                 s * volume[c]
             })
             .sum::<f64>()
@@ -258,6 +273,7 @@ pub fn errors(
     let quadrature = norms::quadrature_errors(
         complex,
         solution,
+        &cell_gradients,
         exact,
         exact_gradient,
         solution.pure_neumann,
