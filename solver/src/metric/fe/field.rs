@@ -14,12 +14,11 @@
 //! integrated with the same points: the Q1 cell's rule where the cell is a
 //! quadrilateral or hexahedron filling its space, the fan's elsewhere.
 //!
-//! The rules ([`super::rules`]) integrate polynomials exactly up to degree
-//! 6 (triangles), 7 per axis (quadrilaterals) or 5 (tetrahedra and
-//! hexahedra): the square of an O(h²) error is then integrated with a
-//! relative error O(h²) or better, far below the digits a convergence
-//! table shows.
+//! The rules ([`super::rules`]) come in two degrees: 7 for the square of
+//! a field's error, 5 for the square of its gradient's; that module says
+//! why and what was measured.
 
+pub(crate) use super::rules::Degree;
 use super::rules::{q1_rule, simplex_rule};
 use super::{simplex_gradients, Point, Topology};
 
@@ -43,23 +42,23 @@ struct Piece {
 
 /// Quadrature points of top cell `c` with its nodal shape functions; an
 /// empty list for a degenerate cell (the metric refuses those first).
-pub(crate) fn nodal_rule(top: &Topology, c: usize) -> Vec<FieldPoint> {
+pub(crate) fn nodal_rule(top: &Topology, c: usize, degree: Degree) -> Vec<FieldPoint> {
     let vertices = top.complex.cell_vertices(top.n, c);
     if top.is_simplex(c) {
         let piece = Piece {
             corners: top.points(c),
             mix: (0..vertices.len()).map(|i| vec![(i, 1.0)]).collect(),
         };
-        return piece_points(top, &piece, vertices.len());
+        return piece_points(top, &piece, vertices.len(), degree);
     }
     if top.n == top.d {
         if let Some(order) = top.element_order(c) {
-            return q1_points(top, c, &order);
+            return q1_points(top, c, &order, degree);
         }
     }
     fan(top, c)
         .iter()
-        .flat_map(|piece| piece_points(top, piece, vertices.len()))
+        .flat_map(|piece| piece_points(top, piece, vertices.len(), degree))
         .collect()
 }
 
@@ -67,10 +66,10 @@ pub(crate) fn nodal_rule(top: &Topology, c: usize) -> Vec<FieldPoint> {
 /// (cell-centred methods): the Q1 rule of a quadrilateral or hexahedron
 /// that fills its space, the cell's own rule when it is a simplex, and the
 /// points of its fan of simplices otherwise.
-pub(crate) fn cell_rule(top: &Topology, c: usize) -> Vec<(f64, Point)> {
+pub(crate) fn cell_rule(top: &Topology, c: usize, degree: Degree) -> Vec<(f64, Point)> {
     if !top.is_simplex(c) && top.n == top.d {
         if let Some(order) = top.element_order(c) {
-            let points: Vec<(f64, Point)> = q1_map(top, c, &order)
+            let points: Vec<(f64, Point)> = q1_map(top, c, &order, degree)
                 .map(|(weight, x, _)| (weight, x))
                 .collect();
             // A map that folds over (a non-convex quadrilateral: the
@@ -78,7 +77,7 @@ pub(crate) fn cell_rule(top: &Topology, c: usize) -> Vec<(f64, Point)> {
             // cell to its fan.
             let positive = points.iter().all(|p| p.0 > 0.0);
             let negative = points.iter().all(|p| p.0 < 0.0);
-            if points.len() == q1_rule(top.n).len() && (positive || negative) {
+            if points.len() == q1_rule(top.n, degree).len() && (positive || negative) {
                 return points.into_iter().map(|(w, x)| (w.abs(), x)).collect();
             }
         }
@@ -97,7 +96,7 @@ pub(crate) fn cell_rule(top: &Topology, c: usize) -> Vec<(f64, Point)> {
         let Some((measure, _)) = simplex_gradients(&piece.corners, top.d) else {
             continue;
         };
-        for (lambda, w) in simplex_rule(n) {
+        for (lambda, w) in simplex_rule(n, degree) {
             out.push((measure * w, combine(&piece.corners, lambda)));
         }
     }
@@ -117,7 +116,7 @@ fn combine(corners: &[Point], lambda: &[f64; 4]) -> Point {
 /// The rule's points on one simplex piece, with the shape functions of the
 /// cell's `m` vertices: the piece's barycentric functions spread over the
 /// vertices through `piece.mix`.
-fn piece_points(top: &Topology, piece: &Piece, m: usize) -> Vec<FieldPoint> {
+fn piece_points(top: &Topology, piece: &Piece, m: usize, degree: Degree) -> Vec<FieldPoint> {
     let Some((measure, lambda_gradients)) = simplex_gradients(&piece.corners, top.d) else {
         return Vec::new();
     };
@@ -129,7 +128,7 @@ fn piece_points(top: &Topology, piece: &Piece, m: usize) -> Vec<FieldPoint> {
             }
         }
     }
-    simplex_rule(top.n)
+    simplex_rule(top.n, degree)
         .iter()
         .map(|(lambda, w)| {
             let mut values = vec![0.0; m];
@@ -216,11 +215,12 @@ fn q1_map<'a>(
     top: &'a Topology,
     c: usize,
     order: &'a [usize],
+    degree: Degree,
 ) -> impl Iterator<Item = (f64, Point, Q1Point)> + 'a {
     let n = top.n;
     let vertices = top.complex.cell_vertices(n, c);
     let corners: Vec<Point> = order.iter().map(|&o| top.point(vertices[o])).collect();
-    q1_rule(n).iter().map_while(move |(xi, weight)| {
+    q1_rule(n, degree).iter().map_while(move |(xi, weight)| {
         let (shape, reference) = super::q1::q1_shape(&xi[..n], n);
         let mut jacobian = [[0.0; 3]; 3];
         let mut x = [0.0; 3];
@@ -253,11 +253,11 @@ struct Q1Point {
 
 /// The reference rule's points of a Q1 cell with its isoparametric shape
 /// functions, in the cell's sorted vertex order.
-fn q1_points(top: &Topology, c: usize, order: &[usize]) -> Vec<FieldPoint> {
+fn q1_points(top: &Topology, c: usize, order: &[usize], degree: Degree) -> Vec<FieldPoint> {
     let n = top.n;
     let m = 1usize << n;
-    let total = q1_rule(n).len();
-    let points: Vec<FieldPoint> = q1_map(top, c, order)
+    let total = q1_rule(n, degree).len();
+    let points: Vec<FieldPoint> = q1_map(top, c, order, degree)
         .map(|(weight, x, data)| {
             let mut values = vec![0.0; m];
             let mut gradients = vec![[0.0; 3]; m];
@@ -296,7 +296,7 @@ mod tests {
     fn integrate(k: &Complex, f: impl Fn(&Point) -> f64) -> f64 {
         let top = Topology::new(k, "test").unwrap();
         (0..k.cell_count(k.dim()))
-            .flat_map(|c| nodal_rule(&top, c))
+            .flat_map(|c| nodal_rule(&top, c, Degree::Quintic))
             .map(|p| p.weight * f(&p.x))
             .sum()
     }
@@ -318,13 +318,13 @@ mod tests {
     #[test]
     fn cell_rule_integrates_quintics_on_boxes_and_measures_every_cell() {
         // ∫ over [0,1]×[0,2]×[0,1] of x²y²z = (1/3)(8/3)(1/2) = 4/9 (degree
-        // 5: the hexahedra's 14-point rule is exact for it).
+        // 2 per axis: the 3 × 3 × 3 Gauss product is exact for it).
         let boxes = box3(2, 3, 2, [0.0, 1.0], [0.0, 2.0], [0.0, 1.0]).unwrap();
         let top = Topology::new(&boxes, "test").unwrap();
         let mut integral = 0.0;
         for c in 0..boxes.cell_count(3) {
-            let rule = cell_rule(&top, c);
-            assert_eq!(rule.len(), 14);
+            let rule = cell_rule(&top, c, Degree::Quintic);
+            assert_eq!(rule.len(), 27);
             integral += rule
                 .iter()
                 .map(|(w, x)| w * x[0].powi(2) * x[1].powi(2) * x[2])
@@ -342,7 +342,10 @@ mod tests {
         ] {
             let top = Topology::new(&k, "test").unwrap();
             for c in 0..k.cell_count(2) {
-                let area: f64 = cell_rule(&top, c).iter().map(|(w, _)| w).sum();
+                let area: f64 = cell_rule(&top, c, Degree::Quintic)
+                    .iter()
+                    .map(|(w, _)| w)
+                    .sum();
                 assert_relative_eq!(area, k.measure(2)[c], max_relative = 1e-12);
             }
         }
@@ -361,7 +364,7 @@ mod tests {
             let mut area = 0.0;
             for c in 0..k.cell_count(2) {
                 let ids = k.cell_vertices(2, c);
-                for p in nodal_rule(&top, c) {
+                for p in nodal_rule(&top, c, Degree::Quintic) {
                     let u: f64 = ids
                         .iter()
                         .zip(&p.values)

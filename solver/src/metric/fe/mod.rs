@@ -33,7 +33,7 @@ pub(crate) mod field;
 mod load;
 mod p1;
 mod q1;
-mod rules;
+pub(crate) mod rules;
 #[cfg(test)]
 mod tests;
 mod topology;

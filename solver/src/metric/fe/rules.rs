@@ -1,20 +1,61 @@
 //! Quadrature rules for norms of the error: on simplices (collapsed
-//! Gauss–Jacobi products) and on the reference square and cube of Q1 cells.
+//! Gauss–Jacobi products) and on the reference square and cube of Q1 cells
+//! (Gauss products).
 //!
 //! The error e = u_h − u of a second-order method is, on a cell of size h,
 //! a quadratic polynomial of size O(h²) plus O(h³) terms, so e² is a quartic
-//! plus higher terms: a rule exact to degree 5 integrates it with a relative
-//! error O(h²), far below the digits of a convergence table. Each rule here
-//! is exact to degree 5 or more with as few points as such a rule needs,
-//! because every point costs an evaluation of the exact solution and its
-//! gradient (a handful of parsed expressions with sin/exp, about 1 µs): the
-//! point count, not the arithmetic, is the cost of the error norms.
+//! plus higher terms, and a rule exact to degree p integrates it with a
+//! relative error O(h^(p−3)). The gradient's error ∇e is O(h) with a
+//! leading part of degree one, so |∇e|² is a quadratic plus higher terms,
+//! integrated with a relative error O(h^(p−1)).
+//!
+//! Convergence tables print five significant digits, from meshes as coarse
+//! as 8³. Measured on the 3D box case at 8³ (fv and Q1 fe) against 6 × 6 × 6
+//! Gauss: degree-5 rules for the field missed by 2–4·10⁻⁵ (the last printed
+//! digit), 4 × 4 × 4 Gauss (degree 7) agreed to seven digits; for the
+//! gradient, 2 × 2 × 2 Gauss missed by 2·10⁻⁴ and 3 × 3 × 3 agreed to seven
+//! digits. Hence [`Degree::Septic`] for the field and [`Degree::Quintic`]
+//! for the gradient.
+//!
+//! Each rule has as few points as its degree needs in product form,
+//! because every point costs evaluations of the exact solution or its
+//! gradient (parsed expressions with sin and exp, a few hundred ns each):
+//! the point count, not the arithmetic, is the cost of the error norms.
 
 use nalgebra::{DMatrix, SymmetricEigen};
 use std::sync::OnceLock;
 
 /// One point of a reference rule: coordinates and weight.
 pub(super) type RulePoint = ([f64; 4], f64);
+
+/// The polynomial degree a rule integrates exactly (per axis for the Q1
+/// products, in total on simplices).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Degree {
+    /// Degree 5: 3 Gauss points per axis. For the square of a gradient's
+    /// error.
+    Quintic,
+    /// Degree 7: 4 Gauss points per axis. For the square of a field's
+    /// error.
+    Septic,
+}
+
+impl Degree {
+    fn index(self) -> usize {
+        match self {
+            Degree::Quintic => 0,
+            Degree::Septic => 1,
+        }
+    }
+
+    /// Points per axis of the product rules: 2q − 1 is the degree.
+    fn points(self) -> usize {
+        match self {
+            Degree::Quintic => 3,
+            Degree::Septic => 4,
+        }
+    }
+}
 
 /// Gauss–Jacobi rule with `q` points on [0, 1] for the weight (1 − u)^α:
 /// (point, weight) pairs, exact for polynomials of degree 2q − 1 times the
@@ -60,106 +101,68 @@ fn gauss_jacobi(q: usize, alpha: f64) -> Vec<(f64, f64)> {
     rule
 }
 
-/// Gauss–Legendre on [0, 1], 4 points: exact to degree 7.
-pub(super) fn gauss4() -> &'static [(f64, f64); 4] {
-    static RULE: OnceLock<[(f64, f64); 4]> = OnceLock::new();
-    RULE.get_or_init(|| {
-        let (a, b) = (0.339_981_043_584_856_3, 0.861_136_311_594_052_6);
-        let (wa, wb) = (0.652_145_154_862_546_1, 0.347_854_845_137_453_9);
-        [
-            (0.5 * (1.0 - b), 0.5 * wb),
-            (0.5 * (1.0 - a), 0.5 * wa),
-            (0.5 * (1.0 + a), 0.5 * wa),
-            (0.5 * (1.0 + b), 0.5 * wb),
-        ]
-    })
-}
-
 /// Barycentric coordinates (λ₀ … λ_n) and weights (summing to 1) on the
-/// n-simplex, n = 1, 2, 3: Gauss (4 points, degree 7) on segments, the
-/// collapsed product of 4-point Gauss rules on triangles (16 points,
-/// degree 6), and on tetrahedra the collapsed product of 3-point
-/// Gauss–Jacobi rules whose weights (1 − u)² and (1 − v) absorb the
-/// Duffy map's Jacobian (27 points, degree 5; the 4-point Gauss product
-/// reached the same degree with 64).
-pub(super) fn simplex_rule(n: usize) -> &'static [RulePoint] {
-    static RULES: [OnceLock<Vec<RulePoint>>; 3] =
-        [OnceLock::new(), OnceLock::new(), OnceLock::new()];
-    RULES[n.clamp(1, 3) - 1].get_or_init(|| {
-        let g = gauss4();
-        let mut rule = Vec::new();
-        match n {
-            1 => {
-                for &(u, wu) in g {
-                    rule.push(([1.0 - u, u, 0.0, 0.0], wu));
+/// n-simplex, n = 1, 2, 3: the collapsed (Duffy) product of Gauss–Jacobi
+/// rules, whose weights (1 − t)^(n−1−axis) absorb the map's Jacobian, so
+/// that q points per axis are exact to degree 2q − 1: 3ⁿ points for
+/// [`Degree::Quintic`], 4ⁿ for [`Degree::Septic`].
+pub(super) fn simplex_rule(n: usize, degree: Degree) -> &'static [RulePoint] {
+    static RULES: [[OnceLock<Vec<RulePoint>>; 3]; 2] = [
+        [OnceLock::new(), OnceLock::new(), OnceLock::new()],
+        [OnceLock::new(), OnceLock::new(), OnceLock::new()],
+    ];
+    let n = n.clamp(1, 3);
+    RULES[degree.index()][n - 1].get_or_init(|| {
+        let axes: Vec<Vec<(f64, f64)>> = (0..n)
+            .map(|axis| gauss_jacobi(degree.points(), (n - 1 - axis) as f64))
+            .collect();
+        let factorial: f64 = (1..=n).map(|k| k as f64).product();
+        let total: usize = axes.iter().map(Vec::len).product();
+        (0..total)
+            .map(|index| {
+                let mut rest = index;
+                let mut lambda = [0.0; 4];
+                let mut weight = factorial;
+                // λ_{k+1} = t_k Π_{j<k} (1 − t_j), λ₀ what is left.
+                let mut left = 1.0;
+                for (axis, points) in axes.iter().enumerate() {
+                    let (t, w) = points[rest % points.len()];
+                    rest /= points.len();
+                    lambda[axis + 1] = left * t;
+                    weight *= w;
+                    left *= 1.0 - t;
                 }
-            }
-            2 => {
-                for &(u, wu) in g {
-                    for &(v, wv) in g {
-                        let (l1, l2) = (u, (1.0 - u) * v);
-                        rule.push(([1.0 - l1 - l2, l1, l2, 0.0], 2.0 * wu * wv * (1.0 - u)));
-                    }
-                }
-            }
-            _ => {
-                let (gu, gv, gs) = (
-                    gauss_jacobi(3, 2.0),
-                    gauss_jacobi(3, 1.0),
-                    gauss_jacobi(3, 0.0),
-                );
-                for &(u, wu) in &gu {
-                    for &(v, wv) in &gv {
-                        for &(s, ws) in &gs {
-                            let l1 = u;
-                            let l2 = (1.0 - u) * v;
-                            let l3 = (1.0 - u) * (1.0 - v) * s;
-                            rule.push(([1.0 - l1 - l2 - l3, l1, l2, l3], 6.0 * wu * wv * ws));
-                        }
-                    }
-                }
-            }
-        }
-        rule
+                lambda[0] = left;
+                (lambda, weight)
+            })
+            .collect()
     })
 }
 
 /// Points ξ ∈ [−1, 1]ⁿ (first n entries) and weights (summing to 2ⁿ) of
-/// the reference rule of Q1 cells: the 4 × 4 Gauss product on the square
-/// (degree 7 per axis), and on the cube the 14-point rule exact to total
-/// degree 5 of Hammer and Stroud (Stroud, *Approximate Calculation of
-/// Multiple Integrals*, 1971, C3: 5-1): six points (±r, 0, 0), … with
-/// weight 320/361 and eight (±s, ±s, ±s) with weight 121/361,
-/// r² = 19/30, s² = 19/33. The 4 × 4 × 4 product it replaces took 64
-/// evaluations of the exact solution per hexahedron.
-pub(super) fn q1_rule(n: usize) -> &'static [RulePoint] {
-    static RULES: [OnceLock<Vec<RulePoint>>; 2] = [OnceLock::new(), OnceLock::new()];
-    RULES[usize::from(n >= 3)].get_or_init(|| {
-        let mut rule = Vec::new();
-        if n >= 3 {
-            let (r, s) = ((19.0f64 / 30.0).sqrt(), (19.0f64 / 33.0).sqrt());
-            for axis in 0..3 {
-                for sign in [-1.0, 1.0] {
-                    let mut xi = [0.0; 4];
-                    xi[axis] = sign * r;
-                    rule.push((xi, 320.0 / 361.0));
+/// the reference rule of Q1 cells, n = 2, 3: the Gauss product with 3
+/// ([`Degree::Quintic`]) or 4 ([`Degree::Septic`]) points per axis.
+pub(super) fn q1_rule(n: usize, degree: Degree) -> &'static [RulePoint] {
+    static RULES: [[OnceLock<Vec<RulePoint>>; 2]; 2] = [
+        [OnceLock::new(), OnceLock::new()],
+        [OnceLock::new(), OnceLock::new()],
+    ];
+    let dims = n.clamp(2, 3);
+    RULES[degree.index()][dims - 2].get_or_init(|| {
+        let points = gauss_jacobi(degree.points(), 0.0);
+        let total = points.len().pow(dims as u32);
+        (0..total)
+            .map(|index| {
+                let (mut xi, mut weight, mut rest) = ([0.0; 4], 1.0, index);
+                for x in xi.iter_mut().take(dims) {
+                    let (t, w) = points[rest % points.len()];
+                    rest /= points.len();
+                    *x = 2.0 * t - 1.0;
+                    weight *= 2.0 * w;
                 }
-            }
-            for corner in 0..8 {
-                let mut xi = [0.0; 4];
-                for (a, x) in xi.iter_mut().take(3).enumerate() {
-                    *x = if corner >> a & 1 == 1 { s } else { -s };
-                }
-                rule.push((xi, 121.0 / 361.0));
-            }
-        } else {
-            for &(u, wu) in gauss4() {
-                for &(v, wv) in gauss4() {
-                    rule.push(([2.0 * u - 1.0, 2.0 * v - 1.0, 0.0, 0.0], 4.0 * wu * wv));
-                }
-            }
-        }
-        rule
+                (xi, weight)
+            })
+            .collect()
     })
 }
 
@@ -192,34 +195,40 @@ mod tests {
     }
 
     #[test]
-    fn tetrahedron_rule_is_exact_to_degree_five() {
-        // ∫ over the unit simplex of λ₁^a λ₂^b λ₃^c = a! b! c! 3! / (a+b+c+3)!
-        // relative to its volume 1/6 (the weights sum to 1).
-        let rule = simplex_rule(3);
-        assert_eq!(rule.len(), 27);
-        for a in 0..=5u32 {
-            for b in 0..=5 - a {
-                for c in 0..=5 - a - b {
-                    let got: f64 = rule
-                        .iter()
-                        .map(|(l, w)| {
-                            w * l[1].powi(a as i32) * l[2].powi(b as i32) * l[3].powi(c as i32)
-                        })
-                        .sum();
-                    let want =
-                        factorial(a) * factorial(b) * factorial(c) * 6.0 / factorial(a + b + c + 3);
-                    assert_relative_eq!(got, want, max_relative = 1e-13);
+    fn simplex_rules_are_exact_to_their_degree() {
+        // ∫ over the unit n-simplex of λ₁^a λ₂^b λ₃^c = a! b! c! n! / (a+b+c+n)!
+        // relative to its volume 1/n! (the weights sum to 1).
+        for n in 1..=3usize {
+            for (degree, top) in [(Degree::Quintic, 5u32), (Degree::Septic, 7)] {
+                let rule = simplex_rule(n, degree);
+                assert_eq!(rule.len(), degree.points().pow(n as u32));
+                let limit = |axis: usize, used: u32| if axis < n { top - used } else { 0 };
+                for a in 0..=limit(0, 0) {
+                    for b in 0..=limit(1, a) {
+                        for c in 0..=limit(2, a + b) {
+                            let got: f64 = rule
+                                .iter()
+                                .map(|(l, w)| {
+                                    w * l[1].powi(a as i32)
+                                        * l[2].powi(b as i32)
+                                        * l[3].powi(c as i32)
+                                })
+                                .sum();
+                            let want =
+                                factorial(a) * factorial(b) * factorial(c) * factorial(n as u32)
+                                    / factorial(a + b + c + n as u32);
+                            assert_relative_eq!(got, want, max_relative = 1e-13);
+                        }
+                    }
                 }
             }
         }
     }
 
     #[test]
-    fn cube_rule_is_exact_to_degree_five_and_not_six() {
-        // ∫_{[−1,1]³} x^a y^b z^c = Π 2/(e + 1) for even exponents, 0 otherwise.
-        let rule = q1_rule(3);
-        assert_eq!(rule.len(), 14);
-        let moment = |e: [u32; 3]| -> f64 {
+    fn q1_rules_are_exact_to_their_degree_per_axis() {
+        // ∫_{[−1,1]^n} Π x_a^{e_a} = Π 2/(e_a + 1) for even e_a, else 0.
+        let moment = |e: &[u32]| -> f64 {
             e.iter()
                 .map(|&k| {
                     if k % 2 == 1 {
@@ -230,20 +239,25 @@ mod tests {
                 })
                 .product()
         };
-        let quadrature = |e: [u32; 3]| -> f64 {
-            rule.iter()
-                .map(|(x, w)| w * (0..3).map(|a| x[a].powi(e[a] as i32)).product::<f64>())
-                .sum()
-        };
-        for a in 0..=5u32 {
-            for b in 0..=5 - a {
-                for c in 0..=5 - a - b {
-                    assert_relative_eq!(quadrature([a, b, c]), moment([a, b, c]), epsilon = 1e-14);
+        for n in [2usize, 3] {
+            for (degree, top) in [(Degree::Quintic, 5u32), (Degree::Septic, 7)] {
+                let rule = q1_rule(n, degree);
+                assert_eq!(rule.len(), degree.points().pow(n as u32));
+                let quadrature = |e: &[u32]| -> f64 {
+                    rule.iter()
+                        .map(|(x, w)| w * (0..n).map(|a| x[a].powi(e[a] as i32)).product::<f64>())
+                        .sum()
+                };
+                for a in 0..=top {
+                    for b in 0..=top {
+                        let e = [a, b, top - a.min(top)];
+                        assert_relative_eq!(quadrature(&e[..n]), moment(&e[..n]), epsilon = 1e-14);
+                    }
                 }
+                // One degree more on one axis is where each rule stops.
+                let e = [top + 1, 0, 0];
+                assert!((quadrature(&e[..n]) - moment(&e[..n])).abs() > 1e-4);
             }
         }
-        // Degree 6 is where it stops: x⁶ gives 2·(320/361)(19/30)³ +
-        // 8·(121/361)(19/33)³ ≠ 8/7.
-        assert!((quadrature([6, 0, 0]) - moment([6, 0, 0])).abs() > 1e-3);
     }
 }

@@ -4,7 +4,7 @@
 //! of the cell value and its reconstructed gradient at the cell point.
 
 use super::*;
-use fe::field::{cell_rule, nodal_rule};
+use fe::field::{cell_rule, nodal_rule, Degree};
 
 /// ∫ (u_h − u), ∫ (u_h − u)², ∫ |∇u_h − ∇u|² and the measure, summed over
 /// the cells.
@@ -14,6 +14,15 @@ struct Sums {
     square: f64,
     gradient: f64,
     measure: f64,
+}
+
+impl Sums {
+    /// One point of the field's rule, with weight `w` and error `e`.
+    fn add_value(&mut self, w: f64, e: f64) {
+        self.difference += w * e;
+        self.square += w * e * e;
+        self.measure += w;
+    }
 }
 
 impl std::ops::Add for Sums {
@@ -53,37 +62,43 @@ pub(super) fn quadrature_errors(
             (0..d).map(|a| (g[a] - e[a]).powi(2)).sum()
         })
     };
+    // The field's error at a degree-7 rule, the gradient's at a degree-5
+    // one (`fe::rules` says why each suffices): the exact gradient is three
+    // expressions, and its points are most of the cost.
     let sums = (0..complex.cell_count(n))
         .into_par_iter()
         .map(|c| {
             let mut s = Sums::default();
-            let mut add = |w: f64, x: &[f64], uh: f64, g: &[f64; 3]| {
-                let e = uh - exact(x);
-                s.difference += w * e;
-                s.square += w * e * e;
-                s.gradient += w * gradient_error(x, g);
-                s.measure += w;
-            };
             match solution.location {
                 Location::Nodal => {
                     let ids = complex.cell_vertices(n, c);
-                    for p in nodal_rule(&top, c) {
+                    for p in nodal_rule(&top, c, Degree::Septic) {
                         let uh: f64 = ids.iter().zip(&p.values).map(|(&v, s)| s * field[v]).sum();
-                        let mut g = [0.0; 3];
-                        for (&v, sg) in ids.iter().zip(&p.gradients) {
-                            for a in 0..3 {
-                                g[a] += sg[a] * field[v];
+                        s.add_value(p.weight, uh - exact(&p.x[..d]));
+                    }
+                    if exact_gradient.is_some() {
+                        for p in nodal_rule(&top, c, Degree::Quintic) {
+                            let mut g = [0.0; 3];
+                            for (&v, sg) in ids.iter().zip(&p.gradients) {
+                                for a in 0..3 {
+                                    g[a] += sg[a] * field[v];
+                                }
                             }
+                            s.gradient += p.weight * gradient_error(&p.x[..d], &g);
                         }
-                        add(p.weight, &p.x[..d], uh, &g);
                     }
                 }
                 _ => {
                     let g = &cell_gradients[c];
                     let xc = &centre[c * d..(c + 1) * d];
-                    for (w, x) in cell_rule(&top, c) {
+                    for (w, x) in cell_rule(&top, c, Degree::Septic) {
                         let uh = field[c] + (0..d).map(|a| g[a] * (x[a] - xc[a])).sum::<f64>();
-                        add(w, &x[..d], uh, g);
+                        s.add_value(w, uh - exact(&x[..d]));
+                    }
+                    if exact_gradient.is_some() {
+                        for (w, x) in cell_rule(&top, c, Degree::Quintic) {
+                            s.gradient += w * gradient_error(&x[..d], g);
+                        }
                     }
                 }
             }
