@@ -263,8 +263,8 @@ fn q1_points(top: &Topology, c: usize, order: &[usize], degree: Degree) -> Vec<F
             let mut gradients = vec![[0.0; 3]; m];
             for (l, &o) in order.iter().enumerate() {
                 values[o] = data.shape[l];
-                for i in 0..n {
-                    gradients[o][i] = (0..n)
+                for (i, gradient) in gradients[o].iter_mut().enumerate().take(n) {
+                    *gradient = (0..n)
                         .map(|a| data.inverse[a][i] * data.reference[l][a])
                         .sum();
                 }
