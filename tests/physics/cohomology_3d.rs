@@ -12,8 +12,8 @@
 //! - Independence modulo exact forms: rank [δ^{k−1} | z₁ … z_β] −
 //!   rank δ^{k−1} = β_k, ranks over Q exact (the complex crate's rank).
 //! - Harmonic forms are closed and co-closed, measured from d and ⋆ here.
-//! - Flat 3-torus: the harmonic 1-forms are the constant forms a dx + b dy
-//!   + c dz (constant fields are curl- and divergence-free) and the
+//! - Flat 3-torus: the harmonic 1-forms are the constant forms
+//!   a dx + b dy + c dz (constant fields are curl- and divergence-free) and the
 //!   harmonic 2-forms the constant fluxes a dy∧dz + b dz∧dx + c dx∧dy.
 //!   A harmonic form has its cocycle's integer periods (it differs by an
 //!   exact form), so h = Σ n_a dx_a / L_a with integers n_a, and the period
@@ -408,14 +408,14 @@ fn flat_three_torus_of_cubes_two_forms_are_constant_fluxes() -> Result {
                 assert_abs_diff_eq!(v[a], first[a], epsilon = 1e-12 * max_abs(form));
             }
         }
-        for f in 0..k.cell_count(2) {
+        for (f, value) in form.iter().enumerate() {
             let points = k.cell_points(2, f);
             // The normal axis: the coordinate all four corners share.
             let a = (0..3)
                 .find(|&a| points.iter().all(|p| (p[a] - points[0][a]).abs() < 1e-12))
                 .ok_or("a face is not axis-aligned")?;
             let area = h[(a + 1) % 3] * h[(a + 2) % 3];
-            assert_abs_diff_eq!(form[f].abs(), first[a].abs() * area, epsilon = 1e-12);
+            assert_abs_diff_eq!(value.abs(), first[a].abs() * area, epsilon = 1e-12);
         }
     }
     Ok(())
@@ -515,4 +515,3 @@ fn tunnel_form_has_period_one_around_the_hole() -> Result {
     }
     Ok(())
 }
-
