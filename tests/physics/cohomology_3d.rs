@@ -515,3 +515,44 @@ fn tunnel_form_has_period_one_around_the_hole() -> Result {
     }
     Ok(())
 }
+
+/// A 2-complex that is not a surface: the ring of eight unit squares
+/// around a square hole (an annulus, β₁ = 1) with a fin, one more square
+/// standing on the interior edge x = 1, 0 ≤ y ≤ 1, which then bounds three
+/// squares. The fin is a disk glued along an edge, so it changes no Betti
+/// number: β = (1, 1, 0). The tree–cotree needs a surface; the reduction
+/// gives the one generator, closed exactly and not exact.
+#[test]
+fn non_surface_two_complex_gets_its_generator() -> Result {
+    // Vertices (i, j, 0), i, j ∈ 0..4, index i + 4 j, then the fin's top
+    // edge (1, 0, 1) = 16 and (1, 1, 1) = 17.
+    let mut coords = Vec::new();
+    for j in 0..4 {
+        for i in 0..4 {
+            coords.extend([i as f64, j as f64, 0.0]);
+        }
+    }
+    coords.extend([1.0, 0.0, 1.0, 1.0, 1.0, 1.0]);
+    let mut squares = Vec::new();
+    for j in 0..3 {
+        for i in 0..3 {
+            if (i, j) != (1, 1) {
+                let v = i + 4 * j;
+                squares.push(vec![v, v + 1, v + 4, v + 5]);
+            }
+        }
+    }
+    // Tensor order: (1,0,0), (1,1,0), (1,0,1), (1,1,1).
+    squares.push(vec![1, 5, 16, 17]);
+    let k = Complex::build(Vertices::new(3, coords)?, TopCells::cuboids(squares))?;
+    let shared = k.find_cell(1, &[1, 5]).ok_or("no edge (1,0,0)–(1,1,0)")?;
+    assert_eq!(k.boundary(2).outer_view(shared).map_or(0, |r| r.nnz()), 3);
+    assert_eq!(k.betti_numbers(), vec![1, 1, 0]);
+    let generators = cocycle_generators(&k, 1)?;
+    assert_eq!(generators.len(), 1);
+    assert!(integer_coboundary(&k, 1, &generators[0])
+        .iter()
+        .all(|&x| x == 0));
+    assert_eq!(rank_modulo_exact(&k, 1, &generators), 1);
+    Ok(())
+}
