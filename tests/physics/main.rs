@@ -10,6 +10,7 @@
 #[path = "../common/orders.rs"]
 mod orders;
 
+mod cohomology_3d;
 mod converge;
 mod converge_any;
 mod coupled;

@@ -9,8 +9,9 @@ use crate::physics::regions::{top_cell_tags, RegionError, Regional};
 use hasse_complex::Complex;
 
 impl Case {
-    /// A DEC kind's degree must be at most the mesh's dimension (and one
-    /// whose cohomology or decomposition is computed), and the
+    /// A DEC kind's degree must be at most the mesh's dimension (cohomology
+    /// generators are computed for every degree; relative ones for degree 1
+    /// on 2-dimensional meshes), and the
     /// circumcentric and Whitney stars need simplices. Only these kinds
     /// measure a periodic mesh unwrapped.
     pub(super) fn check_hodge(&self, complex: &Complex, collector: &mut Collector) {
@@ -69,17 +70,6 @@ impl Case {
                         Some("use boundary = \"natural\", or degree 1 on a surface or planar mesh".into()),
                     );
                 }
-            }
-            if matches!(self.problem, Problem::Cohomology(_))
-                && degree <= n
-                && !(degree == 0 || degree == n || (degree == 1 && n == 2))
-            {
-                collector.error(
-                    span.clone(),
-                    "problem.degree",
-                    format!("cohomology generators of degree {degree} on a {n}-dimensional mesh are not computed (tree–cotree gives degree 1 on surfaces and planar meshes)"),
-                    Some(format!("choose degree 0 or {n}, or a 2-dimensional mesh for degree 1")),
-                );
             }
         }
         if matches!(self.problem, Problem::Decomposition(_)) && n != 2 {

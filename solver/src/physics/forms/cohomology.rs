@@ -37,8 +37,14 @@
 //! of the tree and the boundary's edges held at 0; their harmonic forms
 //! vanish on the boundary and are co-closed at the interior vertices.
 //!
-//! Other degrees (k = 1 or 2 on a 3-complex) are refused with
-//! [`FormsError::Cohomology`].
+//! - Every other degree (k = 1 and 2 on 3-complexes, k = 1 on 2-complexes
+//!   that are not surfaces): integer column reduction of the coboundary
+//!   matrices (see `reduction.rs`): the cocycles V_j of the k-cells left
+//!   unpaired by the reductions of δ^{k−1} and δᵏ, closed exactly in
+//!   integers (checked), independent modulo exact forms, β_k of them.
+//!   For k ≥ 2 the exact part's potential α on the (k−1)-cells is held at
+//!   0 off a set of cells whose columns of d_{k−1} are a basis of its
+//!   image (found by the same reduction), which makes the solve definite.
 //!
 //! ```
 //! use hasse_complex::{dual::DualKind, generate::torus};
@@ -181,8 +187,8 @@ fn wall_masks(complex: &Complex) -> (Vec<bool>, Vec<bool>) {
     )
 }
 
-/// The integer cocycles of a basis of H^k(K) (see the module docs for
-/// which degrees and how).
+/// The integer cocycles of a basis of H^k(K), every degree (see the module
+/// docs for how, by degree).
 pub fn cocycle_generators(complex: &Complex, k: usize) -> Result<Vec<Vec<f64>>, FormsError> {
     let n = complex.dim();
     if k > n {
@@ -230,12 +236,20 @@ pub fn cocycle_generators(complex: &Complex, k: usize) -> Result<Vec<Vec<f64>>, 
             })
             .collect());
     }
-    if k == 1 && n == 2 {
+    if k == 1 && n == 2 && is_surface(complex) {
         return tree_cotree(complex, false);
     }
-    Err(FormsError::Cohomology(format!(
-        "cohomology generators of degree {k} on a {n}-complex are not computed (degrees 0 and {n}, and 1 on 2-complexes, are)"
-    )))
+    super::reduction::cocycles(complex, k)
+}
+
+/// Whether every edge of a 2-complex bounds one or two faces (what the
+/// tree–cotree's dual graph needs).
+fn is_surface(complex: &Complex) -> bool {
+    let cofaces = complex.boundary(2);
+    (0..complex.cell_count(1)).all(|e| {
+        let count = cofaces.outer_view(e).map_or(0, |r| r.nnz());
+        (1..=2).contains(&count)
+    })
 }
 
 /// The top-cell cycles z (∂_n z = 0) of the closed orientable components:
@@ -426,7 +440,9 @@ impl Forms<'_> {
     /// least ⋆-distance, solving d_{k−1}ᵀ ⋆_k d_{k−1} α = d_{k−1}ᵀ ⋆_k ω
     /// (the canonical operator A = d_{k−1}, Ω = ⋆_k). For k = 1 the kernel
     /// (constants per component) is removed by holding α = 0 at one vertex
-    /// per component; other degrees are refused. One [`ExactPart`] per
+    /// per component; for k ≥ 2 (the kernel: every closed (k−1)-cochain)
+    /// by holding α = 0 off a set of (k−1)-cells whose columns of d_{k−1}
+    /// are a basis of its image; k = 0 is refused. One [`ExactPart`] per
     /// cochain of `omegas` (one factorisation for all).
     pub fn exact_part(&self, k: usize, omegas: &[Vec<f64>]) -> Result<Vec<ExactPart>, FormsError> {
         self.exact_part_with(k, omegas, Boundary::Natural)
@@ -443,30 +459,53 @@ impl Forms<'_> {
         boundary: Boundary,
     ) -> Result<Vec<ExactPart>, FormsError> {
         self.check(k)?;
-        if k != 1 {
-            return Err(FormsError::Cohomology(format!(
-                "the exact part is computed for 1-cochains (a Poisson solve on the vertices), not for degree {k}"
-            )));
-        }
         let complex = self.complex;
-        let (mut pinned, roots) = match boundary {
-            Boundary::Natural => (
-                vec![false; complex.cell_count(0)],
-                spanning_forest(complex).1,
-            ),
-            Boundary::Essential => {
-                let (ground, on_wall) = wall_masks(complex);
+        let pinned = match (k, boundary) {
+            (0, _) => {
+                return Err(FormsError::Cohomology(
+                    "0-cochains have no exact part (there are no (−1)-cochains)".into(),
+                ))
+            }
+            (1, Boundary::Natural) => {
+                let mut pinned = vec![false; complex.cell_count(0)];
+                spanning_forest(complex)
+                    .1
+                    .iter()
+                    .for_each(|&r| pinned[r] = true);
+                pinned
+            }
+            (1, Boundary::Essential) => {
+                let (mut ground, on_wall) = wall_masks(complex);
                 let roots = grounded_forest(complex, Some((&ground, &on_wall))).1;
-                (ground, roots)
+                roots.iter().for_each(|&r| ground[r] = true);
+                ground
+            }
+            // Degree ≥ 2: α lives on (k−1)-cells and d_{k−1} has a large
+            // kernel (all closed (k−1)-forms); holding α = 0 off a set of
+            // cells whose columns are a basis of im d_{k−1} removes it
+            // without restricting the exact part.
+            (_, Boundary::Natural) => super::reduction::exact_gauge(complex, k)?
+                .into_iter()
+                .map(|independent| !independent)
+                .collect(),
+            (_, Boundary::Essential) => {
+                return Err(FormsError::Cohomology(format!(
+                    "the relative (essential) exact part is computed for 1-cochains, not for degree {k}"
+                )))
             }
         };
-        roots.iter().for_each(|&r| pinned[r] = true);
+        if k >= 2 && self.star.is_diagonal() {
+            // A zero weight (a dual edge of length 0, e.g. inside a cube of
+            // Kuhn tetrahedra with the circumcentric dual) leaves the gauged
+            // operator singular: name the star rather than the solve.
+            self.positive_diagonal(k, None, "the harmonic projection dᵀ⋆d α = dᵀ⋆c")?;
+        }
         let split = FixedSplit::from_mask(pinned);
-        let d0 = complex.coboundary(0);
-        let restricted = split.restrict_columns(d0);
-        let star = self.star(1)?;
+        let lower = complex.coboundary(k - 1);
+        let restricted = split.restrict_columns(lower);
+        let star = self.star(k)?;
         let operator = Canonical::new(restricted.clone(), star.clone())?;
-        let load = Canonical::coupling(restricted, star, CsMat::<i8>::eye(d0.rows()))?;
+        let load = Canonical::coupling(restricted, star, CsMat::<i8>::eye(lower.rows()))?;
         let matrix = operator.assemble();
         let factor = if split.free().is_empty() {
             None
@@ -479,19 +518,30 @@ impl Forms<'_> {
         omegas
             .iter()
             .map(|omega| {
-                if omega.len() != d0.rows() {
+                if omega.len() != lower.rows() {
                     return Err(FormsError::Field(format!(
-                        "a 1-cochain needs {} values, got {}",
-                        d0.rows(),
+                        "a {k}-cochain needs {} values, got {}",
+                        lower.rows(),
                         omega.len()
                     )));
                 }
-                let free = match &factor {
+                let mut free = match &factor {
                     Some(factor) => factor.solve(&load.apply(omega))?,
                     None => Vec::new(),
                 };
+                if let Some(factor) = &factor {
+                    // One step of iterative refinement on the residual
+                    // dᵀ⋆(ω − dα) of the free cells: the equations of the
+                    // held cells are (exactly) combinations of these, so
+                    // their residual is a sum of the free ones and grows
+                    // with the mesh unless those are at rounding level.
+                    let exact = multiply(lower, &split.lift(&free, &[]));
+                    let rest: Vec<f64> = omega.iter().zip(&exact).map(|(w, e)| w - e).collect();
+                    let correction = factor.solve(&load.apply(&rest))?;
+                    free.iter_mut().zip(correction).for_each(|(a, c)| *a += c);
+                }
                 let alpha = split.lift(&free, &[]);
-                let exact = multiply(d0, &alpha);
+                let exact = multiply(lower, &alpha);
                 Ok(ExactPart {
                     potential: alpha,
                     exact,

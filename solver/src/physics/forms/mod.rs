@@ -32,6 +32,7 @@
 pub mod cohomology;
 pub mod decomposition;
 pub mod laplacian;
+mod reduction;
 pub mod whitney_map;
 
 pub use cohomology::{cocycle_generators, ExactPart, HarmonicBasis};

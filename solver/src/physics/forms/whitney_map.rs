@@ -465,11 +465,12 @@ pub fn probe(
 
 /// The vector proxy of a k-cochain (k = 1, or k = 2 on a 3-complex) per
 /// top cell: on a simplex the Whitney form at its centroid; on another
-/// cell (k = 1 only) the constant vector whose line integrals fit the
-/// cell's edge values best in least squares (the minimum-norm solution,
-/// tangent to a flat cell), which, like the Whitney form, is exact for
-/// constant fields, and on a rectangle is the lowest-order edge element's
-/// (Nédélec) value at the centre, the mean of opposite edges.
+/// cell the constant vector whose line integrals (k = 1) or fluxes
+/// (k = 2) fit the cell's edge or face values best in least squares (the
+/// minimum-norm solution, tangent to a flat cell), which, like the Whitney
+/// form, is exact for constant fields, and on a rectangle or a box is the
+/// lowest-order edge (Nédélec) or face (Raviart–Thomas) element's value at
+/// the centre, the mean of opposite edges or faces.
 pub fn cell_vectors(
     complex: &Complex,
     k: usize,
@@ -496,11 +497,7 @@ pub fn cell_vectors(
             } else if kind == ProxyKind::Tangent {
                 least_squares_vector(complex, c, cochain)
             } else {
-                Err(FormsError::NotSimplex {
-                    dim: n,
-                    cell: c,
-                    vertices: complex.cell_vertices(n, c).len(),
-                })
+                least_squares_flux(complex, c, cochain)
             }
         })
         .collect()
@@ -534,10 +531,75 @@ fn least_squares_vector(
         p[1][a] - p[0][a]
     });
     let values = DVector::from_iterator(edges.len(), edges.iter().map(|&e| cochain[e]));
-    let scale = tangents.norm().max(f64::MIN_POSITIVE);
-    let svd = tangents.svd(true, true);
+    least_squares(c, tangents, values)
+}
+
+/// The minimum-norm least-squares F of rows · F = values, with a relative
+/// rank cut that leaves out the normal of a flat cell.
+fn least_squares(
+    c: usize,
+    rows: DMatrix<f64>,
+    values: DVector<f64>,
+) -> Result<[f64; 3], FormsError> {
+    let scale = rows.norm().max(f64::MIN_POSITIVE);
+    let svd = rows.svd(true, true);
     let v = svd
         .solve(&values, 1e-12 * scale)
         .map_err(|e| FormsError::Internal(format!("least squares on cell {c}: {e}")))?;
     Ok([v[0], v[1], v[2]])
+}
+
+/// The constant field whose fluxes through the faces of 3-cell `c` fit
+/// its 2-cochain values best: the flux of F through a planar face is
+/// F · N_f, N_f = ½ Σ_e s_e (x_tail − x₀) × (x_head − x₀) the face's vector
+/// area, oriented by its boundary (s_e the sign of edge e in ∂f, tail and
+/// head from δ⁰): the right-hand rule of ∂, as for triangles.
+fn least_squares_flux(
+    complex: &Complex,
+    c: usize,
+    cochain: &[f64],
+) -> Result<[f64; 3], FormsError> {
+    let faces: Vec<usize> = complex
+        .boundary_csc(3)
+        .outer_view(c)
+        .map(|col| col.indices().to_vec())
+        .unwrap_or_default();
+    let by_face = complex.boundary_csc(2);
+    let d0 = complex.coboundary(0);
+    let mut areas = Vec::with_capacity(faces.len());
+    for &f in &faces {
+        // The face's own unwrapped frame: every edge measured in it.
+        let ids = complex.cell_vertices(2, f);
+        let points: Vec<Vector3<f64>> = complex
+            .cell_points(2, f)
+            .into_iter()
+            .map(Vector3::from)
+            .collect();
+        let at = |v: usize| -> Result<Vector3<f64>, FormsError> {
+            ids.iter()
+                .position(|&w| w == v)
+                .map(|i| points[i] - points[0])
+                .ok_or_else(|| FormsError::Internal(format!("vertex {v} not on face {f}")))
+        };
+        let mut area = Vector3::zeros();
+        if let Some(column) = by_face.outer_view(f) {
+            for (e, &s) in column.iter() {
+                let (mut tail, mut head) = (usize::MAX, usize::MAX);
+                if let Some(row) = d0.outer_view(e) {
+                    for (v, &sign) in row.iter() {
+                        if sign < 0 {
+                            tail = v;
+                        } else {
+                            head = v;
+                        }
+                    }
+                }
+                area += f64::from(s) * at(tail)?.cross(&at(head)?) / 2.0;
+            }
+        }
+        areas.push(area);
+    }
+    let rows = DMatrix::from_fn(faces.len(), 3, |r, a| areas[r][a]);
+    let values = DVector::from_iterator(faces.len(), faces.iter().map(|&f| cochain[f]));
+    least_squares(c, rows, values)
 }

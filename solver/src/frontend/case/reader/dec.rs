@@ -63,7 +63,7 @@ impl Reader {
             "degree",
             0,
             header,
-            "the degree k of the harmonic forms: 1 (one-forms) on a surface or planar mesh, or 0 or the mesh's dimension",
+            "the degree k of the harmonic forms, 0 to the mesh's dimension (1 or 2 on a 3-dimensional mesh)",
         );
         let boundary = self.choice(
             table,
