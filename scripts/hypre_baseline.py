@@ -11,8 +11,10 @@ Prints one line `RESULT case hypre key=value ...`:
   PETSc's reference norm is ‖b‖₂); residual: that ratio recomputed
   afterwards from A, x and b;
 - peak_gib: the process's peak resident memory (VmHWM), as pyamg's line,
-  reading the file included; matrix_gib: the bytes of the assembled AIJ
-  matrix alone (PETSc's own count, MatGetInfo memory), the yardstick of
+  reading the file included; matrix_gib: the bytes of the assembled matrix
+  alone in CSR (8-byte values, PETSc's column and row-start indices, both
+  triangles; MatGetInfo's `memory` reads 0 without PETSc's memory
+  logging, so the size is computed from the entries), the yardstick of
   "peak memory ≤ 1.5× the matrix's own".
 
 BoomerAMG runs with the options PETSc sets when none are given (PETSc
@@ -94,7 +96,8 @@ A = PETSc.Mat().createAIJ(size=(n, n), csr=(indptr, indices, values), comm=PETSc
 A.setOption(PETSc.Mat.Option.SPD, True)
 A.assemble()
 del indptr, indices, values
-matrix_bytes = A.getInfo()["memory"]
+index_bytes = np.dtype(PETSc.IntType).itemsize
+matrix_bytes = int(A.getInfo()["nz_used"]) * (8 + index_bytes) + (n + 1) * index_bytes
 b = A.createVecLeft()
 b.setArray(b_array)
 x = A.createVecRight()
