@@ -165,7 +165,8 @@ for case in runs:
         rows += delaunay_rows(f"{case} ({n})", r)
         continue
     mg, direct, plain, amg = (r.get(p, {}) for p in ("mg", "direct", "plain", "pyamg"))
-    n = mg.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or r.get("nd", {}).get("unknowns") or "?"
+    n = (mg.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or r.get("nd", {}).get("unknowns")
+         or r.get("sa", {}).get("unknowns") or r.get("hypre", {}).get("unknowns") or "?")
     label = f"{case} ({n})"
     assembly = num(mg, "assembly") or num(direct, "assembly")
     rows.append((label, "assembly (Ω, AᵀΩA, b)", fmt(assembly), "plain triplets", fmt(num(plain, "assembly")), ratio(assembly, num(plain, "assembly"))))
