@@ -56,6 +56,17 @@
 //! - `check`: hasse's FE and DEC matrices, load and solution against the
 //!   plain ones, entry by entry (it panics when they disagree).
 //!
+//! Unstructured 3D cases `kuhn-N` (N cubes per axis, each cut into 6
+//! Kuhn tetrahedra, interior vertices moved by up to 0.2 of the shortest
+//! edge at them, seed 1: the "perturbed Kuhn box" of the AMG tables) solve
+//! nodal P1 (u = 0 on the boundary, (N − 1)³ unknowns), phases:
+//!
+//! - `amg`: complex, FE assembly, smoothed-aggregation multigrid
+//!   (`Hierarchy::Algebraic`) and CG to relative residual 1e-8, with the
+//!   solve's own peak memory (complex dropped) as for a Delaunay case.
+//! - `export`: the system on the interior vertices for the baselines
+//!   (pyamg, hypre through petsc4py).
+//!
 //! Each child prints one line `RESULT case phase key=value …`; the parent
 //! (and `scripts/bench`) turn them into a table.
 //!
@@ -130,6 +141,9 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
     if let Some(side) = parse_delaunay(case) {
         return delaunay_phase(case, side, phase, dir);
     }
+    if let Some(n) = case.strip_prefix("kuhn-").and_then(|n| n.parse().ok()) {
+        return kuhn_phase(case, n, phase, dir);
+    }
     let (d, n) =
         parse_case(case).unwrap_or_else(|| panic!("case {case}: use 2d-N, 3d-N or delaunay-COUNT"));
     let started = Instant::now();
@@ -160,6 +174,10 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                     },
                 },
             };
+            // The complex is gone (`build` keeps the system alone): the
+            // solve's peak is the matrix, b and the hierarchy, what the
+            // baselines' processes hold.
+            let reset = reset_peak_memory();
             let (_, report, cg) = solve_with_fixed(
                 &system.matrix,
                 &system.rhs,
@@ -169,9 +187,10 @@ fn phase(case: &str, phase: &str, dir: &str) -> String {
                 Some(&settings),
             )
             .expect("MG-CG");
+            let solve_peak = if reset { peak_memory_gib() } else { f64::NAN };
             let cg = cg.expect("iterative report");
             format!(
-                "unknowns={} complex={complex_s:.3} assembly={assembly_s:.3} setup={:.3} solve={:.3} iterations={} residual={:.2e}",
+                "unknowns={} complex={complex_s:.3} assembly={assembly_s:.3} setup={:.3} solve={:.3} iterations={} residual={:.2e} solve_peak_gib={solve_peak:.3}",
                 report.unknowns, report.numeric_seconds, cg.seconds, cg.iterations, cg.relative_residual
             )
         }
@@ -425,6 +444,8 @@ const GRID_PHASES: [&str; 11] = [
     "amd",
     "nd",
 ];
+/// Every phase of a perturbed Kuhn case.
+const KUHN_PHASES: [&str; 1] = ["amg"];
 /// Every phase of a Delaunay case.
 const DELAUNAY_PHASES: [&str; 8] = [
     "check", "amg", "dec", "direct", "solve", "plain", "amd", "nd",
@@ -452,12 +473,14 @@ fn main() {
                     vec!["mg", "mg-pc", "sa"]
                 },
             ),
+            ("kuhn-80", KUHN_PHASES.to_vec()),
             ("delaunay-1m", DELAUNAY_PHASES.to_vec()),
         ]
     } else {
         vec![
             ("2d-64", GRID_PHASES.to_vec()),
             ("3d-16", GRID_PHASES.to_vec()),
+            ("kuhn-12", KUHN_PHASES.to_vec()),
             ("delaunay-20k", DELAUNAY_PHASES.to_vec()),
         ]
     };
@@ -478,6 +501,8 @@ fn main() {
                     .unwrap_or_else(|| {
                         let phases = if parse_delaunay(name).is_some() {
                             DELAUNAY_PHASES.to_vec()
+                        } else if name.starts_with("kuhn-") {
+                            KUHN_PHASES.to_vec()
                         } else {
                             GRID_PHASES.to_vec()
                         };
@@ -742,6 +767,72 @@ fn vector_difference(a: &[f64], b: &[f64]) -> f64 {
         .zip(b)
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     diff / scale
+}
+
+/// The perturbed Kuhn box of a case `kuhn-N`, with the seconds it took.
+fn kuhn_complex(n: usize) -> (Complex, f64) {
+    let t = Instant::now();
+    let axis = generate::uniform_axis(n, 0.0, 1.0).expect("axis");
+    let grid = generate::kuhn(&[axis.clone(), axis.clone(), axis]).expect("Kuhn box");
+    let complex = generate::perturb(&grid, 0.2, 1).expect("perturbed Kuhn box");
+    (complex, seconds(t))
+}
+
+fn kuhn_phase(case: &str, n: usize, phase: &str, dir: &str) -> String {
+    let started = Instant::now();
+    let (complex, complex_s) = kuhn_complex(n);
+    let counts = format!(
+        "vertices={} tetrahedra={} complex={complex_s:.3}",
+        complex.cell_count(0),
+        complex.cell_count(3)
+    );
+    let system = nodal_problem(Method::Fe)
+        .assemble(&complex)
+        .expect("assembly");
+    let fields = match phase {
+        "amg" => {
+            // The baselines hold the matrix alone: the solve's own peak is
+            // read with the complex gone, as in a Delaunay case.
+            drop(complex);
+            let build_peak = peak_memory_gib();
+            let reset = reset_peak_memory();
+            let (_, report, cg) = solve_with_fixed(
+                &system.matrix,
+                &system.rhs,
+                &system.fixed,
+                Factorization::Llt,
+                Ordering::Automatic,
+                Some(&algebraic_cg()),
+            )
+            .expect("AMG-CG");
+            let solve_peak = if reset { peak_memory_gib() } else { f64::NAN };
+            let cg = cg.expect("iterative report");
+            assert!(cg.relative_residual <= 1e-8, "AMG-CG residual {cg:?}");
+            format!(
+                "{counts} unknowns={} nnz={} assembly={:.3} setup={:.3} solve={:.3} iterations={} residual={:.2e} build_peak_gib={build_peak:.3} solve_peak_gib={solve_peak:.3}",
+                report.unknowns,
+                report.nonzeros,
+                system.assembly_seconds,
+                report.numeric_seconds,
+                cg.seconds,
+                cg.iterations,
+                cg.relative_residual
+            )
+        }
+        "export" => {
+            let (matrix, rhs) = free_block(&system);
+            let path = format!("{dir}/{case}");
+            write_matrix_market(&format!("{path}.mtx"), &matrix).expect("write matrix");
+            write_vector_market(&format!("{path}.rhs.mtx"), &rhs).expect("write rhs");
+            format!("{counts} file={path}.mtx")
+        }
+        other => panic!("unknown phase {other}: amg or export"),
+    };
+    format!(
+        "RESULT {case} {phase} {fields} total={:.3} peak_gib={:.3}",
+        seconds(started),
+        peak_memory_gib()
+    )
 }
 
 fn delaunay_phase(case: &str, side: usize, phase: &str, dir: &str) -> String {

@@ -1,10 +1,14 @@
-"""Turn the `RESULT case phase key=value ...` lines of benches/multigrid.rs
-and scripts/pyamg_baseline.py (stdin) into one table: hasse next to its
-baseline, with the ratio hasse / baseline (below 1: hasse is faster or
-smaller). Structured cases (phases mg, mg-pc, sa, direct, solve, plain, q1-solve,
-q1-assembly, q1-plain, amd, nd) and
-Delaunay cases (phases amg, dec, direct, plain, amd, nd, check) get their own
-rows; a failed phase shows as — in its rows."""
+"""Turn the `RESULT case phase key=value ...` lines of benches/multigrid.rs,
+scripts/pyamg_baseline.py (phase pyamg) and scripts/hypre_baseline.py
+(phase hypre: BoomerAMG-CG through petsc4py, one rank) on stdin into one
+table: hasse next to its baseline, with the ratio hasse / baseline (below
+1: hasse is faster or smaller). Structured cases (phases mg, mg-pc, sa,
+direct, solve, plain, q1-solve, q1-assembly, q1-plain, amd, nd), perturbed
+Kuhn cases (phase amg) and Delaunay cases (phases amg, dec, direct, plain,
+amd, nd, check) get their own rows; a failed phase shows as — in its rows.
+The AMG rows ("AMG against hypre") compare smoothed aggregation with both
+baselines and its peak memory with the matrix's own (PETSc's count of the
+assembled AIJ matrix, `matrix_gib` of the hypre line)."""
 import sys
 from collections import defaultdict
 
@@ -28,7 +32,8 @@ def num(d, k):
 
 
 def fmt(v, unit="s"):
-    return "—" if v is None else f"{v:.2f} {unit}"
+    # Three decimals for memory: a 10⁶-unknown matrix is under 0.1 GiB.
+    return "—" if v is None else (f"{v:.3f} {unit}" if unit == "GiB" else f"{v:.2f} {unit}")
 
 
 def ratio(a, b):
@@ -91,6 +96,7 @@ def delaunay_rows(label, r):
         out.append((label, f"{name} SA-AMG setup + CG to 1e-8 ({it(run)})", fmt(total), f"pyamg SA-CG ({it(amg)})", fmt(amg_total), ratio(total, amg_total)))
     out.append((label, "  AMG setup alone (FE)", fmt(num(fe, "setup")), "pyamg setup", fmt(num(amg, "setup")), ratio(num(fe, "setup"), num(amg, "setup"))))
     out.append((label, "  CG iterations alone (FE)", fmt(num(fe, "solve")), "pyamg solve", fmt(num(amg, "solve")), ratio(num(fe, "solve"), num(amg, "solve"))))
+    out += [row for row in amg_rows(label, fe, {"hypre": r.get("hypre", {})}, "FE SA-AMG")]
     # The solve-alone peaks are read with the complex dropped (the process
     # holds M and b as pyamg's does); the whole-run peaks include the complex.
     for what, key in (("AMG-CG (FE) alone", "solve_peak_gib"), ("whole FE AMG run", "peak_gib")):
@@ -111,16 +117,56 @@ def delaunay_rows(label, r):
     return out + ordering_rows(label, r)
 
 
+def amg_rows(label, run, r, what):
+    """Smoothed-aggregation AMG-CG (`run`: phase sa or amg) against hypre
+    BoomerAMG-CG and pyamg on the same matrix, and its solve's peak memory
+    against the matrix's own."""
+    hypre, pyamg = r.get("hypre", {}), r.get("pyamg", {})
+    if not hypre and not pyamg:
+        return []
+    total = add(num(run, "setup"), num(run, "solve"))
+    out = []
+    for name, base in (("hypre BoomerAMG-CG, 1 rank", hypre), ("pyamg SA-CG", pyamg)):
+        if base:
+            base_total = add(num(base, "setup"), num(base, "solve"))
+            out.append((label, f"{what} setup + CG to 1e-8 ({it(run)})", fmt(total), f"{name} ({it(base)})", fmt(base_total), ratio(total, base_total)))
+            out.append((label, "  AMG setup alone", fmt(num(run, "setup")), f"{name.split(',')[0].split(' SA')[0]} setup", fmt(num(base, "setup")), ratio(num(run, "setup"), num(base, "setup"))))
+            out.append((label, "  CG alone", fmt(num(run, "solve")), f"{name.split(',')[0].split(' SA')[0]} solve", fmt(num(base, "solve")), ratio(num(run, "solve"), num(base, "solve"))))
+    peak = num(run, "solve_peak_gib")
+    if hypre:
+        out.append((label, "  peak memory, AMG setup + CG (matrix held)", fmt(peak, "GiB"), "the matrix alone (PETSc AIJ)", fmt(num(hypre, "matrix_gib"), "GiB"), ratio(peak, num(hypre, "matrix_gib"))))
+        out.append((label, "  same", fmt(peak, "GiB"), "hypre process (file read included)", fmt(num(hypre, "peak_gib"), "GiB"), ratio(peak, num(hypre, "peak_gib"))))
+    return out
+
+
+def kuhn_rows(label, r):
+    """Nodal P1 on the perturbed Kuhn box: complex, assembly, and AMG-CG
+    against hypre and pyamg."""
+    fe = r.get("amg", {})
+    out = [(label, f"complex: kuhn + perturb ({fe.get('tetrahedra', '?')} tetrahedra)", fmt(num(fe, "complex")), "—", "—", "—"),
+           (label, "FE assembly (Ω, AᵀΩA, b)", fmt(num(fe, "assembly")), "—", "—", "—")]
+    return out + amg_rows(label, fe, r, "P1 SA-AMG")
+
+
+def mg_total_of(mg):
+    return add(num(mg, "setup"), num(mg, "solve"))
+
+
 rows = []
 for case in runs:
     r = runs[case]
+    if case.startswith("kuhn-"):
+        n = r.get("amg", {}).get("unknowns") or r.get("hypre", {}).get("unknowns") or "?"
+        rows += kuhn_rows(f"{case} ({n})", r)
+        continue
     if "amg" in r or "check" in r:
         fe, direct, plain = (r.get(p, {}) for p in ("amg", "direct", "plain"))
         n = fe.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or "?"
         rows += delaunay_rows(f"{case} ({n})", r)
         continue
     mg, direct, plain, amg = (r.get(p, {}) for p in ("mg", "direct", "plain", "pyamg"))
-    n = mg.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or r.get("nd", {}).get("unknowns") or "?"
+    n = (mg.get("unknowns") or direct.get("unknowns") or plain.get("unknowns") or r.get("nd", {}).get("unknowns")
+         or r.get("sa", {}).get("unknowns") or r.get("hypre", {}).get("unknowns") or "?")
     label = f"{case} ({n})"
     assembly = num(mg, "assembly") or num(direct, "assembly")
     rows.append((label, "assembly (Ω, AᵀΩA, b)", fmt(assembly), "plain triplets", fmt(num(plain, "assembly")), ratio(assembly, num(plain, "assembly"))))
@@ -152,6 +198,11 @@ for case in runs:
         sa_total = None if num(sa, "setup") is None else num(sa, "setup") + num(sa, "solve")
         rows.append((label, f"  AMG (smoothed aggregation, matrix alone) setup + CG ({sa.get('iterations', '?')} it)", fmt(sa_total), "pyamg SA-CG", fmt(amg_total), ratio(sa_total, amg_total)))
         rows.append((label, "    AMG setup alone", fmt(num(sa, "setup")), "pyamg setup", fmt(num(amg, "setup")), ratio(num(sa, "setup"), num(amg, "setup"))))
+        rows += amg_rows(label, sa, {"hypre": r.get("hypre", {})}, "AMG (sa)")
+    hypre = r.get("hypre", {})
+    if hypre and mg:
+        hypre_total = add(num(hypre, "setup"), num(hypre, "solve"))
+        rows.append((label, f"MG setup + CG to 1e-8 ({mg.get('iterations', '?')} it)", fmt(mg_total_of(mg)), f"hypre BoomerAMG-CG ({it(hypre)})", fmt(hypre_total), ratio(mg_total_of(mg), hypre_total)))
     pc = r.get("mg-pc", {})
     pc_total = None if num(pc, "setup") is None else num(pc, "setup") + num(pc, "solve")
     rows.append((label, f"  same, constant P, correction 2 ({pc.get('iterations', '?')} it)", fmt(pc_total), f"pyamg SA-CG", fmt(amg_total), ratio(pc_total, amg_total)))

@@ -24,6 +24,53 @@ pub(super) fn smooth_prolongation(
     Ok(matrix.smoothed(p, &scale))
 }
 
+/// Which off-diagonal entries of a row are strong couplings, in terms of
+/// the scaled coupling s_ij = |a_ij| / √|a_ii a_jj|.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Strength {
+    /// s_ij ≥ θ: Vaněk, Mandel and Brezina's measure, for the finest
+    /// level, whose rows are the discretisation's own stencils.
+    Absolute(f64),
+    /// s_ij ≥ θ · max_k s_ik (k ≠ i): each row against its own strongest
+    /// coupling, as classical AMG measures strength (hypre's default
+    /// threshold is 0.25), for Galerkin levels whose rows spread over many
+    /// neighbours; see [`level_strength`](super::cycle::level_strength).
+    Relative(f64),
+}
+
+/// The strong neighbours of every row (without the row itself and without
+/// zero entries). Under [`Strength::Relative`] the relation need not be
+/// symmetric; the aggregation passes read it row by row and do not need it
+/// to be.
+pub(super) fn strong_neighbours(matrix: &RowMatrix, strength: Strength) -> Vec<Vec<u32>> {
+    let diagonal = matrix.diagonal();
+    // Squared scaled couplings: s_ij² = a_ij² / |a_ii a_jj|, no square root.
+    let scaled = |i: usize, j: u32, a: f64| a * a / (diagonal[i] * diagonal[j as usize]).abs();
+    (0..matrix.nrows())
+        .into_par_iter()
+        .with_min_len(ROW_CHUNK)
+        .map(|i| {
+            let (c, v) = matrix.row(i);
+            let threshold2 = match strength {
+                Strength::Absolute(theta) => theta * theta,
+                Strength::Relative(theta) => {
+                    let largest = c
+                        .iter()
+                        .zip(v)
+                        .filter(|(&j, _)| j as usize != i)
+                        .fold(0.0f64, |m, (&j, &a)| m.max(scaled(i, j, a)));
+                    theta * theta * largest
+                }
+            };
+            c.iter()
+                .zip(v)
+                .filter(|(&j, &a)| j as usize != i && a != 0.0 && scaled(i, j, a) >= threshold2)
+                .map(|(&j, _)| j)
+                .collect()
+        })
+        .collect()
+}
+
 /// The tentative prolongation of smoothed aggregation and the coarse
 /// near-null vector: aggregates of strongly connected unknowns (standard
 /// greedy aggregation in three passes), one column per aggregate J holding
@@ -46,28 +93,11 @@ pub(super) fn smooth_prolongation(
 /// `None` when no two unknowns aggregate.
 pub(super) fn aggregate(
     matrix: &RowMatrix,
-    strength: f64,
+    strength: Strength,
     candidate: &[f64],
 ) -> Result<Option<(RowMatrix, Vec<f64>)>, MultigridError> {
     let n = matrix.nrows();
-    let diagonal = matrix.diagonal();
-    let theta2 = strength * strength;
-    let strong: Vec<Vec<u32>> = (0..n)
-        .into_par_iter()
-        .with_min_len(ROW_CHUNK)
-        .map(|i| {
-            let (c, v) = matrix.row(i);
-            c.iter()
-                .zip(v)
-                .filter(|(&j, &a)| {
-                    j as usize != i
-                        && a != 0.0
-                        && a * a >= theta2 * (diagonal[i] * diagonal[j as usize]).abs()
-                })
-                .map(|(&j, _)| j)
-                .collect()
-        })
-        .collect();
+    let strong = strong_neighbours(matrix, strength);
     const NONE: usize = usize::MAX;
     let mut agg = vec![NONE; n];
     let mut count = 0usize;

@@ -2,7 +2,7 @@
 //! smoothing, the factorised coarsest level, and the cycle as a
 //! preconditioner of conjugate gradients.
 
-use super::aggregation::{aggregate, smooth_prolongation};
+use super::aggregation::{aggregate, smooth_prolongation, Strength};
 use super::transfer::{Prolongation, Transfer};
 use super::{check_options, CellProlongation, MultigridError, MultigridOptions, Smoother};
 use crate::la::iterative::{
@@ -240,8 +240,15 @@ fn largest_ritz(alphas: &[f64], betas: &[f64]) -> f64 {
         .fold(0.0f64, |m, &v| m.max(v))
 }
 
-/// The strength threshold of `level` (0 the finest): θ·2^(−level), the
-/// rule of Vaněk, Mandel and Brezina's smoothed aggregation.
+/// Row-relative threshold of the Galerkin levels ([`Strength::Relative`]):
+/// hypre BoomerAMG's default strong threshold, the same test on the
+/// scaled couplings.
+pub(super) const COARSE_STRENGTH: f64 = 0.25;
+
+/// The strength measure of `level` (0 the finest): the absolute threshold
+/// θ = `strength` on the finest level, and on the Galerkin levels below it
+/// each row measured against its own strongest coupling,
+/// [`COARSE_STRENGTH`].
 ///
 /// A fixed θ stops the coarsening after one level in 3D. The scaled
 /// coupling |a_ij|/√(a_ii a_jj) is 1/6 for every neighbour of the 7-point
@@ -252,12 +259,30 @@ fn largest_ritz(alphas: &[f64], betas: &[f64]) -> f64 {
 /// neighbour, became singletons, coarsening stalled, and the whole
 /// level 1 (1/8 of the unknowns, 30 entries per row) went to the sparse
 /// LLᵀ meant for ≤ `coarse_size` unknowns: 82 s and 4.4 GiB of setup at
-/// 100³. Halving θ per level follows the halving of the couplings as the
-/// stencils widen; θ = 0.04 on level 1 keeps the strongest 40 % or so of
-/// its couplings and coarsens it eightfold.
-pub(super) fn level_strength(strength: f64, level: usize) -> f64 {
-    // 2^(−level) underflows only past level 1074; max_levels is far below.
-    strength * 0.5f64.powi(level.min(1074) as i32)
+/// 100³.
+///
+/// Halving θ per level (Vaněk, Mandel and Brezina's θ·2^(−l), the rule
+/// before this one) fixed the stall but not the counts: the couplings of
+/// a Galerkin row do not shrink by a fixed factor per level, so on the
+/// 100³ box θ = 0.02 turned level 2 (10 677 unknowns, 105 entries per row)
+/// into 261 aggregates of 40 and CG took 13 iterations against 8 at 20³;
+/// every coupling strong below the finest level (θ = 0) held the 3D FV
+/// counts at 10–11 but made 2D Delaunay P1 (16/20/23) and Kuhn P1
+/// 48³/80³ (15/17) worse. Measuring each row against its own strongest
+/// coupling follows whatever spread the Galerkin product gives: FV box
+/// 20³/40³/64³/100³ in 8/9/9/11 iterations (θ halving: 8/9/9/13), Kuhn P1
+/// 24³/48³/80³ in 9/10/11 (9/10/11), jittered Delaunay P1 with 1.6·10⁴ /
+/// 2.5·10⁵ / 10⁶ triangles in 11/12/13 (11/12/13)
+/// (`cargo bench --bench multigrid -- CASE sa|amg`, benches/README.md).
+/// The finest level keeps the absolute θ: its stencils are the
+/// discretisation's own, and there the row-relative test would call the
+/// weak couplings of a jittered Delaunay row strong.
+pub(super) fn level_strength(strength: f64, level: usize) -> Strength {
+    if level == 0 {
+        Strength::Absolute(strength)
+    } else {
+        Strength::Relative(COARSE_STRENGTH)
+    }
 }
 
 impl Multigrid {

@@ -139,10 +139,12 @@ pub struct MultigridOptions {
     pub coarse_size: usize,
     /// At most this many levels, the coarsest included.
     pub max_levels: usize,
-    /// Strength of connection θ of the algebraic levels: on level l (0 the
-    /// finest) j is a strong neighbour of i when
-    /// a_ij² ≥ (θ 2^(−l))² |a_ii a_jj|, the threshold halved per level
-    /// because the coarse operators spread each row over more neighbours.
+    /// Strength of connection θ of the finest algebraic level: j is a
+    /// strong neighbour of i when a_ij² ≥ θ² |a_ii a_jj|. On the Galerkin
+    /// levels below it, whose rows spread over many more neighbours, j is
+    /// strong when its scaled coupling |a_ij|/√|a_ii a_jj| is at least a
+    /// quarter of the row's strongest (the classical, row-relative test
+    /// with hypre's default threshold 0.25).
     pub strength: f64,
     /// How cell-centred prolongations of a geometric hierarchy are used.
     pub cell_prolongation: CellProlongation,

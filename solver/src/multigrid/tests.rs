@@ -289,6 +289,40 @@ fn aggregation_coarsens_every_level_of_a_3d_seven_point_stencil() -> TestResult 
 }
 
 #[test]
+fn strength_is_absolute_on_the_finest_level_and_row_relative_below() -> TestResult {
+    use super::aggregation::{strong_neighbours, Strength};
+    use super::cycle::{level_strength, COARSE_STRENGTH};
+    // Row 0 has diagonal 4 and couplings −2, −0.6, −0.4 to unknowns of
+    // diagonal 4: scaled couplings |a_0j|/√(4·4) = 0.5, 0.15, 0.1 (by hand).
+    // Absolute θ = 0.08: all three are strong. Row-relative 0.25: the
+    // threshold is 0.25 · 0.5 = 0.125, so 0.5 and 0.15 are strong and 0.1
+    // is not. Row 3 (diagonal 4, one coupling −0.4 to row 0): its only
+    // coupling is its strongest, so it is strong under the relative test
+    // although 0.1 is weak for row 0: the relation is not symmetric.
+    let m = RowMatrix::from_rows(
+        4,
+        vec![
+            vec![(0, 4.0), (1, -2.0), (2, -0.6), (3, -0.4)],
+            vec![(0, -2.0), (1, 4.0)],
+            vec![(0, -0.6), (2, 4.0)],
+            vec![(0, -0.4), (3, 4.0)],
+        ],
+    )?;
+    assert_eq!(level_strength(0.08, 0), Strength::Absolute(0.08));
+    assert_eq!(level_strength(0.08, 3), Strength::Relative(0.25));
+    let absolute = strong_neighbours(&m, Strength::Absolute(0.08));
+    assert_eq!(absolute[0], vec![1, 2, 3]);
+    // θ = 0.12: 0.1 falls below it, 0.15 stays above.
+    assert_eq!(
+        strong_neighbours(&m, Strength::Absolute(0.12))[0],
+        vec![1, 2]
+    );
+    let relative = strong_neighbours(&m, Strength::Relative(COARSE_STRENGTH));
+    assert_eq!(relative, vec![vec![1, 2], vec![0], vec![0], vec![0]]);
+    Ok(())
+}
+
+#[test]
 fn the_coarse_operators_of_a_neumann_laplacian_keep_its_kernel() -> TestResult {
     use super::aggregation::{aggregate, smooth_prolongation};
     use super::cycle::level_strength;
