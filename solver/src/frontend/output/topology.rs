@@ -424,12 +424,11 @@ impl<'a> Columns<'a> {
         }
         s.starts.push(s.cycles.len());
         let cycle = |k: usize| &s.cycles[s.starts[k]..s.starts[k + 1]];
-        if vertices.len() == 8 && faces.len() == 6 && s.cycles.len() == 24 {
-            if (0..6).all(|k| cycle(k).len() == 4) {
-                if let Some(hex) = hexahedron(complex, &s.cycles) {
-                    out.push(c, &Element::Hexahedron(hex));
-                    return Ok(());
-                }
+        let quads = faces.len() == 6 && (0..6).all(|k| cycle(k).len() == 4);
+        if vertices.len() == 8 && quads {
+            if let Some(hex) = hexahedron(complex, &s.cycles) {
+                out.push(c, &Element::Hexahedron(hex));
+                return Ok(());
             }
         }
         // A convex polyhedron is the union of the cones from one of its vertices
