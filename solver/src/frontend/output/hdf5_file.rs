@@ -211,20 +211,39 @@ pub(crate) fn write(
     grids: &[Vec<GridTopology>],
     written_at: &str,
 ) -> Result<(), OutputError> {
-    let file = hdf5::File::create(path).at(path)?;
-    let w = Writer::new(path, COMPRESSION);
-    write_contents(&w, &file, levels, grids, written_at)?;
-    file.flush().at(path)?;
-    file.close().at(path)
+    let degrees: Vec<usize> = grids
+        .first()
+        .map(|g| g.iter().map(|grid| grid.degree).collect())
+        .unwrap_or_default();
+    write_while(path, levels, &degrees, || Ok(grids), written_at).map(|_| ())
 }
 
-fn write_contents(
+/// [`write`], with the grids (of the cells of `degrees` on every mesh)
+/// given by `grids`, called only once everything else but the provenance
+/// is written: the caller builds them meanwhile. Returns them.
+pub(crate) fn write_while<G: AsRef<[Vec<GridTopology>]>>(
+    path: &Path,
+    levels: &Levels,
+    degrees: &[usize],
+    grids: impl FnOnce() -> Result<G, OutputError>,
+    written_at: &str,
+) -> Result<G, OutputError> {
+    let file = hdf5::File::create(path).at(path)?;
+    let w = Writer::new(path, COMPRESSION);
+    let grids = write_contents(&w, &file, levels, degrees, grids, written_at)?;
+    file.flush().at(path)?;
+    file.close().at(path)?;
+    Ok(grids)
+}
+
+fn write_contents<G: AsRef<[Vec<GridTopology>]>>(
     w: &Writer,
     root: &Group,
     levels: &Levels,
-    grids: &[Vec<GridTopology>],
+    degrees: &[usize],
+    grids: impl FnOnce() -> Result<G, OutputError>,
     written_at: &str,
-) -> Result<(), OutputError> {
+) -> Result<G, OutputError> {
     let times: Vec<f64> = levels.steps.iter().map(|s| s.time).collect();
     w.string_attr(root, "format", "hasse-output")?;
     let version = if levels.mesh_changes {
@@ -243,8 +262,11 @@ fn write_contents(
         write_step(w, &steps, k, step)?;
     }
 
-    for (mesh, grids) in levels.meshes.iter().zip(grids) {
-        write_mesh(w, &w.group(root, &mesh.group)?, levels, mesh, grids)?;
+    for mesh in &levels.meshes {
+        write_mesh(w, &w.group(root, &mesh.group)?, levels, mesh, degrees)?;
+    }
+    let grids = grids()?;
+    for (mesh, grids) in levels.meshes.iter().zip(grids.as_ref()) {
         write_xdmf_arrays(w, &w.group(root, &mesh.xdmf_group)?, levels, mesh, grids)?;
     }
 
@@ -258,7 +280,8 @@ fn write_contents(
     if let Some(text) = &p.case_text {
         w.string_dataset(&prov, "case_text", text)?;
     }
-    w.string_dataset(&prov, "report", &p.report.to_string())
+    w.string_dataset(&prov, "report", &p.report.to_string())?;
+    Ok(grids)
 }
 
 /// Level `k` into group `steps/<k>`: attr `time`, one dataset per cochain.
@@ -343,13 +366,14 @@ fn write_expanded(
 /// `dim`, `embedding_dim` and `complex` (the layout's name), `vertices`,
 /// `cells/<p>`, `tags/<name>`; with [`ComplexLayout::Full`] `cells/<p>`
 /// for every p and `boundary/<p>`, otherwise `cells/<p>` only for the top
-/// cells and the degrees of the cochains and XDMF grids on this mesh.
+/// cells and the degrees of the cochains and XDMF grids (`degrees`) on
+/// this mesh.
 fn write_mesh(
     w: &Writer,
     group: &Group,
     levels: &Levels,
     mesh: &MeshAt,
-    grids: &[GridTopology],
+    degrees: &[usize],
 ) -> Result<(), OutputError> {
     let complex = mesh.complex;
     let n = complex.dim();
@@ -369,8 +393,8 @@ fn write_mesh(
     let full = levels.layout == ComplexLayout::Full;
     let mut needed = vec![false; n + 1];
     needed[n] = true;
-    for grid in grids {
-        needed[grid.degree] = true;
+    for &p in degrees {
+        needed[p] = true;
     }
     for &k in &mesh.steps {
         for c in levels.steps[k].cochains {

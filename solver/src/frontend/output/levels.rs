@@ -13,7 +13,6 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
     validate(levels)?;
     let (dir, file_name) = split_stem(stem)?;
     let degrees = xdmf::degrees(levels);
-    let grids = xdmf::grids(levels, &degrees)?;
 
     create_dir(&dir)?;
     let h5_name = format!("{file_name}.h5");
@@ -33,7 +32,7 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
                 let grid = (i > 0).then(|| xdmf::grid_name(p, n));
                 let path = dir.join(level_file_name(&file_name, k, grid));
                 of_level.push(path.clone());
-                documents.push((path, xdmf::level_document(levels, &grids, i, k, &files)));
+                documents.push((path, Document::Level { grid: i, level: k }));
             }
             level_files.push(of_level);
         }
@@ -44,15 +43,12 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
     for (i, &p) in degrees.iter().enumerate().skip(1) {
         let path = dir.join(format!("{file_name}.{}.xdmf", xdmf::grid_name(p, n)));
         extra_xdmf.push(path.clone());
-        documents.push((path, xdmf::document(levels, &grids, i, &files)));
+        documents.push((path, Document::Series { grid: i }));
     }
     // Rename order: the h5 first, because no xdmf may point at a file that
     // is not there; the main xdmf last, because it is the one users open,
     // so once it appears the whole output is in place.
-    documents.push((
-        final_xdmf.clone(),
-        xdmf::document(levels, &grids, 0, &files),
-    ));
+    documents.push((final_xdmf.clone(), Document::Series { grid: 0 }));
 
     let tag = temporary_tag();
     let mut finals = vec![final_h5.clone()];
@@ -70,9 +66,26 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
     known.extend(earlier_levels.iter().cloned());
     remove_orphaned_temporaries(&dir, &known);
 
-    hdf5_file::write(&temps.0[0], levels, &grids, &rfc3339_now())?;
-    for (path, (_, text)) in temps.0[1..].iter().zip(&documents) {
-        write_text(path, text)?;
+    // The grids' reader vertex orders (at 10⁶ cells, the output's largest
+    // computation) are built on the other cores while this thread writes
+    // the fields and the complex, which do not need them, to the h5 file.
+    let grids = std::thread::scope(|scope| {
+        let builder = scope.spawn(|| xdmf::grids(levels, &degrees));
+        let built = || {
+            builder
+                .join()
+                .unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+        };
+        hdf5_file::write_while(&temps.0[0], levels, &degrees, built, &rfc3339_now())
+    })?;
+    for (path, (_, document)) in temps.0[1..].iter().zip(&documents) {
+        let text = match *document {
+            Document::Level { grid, level } => {
+                xdmf::level_document(levels, &grids, grid, level, &files)
+            }
+            Document::Series { grid } => xdmf::document(levels, &grids, grid, &files),
+        };
+        write_text(path, &text)?;
     }
 
     // Contents reach the disk before the names do, so a crash right after
@@ -102,6 +115,13 @@ pub(super) fn write_levels(stem: &Path, levels: &Levels) -> Result<OutputFiles, 
         extra_xdmf,
         levels: level_files,
     })
+}
+
+/// Which XDMF document a file holds: that of the grid of degree
+/// `degrees[grid]` over the whole series, or for one level alone.
+enum Document {
+    Series { grid: usize },
+    Level { grid: usize, level: usize },
 }
 
 /// `<stem>.level-<k>.xdmf`, or `<stem>.level-<k>.<grid>.xdmf` for a lower

@@ -11,6 +11,8 @@
 use super::OutputError;
 use hasse_complex::Complex;
 use nalgebra::Vector3;
+use rayon::prelude::*;
+use sprs::{CsMat, CsVecView};
 use std::collections::HashMap;
 
 /// XDMF topology type codes used in `Mixed` connectivity arrays.
@@ -21,6 +23,42 @@ pub(crate) mod code {
     pub const QUADRILATERAL: i64 = 5;
     pub const TETRAHEDRON: i64 = 6;
     pub const HEXAHEDRON: i64 = 9;
+}
+
+/// The element types a grid can have as its one XDMF type (a grid of
+/// polygons is always `Mixed`: each polygon carries its vertex count).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Kind {
+    Line,
+    Triangle,
+    Quadrilateral,
+    Tetrahedron,
+    Hexahedron,
+}
+
+impl Kind {
+    /// XDMF name and node count of a grid whose elements all have this kind.
+    fn uniform_type(self) -> (&'static str, usize) {
+        match self {
+            Kind::Line => ("Polyline", 2),
+            Kind::Triangle => ("Triangle", 3),
+            Kind::Quadrilateral => ("Quadrilateral", 4),
+            Kind::Tetrahedron => ("Tetrahedron", 4),
+            Kind::Hexahedron => ("Hexahedron", 8),
+        }
+    }
+
+    /// What precedes an element's vertices in an XDMF `Mixed` array: its
+    /// code, and for a polyline its node count.
+    fn mixed_header(self) -> &'static [i64] {
+        match self {
+            Kind::Line => &[code::POLYLINE, 2],
+            Kind::Triangle => &[code::TRIANGLE],
+            Kind::Quadrilateral => &[code::QUADRILATERAL],
+            Kind::Tetrahedron => &[code::TETRAHEDRON],
+            Kind::Hexahedron => &[code::HEXAHEDRON],
+        }
+    }
 }
 
 /// One element of a grid, vertices in reader order.
@@ -46,32 +84,24 @@ impl Element {
         }
     }
 
-    /// XDMF name and node count when every element of a grid has this kind.
-    fn uniform_type(&self) -> Option<(&'static str, usize)> {
+    /// Its kind, `None` for a polygon (which has no uniform XDMF type).
+    fn kind(&self) -> Option<Kind> {
         match self {
-            Element::Line(_) => Some(("Polyline", 2)),
-            Element::Triangle(_) => Some(("Triangle", 3)),
-            Element::Quadrilateral(_) => Some(("Quadrilateral", 4)),
+            Element::Line(_) => Some(Kind::Line),
+            Element::Triangle(_) => Some(Kind::Triangle),
+            Element::Quadrilateral(_) => Some(Kind::Quadrilateral),
             Element::Polygon(_) => None,
-            Element::Tetrahedron(_) => Some(("Tetrahedron", 4)),
-            Element::Hexahedron(_) => Some(("Hexahedron", 8)),
+            Element::Tetrahedron(_) => Some(Kind::Tetrahedron),
+            Element::Hexahedron(_) => Some(Kind::Hexahedron),
         }
-    }
-
-    fn same_kind(&self, other: &Element) -> bool {
-        std::mem::discriminant(self) == std::mem::discriminant(other)
     }
 
     /// Append this element to an XDMF `Mixed` array: code, (count,) vertices.
     fn push_mixed(&self, out: &mut Vec<i64>) {
         let v = self.vertices();
-        match self {
-            Element::Line(_) => out.extend([code::POLYLINE, 2]),
-            Element::Polygon(_) => out.extend([code::POLYGON, v.len() as i64]),
-            Element::Triangle(_) => out.push(code::TRIANGLE),
-            Element::Quadrilateral(_) => out.push(code::QUADRILATERAL),
-            Element::Tetrahedron(_) => out.push(code::TETRAHEDRON),
-            Element::Hexahedron(_) => out.push(code::HEXAHEDRON),
+        match self.kind() {
+            Some(kind) => out.extend_from_slice(kind.mixed_header()),
+            None => out.extend([code::POLYGON, v.len() as i64]),
         }
         out.extend(v.iter().map(|&x| x as i64));
     }
@@ -93,29 +123,93 @@ pub(crate) struct GridTopology {
 }
 
 impl GridTopology {
-    fn from_elements(degree: usize, elements: Vec<(usize, Element)>) -> Self {
-        let uniform = match elements.first() {
-            Some((_, first)) if elements.iter().all(|(_, e)| e.same_kind(first)) => {
-                first.uniform_type()
-            }
+    /// The grid of the elements of `runs`, consecutive runs of cells in
+    /// increasing order: uniform when every element has the same kind.
+    fn from_runs(degree: usize, mut runs: Vec<Elements>) -> Self {
+        let mut kinds =
+            runs.iter()
+                .filter(|r| !r.cells.is_empty())
+                .map(|r| if r.mixed { None } else { r.kind });
+        let kind = match kinds.next() {
+            Some(Some(first)) if kinds.all(|k| k == Some(first)) => Some(first),
             _ => None,
         };
-        let mut connectivity = Vec::new();
-        for (_, e) in &elements {
-            match uniform {
-                Some(_) => connectivity.extend(e.vertices().iter().map(|&x| x as i64)),
-                None => e.push_mixed(&mut connectivity),
+        if kind.is_none() {
+            for run in &mut runs {
+                run.make_mixed();
             }
         }
-        let identity = elements.iter().enumerate().all(|(k, (cell, _))| k == *cell);
-        let cell_ids = (!identity).then(|| elements.iter().map(|(c, _)| *c as u64).collect());
+        let element_count = runs.iter().map(|r| r.cells.len()).sum();
+        let identity = runs
+            .iter()
+            .flat_map(|r| &r.cells)
+            .enumerate()
+            .all(|(k, &cell)| k as u64 == cell);
+        let cell_ids =
+            (!identity).then(|| runs.iter().flat_map(|r| r.cells.iter().copied()).collect());
+        let mut connectivity = Vec::with_capacity(runs.iter().map(|r| r.connectivity.len()).sum());
+        for run in runs {
+            connectivity.extend_from_slice(&run.connectivity);
+        }
         GridTopology {
             degree,
-            uniform,
+            uniform: kind.map(Kind::uniform_type),
             connectivity,
-            element_count: elements.len(),
+            element_count,
             cell_ids,
         }
+    }
+}
+
+/// The elements of a run of consecutive cells, as one task builds them:
+/// a uniform array while every element has one kind, a `Mixed` one after.
+#[derive(Default)]
+struct Elements {
+    /// The kind of every element so far, while not `mixed`; `None` while empty.
+    kind: Option<Kind>,
+    /// Whether `connectivity` is an XDMF `Mixed` array.
+    mixed: bool,
+    connectivity: Vec<i64>,
+    /// The cell of each element.
+    cells: Vec<u64>,
+}
+
+impl Elements {
+    fn push(&mut self, cell: usize, element: &Element) {
+        if !self.mixed {
+            match (self.kind, element.kind()) {
+                (None, Some(kind)) if self.cells.is_empty() => self.kind = Some(kind),
+                (Some(kind), Some(other)) if kind == other => {}
+                _ => self.make_mixed(),
+            }
+        }
+        self.cells.push(cell as u64);
+        if self.mixed {
+            element.push_mixed(&mut self.connectivity);
+        } else {
+            let v = element.vertices();
+            self.connectivity.extend(v.iter().map(|&x| x as i64));
+        }
+    }
+
+    /// Rewrite a uniform array as a `Mixed` one (once two kinds meet, in a
+    /// run or between runs).
+    fn make_mixed(&mut self) {
+        if self.mixed {
+            return;
+        }
+        self.mixed = true;
+        let Some(kind) = self.kind else {
+            return;
+        };
+        let (_, nodes) = kind.uniform_type();
+        let header = kind.mixed_header();
+        let mut mixed = Vec::with_capacity(self.cells.len() * (nodes + header.len()));
+        for element in self.connectivity.chunks(nodes) {
+            mixed.extend_from_slice(header);
+            mixed.extend_from_slice(element);
+        }
+        self.connectivity = mixed;
     }
 }
 
@@ -129,56 +223,245 @@ pub(crate) enum Polygons {
     Triangulate,
 }
 
+/// Cells per parallel task: enough that a task's buffers and scheduling
+/// cost nothing against its work, few enough that the tasks of a grid of
+/// 10⁴ cells already spread over the cores.
+const TASK_CELLS: usize = 1 << 11;
+
 /// Build the grid of the p-cells of `complex` (1 ≤ p ≤ dim), with its
 /// polygons of five or more vertices written as `polygons` says.
+///
+/// Each cell's elements depend on that cell alone, so runs of cells are
+/// built in parallel (at 10⁶ hexahedra this is most of the output's work)
+/// and joined in cell order; the error reported is that of the first bad
+/// cell, as a serial pass would find it.
 pub(crate) fn grid_topology(
     complex: &Complex,
     p: usize,
     polygons: Polygons,
 ) -> Result<GridTopology, OutputError> {
-    let mut elements = Vec::with_capacity(complex.cell_count(p));
-    match p {
-        1 => {
-            for e in 0..complex.cell_count(1) {
-                let (tail, head) = edge_ends(complex, e)?;
-                elements.push((e, Element::Line([tail, head])));
-            }
-        }
-        2 => {
-            for f in 0..complex.cell_count(2) {
-                let cycle = face_cycle(complex, f)?;
-                if polygons == Polygons::Triangulate && cycle.len() > 4 {
-                    let triangles = fan_triangles(complex, &cycle);
-                    if triangles.is_empty() {
-                        return Err(topology_error(2, f, "polygon has zero area"));
-                    }
-                    elements.extend(triangles.into_iter().map(|t| (f, Element::Triangle(t))));
-                } else {
-                    elements.push((f, polygon_element(cycle)));
-                }
-            }
-        }
-        3 => {
-            for c in 0..complex.cell_count(3) {
-                for element in solid_elements(complex, c)? {
-                    elements.push((c, element));
-                }
-            }
-        }
-        _ => {
-            return Err(OutputError::Topology {
-                message: format!("no XDMF grid for cells of dimension {p}"),
-            })
-        }
+    if !(1..=3).contains(&p) {
+        return Err(OutputError::Topology {
+            message: format!("no XDMF grid for cells of dimension {p}"),
+        });
     }
-    Ok(GridTopology::from_elements(p, elements))
+    let columns = Columns::of(complex);
+    let count = complex.cell_count(p);
+    let runs: Vec<Result<Elements, OutputError>> = (0..count.div_ceil(TASK_CELLS))
+        .into_par_iter()
+        .map(|task| {
+            let mut run = Elements::default();
+            let mut scratch = Scratch::default();
+            for c in task * TASK_CELLS..count.min((task + 1) * TASK_CELLS) {
+                columns.push_cell(p, c, polygons, &mut scratch, &mut run)?;
+            }
+            Ok(run)
+        })
+        .collect();
+    let runs = runs.into_iter().collect::<Result<Vec<_>, _>>()?;
+    Ok(GridTopology::from_runs(p, runs))
 }
 
-fn polygon_element(cycle: Vec<usize>) -> Element {
+/// Buffers of one task, reused from cell to cell.
+#[derive(Default)]
+struct Scratch {
+    /// A face's oriented edges, (tail, head).
+    pairs: Vec<(usize, usize)>,
+    /// A face's vertex cycle.
+    cycle: Vec<usize>,
+    /// The cycles of a 3-cell's faces, one after the other …
+    cycles: Vec<usize>,
+    /// … face k's being `cycles[starts[k]..starts[k + 1]]`.
+    starts: Vec<usize>,
+}
+
+/// Faces with more edges than this chain them through a hash map; up to
+/// it a scan of the (tail, head) pairs is faster and allocates nothing.
+const LINEAR_EDGES: usize = 16;
+
+/// The complex with its boundary matrices by columns (cell → facets),
+/// looked up once per grid instead of once per cell.
+struct Columns<'a> {
+    complex: &'a Complex,
+    /// ∂_1, ∂_2, ∂_3 in CSC, where the complex has them.
+    d: [Option<&'a CsMat<i8>>; 3],
+}
+
+impl<'a> Columns<'a> {
+    fn of(complex: &'a Complex) -> Self {
+        let d = |p: usize| complex.try_boundary_csc(p).ok().map(|m| &**m);
+        Columns {
+            complex,
+            d: [d(1), d(2), d(3)],
+        }
+    }
+
+    /// The facets of p-cell `c` with their signs.
+    fn column(&self, p: usize, c: usize, what: &str) -> Result<CsVecView<'a, i8>, OutputError> {
+        self.d[p - 1]
+            .and_then(|d| d.outer_view(c))
+            .ok_or_else(|| topology_error(p, c, what))
+    }
+
+    /// Append the elements of p-cell `c` to `out`.
+    fn push_cell(
+        &self,
+        p: usize,
+        c: usize,
+        polygons: Polygons,
+        scratch: &mut Scratch,
+        out: &mut Elements,
+    ) -> Result<(), OutputError> {
+        match p {
+            1 => {
+                let (tail, head) = self.edge_ends(c)?;
+                out.push(c, &Element::Line([tail, head]));
+            }
+            2 => {
+                self.face_cycle(c, &mut scratch.pairs, &mut scratch.cycle)?;
+                let cycle = &scratch.cycle;
+                if polygons == Polygons::Triangulate && cycle.len() > 4 {
+                    let triangles = fan_triangles(self.complex, cycle);
+                    if triangles.is_empty() {
+                        return Err(topology_error(2, c, "polygon has zero area"));
+                    }
+                    for t in triangles {
+                        out.push(c, &Element::Triangle(t));
+                    }
+                } else {
+                    out.push(c, &polygon_element(cycle));
+                }
+            }
+            _ => self.solid_elements(c, scratch, out)?,
+        }
+        Ok(())
+    }
+
+    /// Tail and head of edge `e` as ∂_1 orients it.
+    fn edge_ends(&self, e: usize) -> Result<(usize, usize), OutputError> {
+        let column = self.column(1, e, "edge missing from ∂_1")?;
+        let (mut tail, mut head) = (None, None);
+        for (v, &s) in column.iter() {
+            if s < 0 {
+                tail = Some(v);
+            } else if s > 0 {
+                head = Some(v);
+            }
+        }
+        match (tail, head) {
+            (Some(t), Some(h)) => Ok((t, h)),
+            _ => Err(topology_error(1, e, "edge has no tail and head in ∂_1")),
+        }
+    }
+
+    /// Vertices of 2-cell `f` into `cycle`, in the cyclic order of its
+    /// orientation from its lowest vertex; `pairs` is scratch.
+    fn face_cycle(
+        &self,
+        f: usize,
+        pairs: &mut Vec<(usize, usize)>,
+        cycle: &mut Vec<usize>,
+    ) -> Result<(), OutputError> {
+        let not_a_cycle = || topology_error(2, f, "boundary edges do not form one cycle");
+        let column = self.column(2, f, "face missing from ∂_2")?;
+        let mut next = (column.nnz() > LINEAR_EDGES).then(|| HashMap::with_capacity(column.nnz()));
+        pairs.clear();
+        let mut start = None;
+        for (e, &s) in column.iter() {
+            let (t, h) = self.edge_ends(e)?;
+            let (from, to) = if s > 0 { (t, h) } else { (h, t) };
+            let repeated = match &mut next {
+                Some(next) => next.insert(from, to).is_some(),
+                None => pairs.iter().any(|&(a, _)| a == from),
+            };
+            if repeated {
+                return Err(not_a_cycle());
+            }
+            pairs.push((from, to));
+            start = Some(start.map_or(from, |s: usize| s.min(from)));
+        }
+        let start = start.ok_or_else(|| topology_error(2, f, "face has no edges"))?;
+        cycle.clear();
+        let mut v = start;
+        for _ in 0..pairs.len() {
+            cycle.push(v);
+            let to = match &next {
+                Some(next) => next.get(&v).copied(),
+                None => pairs.iter().find(|&&(a, _)| a == v).map(|&(_, b)| b),
+            };
+            v = to.ok_or_else(not_a_cycle)?;
+        }
+        if v != start {
+            return Err(not_a_cycle());
+        }
+        Ok(())
+    }
+
+    /// The elements one 3-cell is written as: a tetrahedron, a hexahedron,
+    /// or (any other convex polyhedron) a fan of tetrahedra from its lowest
+    /// vertex.
+    fn solid_elements(
+        &self,
+        c: usize,
+        s: &mut Scratch,
+        out: &mut Elements,
+    ) -> Result<(), OutputError> {
+        let complex = self.complex;
+        let vertices = complex.cell_vertices(3, c);
+        let column = self.column(3, c, "cell missing from ∂_3")?;
+        let faces = column.indices();
+        if vertices.len() == 4 && faces.len() == 4 {
+            let t = [vertices[0], vertices[1], vertices[2], vertices[3]];
+            out.push(c, &Element::Tetrahedron(positive_tet(complex, t)));
+            return Ok(());
+        }
+        s.cycles.clear();
+        s.starts.clear();
+        for &f in faces {
+            self.face_cycle(f, &mut s.pairs, &mut s.cycle)?;
+            s.starts.push(s.cycles.len());
+            s.cycles.extend_from_slice(&s.cycle);
+        }
+        s.starts.push(s.cycles.len());
+        let cycle = |k: usize| &s.cycles[s.starts[k]..s.starts[k + 1]];
+        let quads = faces.len() == 6 && (0..6).all(|k| cycle(k).len() == 4);
+        if vertices.len() == 8 && quads {
+            if let Some(hex) = hexahedron(complex, &s.cycles) {
+                out.push(c, &Element::Hexahedron(hex));
+                return Ok(());
+            }
+        }
+        // A convex polyhedron is the union of the cones from one of its vertices
+        // over the faces that do not contain it; fanning those faces gives
+        // tetrahedra without adding points, which every reader understands.
+        let apex = vertices[0];
+        let before = out.cells.len();
+        for k in 0..faces.len() {
+            let face = cycle(k);
+            if face.contains(&apex) {
+                continue;
+            }
+            for j in 1..face.len().saturating_sub(1) {
+                let t = [apex, face[0], face[j], face[j + 1]];
+                out.push(c, &Element::Tetrahedron(positive_tet(complex, t)));
+            }
+        }
+        if out.cells.len() == before {
+            return Err(topology_error(
+                3,
+                c,
+                "polyhedron has no face opposite a vertex",
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn polygon_element(cycle: &[usize]) -> Element {
     match cycle.len() {
         3 => Element::Triangle([cycle[0], cycle[1], cycle[2]]),
         4 => Element::Quadrilateral([cycle[0], cycle[1], cycle[2], cycle[3]]),
-        _ => Element::Polygon(cycle),
+        _ => Element::Polygon(cycle.to_vec()),
     }
 }
 
@@ -228,57 +511,6 @@ fn is_flat(complex: &Complex, t: [usize; 3]) -> bool {
     u.cross(&w).norm() <= 1e-10 * u.norm() * w.norm()
 }
 
-/// Tail and head of edge `e` as ∂_1 orients it.
-fn edge_ends(complex: &Complex, e: usize) -> Result<(usize, usize), OutputError> {
-    let column = complex
-        .boundary_csc(1)
-        .outer_view(e)
-        .ok_or_else(|| topology_error(1, e, "edge missing from ∂_1"))?;
-    let (mut tail, mut head) = (None, None);
-    for (v, &s) in column.iter() {
-        if s < 0 {
-            tail = Some(v);
-        } else if s > 0 {
-            head = Some(v);
-        }
-    }
-    match (tail, head) {
-        (Some(t), Some(h)) => Ok((t, h)),
-        _ => Err(topology_error(1, e, "edge has no tail and head in ∂_1")),
-    }
-}
-
-/// Vertices of 2-cell `f` in the cyclic order of its orientation.
-pub(crate) fn face_cycle(complex: &Complex, f: usize) -> Result<Vec<usize>, OutputError> {
-    let column = complex
-        .boundary_csc(2)
-        .outer_view(f)
-        .ok_or_else(|| topology_error(2, f, "face missing from ∂_2"))?;
-    let mut next = HashMap::with_capacity(column.nnz());
-    let mut start = None;
-    for (e, &s) in column.iter() {
-        let (t, h) = edge_ends(complex, e)?;
-        let (from, to) = if s > 0 { (t, h) } else { (h, t) };
-        if next.insert(from, to).is_some() {
-            return Err(topology_error(2, f, "boundary edges do not form one cycle"));
-        }
-        start = Some(start.map_or(from, |s: usize| s.min(from)));
-    }
-    let start = start.ok_or_else(|| topology_error(2, f, "face has no edges"))?;
-    let mut cycle = Vec::with_capacity(next.len());
-    let mut v = start;
-    for _ in 0..next.len() {
-        cycle.push(v);
-        v = *next
-            .get(&v)
-            .ok_or_else(|| topology_error(2, f, "boundary edges do not form one cycle"))?;
-    }
-    if v != start {
-        return Err(topology_error(2, f, "boundary edges do not form one cycle"));
-    }
-    Ok(cycle)
-}
-
 fn point3(complex: &Complex, v: usize) -> [f64; 3] {
     let mut p = [0.0; 3];
     for (a, x) in complex.vertices().point(v).iter().enumerate() {
@@ -301,84 +533,39 @@ fn positive_tet(complex: &Complex, mut t: [usize; 4]) -> [usize; 4] {
     t
 }
 
-/// The elements one 3-cell is written as: a tetrahedron, a hexahedron, or
-/// (any other convex polyhedron) a fan of tetrahedra from its lowest vertex.
-fn solid_elements(complex: &Complex, c: usize) -> Result<Vec<Element>, OutputError> {
-    let vertices = complex.cell_vertices(3, c);
-    let faces: Vec<usize> = complex
-        .boundary_csc(3)
-        .outer_view(c)
-        .ok_or_else(|| topology_error(3, c, "cell missing from ∂_3"))?
-        .indices()
-        .to_vec();
-    if vertices.len() == 4 && faces.len() == 4 {
-        let t = [vertices[0], vertices[1], vertices[2], vertices[3]];
-        return Ok(vec![Element::Tetrahedron(positive_tet(complex, t))]);
-    }
-    let cycles = faces
-        .iter()
-        .map(|&f| face_cycle(complex, f))
-        .collect::<Result<Vec<_>, _>>()?;
-    if vertices.len() == 8 && cycles.len() == 6 && cycles.iter().all(|f| f.len() == 4) {
-        if let Some(hex) = hexahedron(complex, &cycles) {
-            return Ok(vec![Element::Hexahedron(hex)]);
-        }
-    }
-    // A convex polyhedron is the union of the cones from one of its vertices
-    // over the faces that do not contain it; fanning those faces gives
-    // tetrahedra without adding points, which every reader understands.
-    let apex = vertices[0];
-    let mut tets = Vec::new();
-    for cycle in cycles.iter().filter(|f| !f.contains(&apex)) {
-        for k in 1..cycle.len() - 1 {
-            let t = [apex, cycle[0], cycle[k], cycle[k + 1]];
-            tets.push(Element::Tetrahedron(positive_tet(complex, t)));
-        }
-    }
-    if tets.is_empty() {
-        return Err(topology_error(
-            3,
-            c,
-            "polyhedron has no face opposite a vertex",
-        ));
-    }
-    Ok(tets)
-}
-
-/// VTK hexahedron order: a bottom quad (0..4) whose right-hand normal points
-/// into the cell, and above each bottom vertex its neighbour along a cell edge.
-fn hexahedron(complex: &Complex, cycles: &[Vec<usize>]) -> Option<[usize; 8]> {
-    let mut neighbours: HashMap<usize, Vec<usize>> = HashMap::new();
-    for cycle in cycles {
-        for k in 0..cycle.len() {
-            let (a, b) = (cycle[k], cycle[(k + 1) % cycle.len()]);
-            for (x, y) in [(a, b), (b, a)] {
-                let list = neighbours.entry(x).or_default();
-                if !list.contains(&y) {
-                    list.push(y);
-                }
-            }
-        }
-    }
-    let bottom = &cycles[0];
+/// VTK hexahedron order from the vertex cycles of a hexahedron's six
+/// quadrilateral faces (`quads`, four after four): a bottom quad (0..4)
+/// whose right-hand normal points into the cell, and above each bottom
+/// vertex its one neighbour along a cell edge that is not on the bottom.
+fn hexahedron(complex: &Complex, quads: &[usize]) -> Option<[usize; 8]> {
+    let bottom = &quads[..4];
     let mut hex = [0usize; 8];
     for (k, &v) in bottom.iter().enumerate() {
         hex[k] = v;
-        let up: Vec<usize> = neighbours
-            .get(&v)?
-            .iter()
-            .copied()
-            .filter(|w| !bottom.contains(w))
-            .collect();
-        if up.len() != 1 {
-            return None;
+        let mut up = None;
+        for quad in quads.chunks(4) {
+            for i in 0..quad.len() {
+                let (a, b) = (quad[i], quad[(i + 1) % quad.len()]);
+                let w = match (a == v, b == v) {
+                    (true, _) => b,
+                    (_, true) => a,
+                    _ => continue,
+                };
+                if bottom.contains(&w) {
+                    continue;
+                }
+                match up {
+                    None => up = Some(w),
+                    Some(u) if u == w => {}
+                    Some(_) => return None,
+                }
+            }
         }
-        hex[k + 4] = up[0];
+        hex[k + 4] = up?;
     }
-    let mut distinct = hex.to_vec();
+    let mut distinct = hex;
     distinct.sort_unstable();
-    distinct.dedup();
-    if distinct.len() != 8 {
+    if distinct.windows(2).any(|w| w[0] == w[1]) {
         return None;
     }
     if hex_orientation(complex, &hex) < 0.0 {
@@ -402,180 +589,4 @@ fn topology_error(p: usize, cell: usize, what: &str) -> OutputError {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use hasse_complex::{generate, TopCells, Vertices};
-
-    fn shoelace(complex: &Complex, cycle: &[usize]) -> f64 {
-        (0..cycle.len())
-            .map(|k| {
-                let a = point3(complex, cycle[k]);
-                let b = point3(complex, cycle[(k + 1) % cycle.len()]);
-                a[0] * b[1] - b[0] * a[1]
-            })
-            .sum::<f64>()
-            / 2.0
-    }
-
-    #[test]
-    fn unit_quad_is_cyclic_with_positive_area() {
-        let k = generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
-        let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
-        assert_eq!(grid.uniform, Some(("Quadrilateral", 4)));
-        let quad: Vec<usize> = grid.connectivity.iter().map(|&v| v as usize).collect();
-        // Tensor order 0,1,2,3 = (0,0),(1,0),(0,1),(1,1); cyclic means the
-        // diagonal pairs {0,3} and {1,2} sit at distance two in the cycle.
-        let at = |v: usize| quad.iter().position(|&x| x == v).unwrap();
-        assert_eq!((at(0) as i64 - at(3) as i64).abs(), 2);
-        assert_eq!((at(1) as i64 - at(2) as i64).abs(), 2);
-        assert!((shoelace(&k, &quad) - 1.0).abs() < 1e-12);
-    }
-
-    /// Volume of a VTK-ordered hexahedron split into the five tetrahedra of
-    /// the corner decomposition, each in VTK orientation.
-    fn vtk_hex_volume(p: &[[f64; 3]; 8]) -> f64 {
-        let tets = [
-            [0, 1, 3, 4],
-            [1, 2, 3, 6],
-            [1, 4, 5, 6],
-            [3, 6, 7, 4],
-            [1, 3, 4, 6],
-        ];
-        tets.iter()
-            .map(|t| tet_volume6(p[t[0]], p[t[1]], p[t[2]], p[t[3]]) / 6.0)
-            .sum()
-    }
-
-    #[test]
-    fn unit_hex_has_positive_vtk_volume() {
-        let k = generate::box3(1, 1, 1, [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]).unwrap();
-        let grid = grid_topology(&k, 3, Polygons::Keep).unwrap();
-        assert_eq!(grid.uniform, Some(("Hexahedron", 8)));
-        let hex: Vec<usize> = grid.connectivity.iter().map(|&v| v as usize).collect();
-        let p: [[f64; 3]; 8] = std::array::from_fn(|i| point3(&k, hex[i]));
-        assert!((vtk_hex_volume(&p) - 6.0).abs() < 1e-12);
-        // Each top vertex sits straight above its bottom vertex along one axis.
-        for i in 0..4 {
-            let d = Vector3::from(p[i + 4]) - Vector3::from(p[i]);
-            assert_eq!(d.iter().filter(|x| x.abs() > 0.0).count(), 1);
-        }
-        // Bottom face is a cycle: consecutive vertices differ along one axis.
-        for i in 0..4 {
-            let d = Vector3::from(p[(i + 1) % 4]) - Vector3::from(p[i]);
-            assert_eq!(d.iter().filter(|x| x.abs() > 0.0).count(), 1);
-        }
-    }
-
-    #[test]
-    fn mixed_polygons_use_polygon_codes() {
-        // A pentagon and a triangle sharing the edge (1, 2).
-        let v = Vertices::from_points(&[
-            [0.0, 0.0],
-            [2.0, 0.0],
-            [2.0, 1.0],
-            [1.0, 2.0],
-            [0.0, 1.0],
-            [3.0, 0.5],
-        ])
-        .unwrap();
-        let k =
-            Complex::build(v, TopCells::polygons([vec![0, 1, 2, 3, 4], vec![1, 5, 2]])).unwrap();
-        let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
-        assert_eq!(grid.uniform, None);
-        assert_eq!(grid.connectivity.len(), (2 + 5) + (1 + 3));
-        let pentagon: Vec<usize> = grid.connectivity[2..7]
-            .iter()
-            .map(|&x| x as usize)
-            .collect();
-        assert_eq!(&grid.connectivity[..2], &[code::POLYGON, 5]);
-        assert_eq!(grid.connectivity[7], code::TRIANGLE);
-        assert!((shoelace(&k, &pentagon) - 3.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn general_polyhedron_becomes_positive_tetrahedra() {
-        // A triangular prism: 2 triangles, 3 quads.
-        let v = Vertices::from_points(&[
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [1.0, 0.0, 1.0],
-            [0.0, 1.0, 1.0],
-        ])
-        .unwrap();
-        let prism = vec![
-            vec![0, 2, 1],
-            vec![3, 4, 5],
-            vec![0, 1, 4, 3],
-            vec![1, 2, 5, 4],
-            vec![2, 0, 3, 5],
-        ];
-        let k = Complex::build(v, TopCells::polyhedra([prism])).unwrap();
-        let grid = grid_topology(&k, 3, Polygons::Keep).unwrap();
-        assert_eq!(grid.uniform, Some(("Tetrahedron", 4)));
-        let ids = grid.cell_ids.clone().unwrap();
-        assert!(ids.iter().all(|&c| c == 0));
-        let volume: f64 = grid
-            .connectivity
-            .chunks(4)
-            .map(|t| {
-                let [a, b, c, d] = [0, 1, 2, 3].map(|i| point3(&k, t[i] as usize));
-                let v6 = tet_volume6(a, b, c, d);
-                assert!(v6 > 0.0);
-                v6 / 6.0
-            })
-            .sum();
-        assert!((volume - 0.5).abs() < 1e-12);
-    }
-
-    #[test]
-    fn hanging_vertices_are_triangulated_without_flat_triangles() {
-        // The unit square with a hanging vertex in the middle of its bottom
-        // and of its right side (a neighbour on each was cut): a hexagon
-        // whose fan from the corner (0, 0) would hold two flat triangles.
-        let v = Vertices::from_points(&[
-            [0.0, 0.0],
-            [0.5, 0.0],
-            [1.0, 0.0],
-            [1.0, 0.5],
-            [1.0, 1.0],
-            [0.0, 1.0],
-            [2.0, 0.0],
-        ])
-        .unwrap();
-        let k = Complex::build(
-            v,
-            TopCells::polygons([vec![0, 1, 2, 3, 4, 5], vec![2, 6, 3]]),
-        )
-        .unwrap();
-        let kept = grid_topology(&k, 2, Polygons::Keep).unwrap();
-        assert_eq!(&kept.connectivity[..2], &[code::POLYGON, 6]);
-        assert_eq!(kept.cell_ids, None);
-
-        let grid = grid_topology(&k, 2, Polygons::Triangulate).unwrap();
-        assert_eq!(grid.uniform, Some(("Triangle", 3)));
-        let ids = grid.cell_ids.clone().unwrap();
-        // Four triangles for the hexagon (k − 2), one for the triangle.
-        assert_eq!(ids, [0, 0, 0, 0, 1]);
-        let mut used = Vec::new();
-        let area: f64 = grid.connectivity[..12]
-            .chunks(3)
-            .map(|t| {
-                let t: Vec<usize> = t.iter().map(|&v| v as usize).collect();
-                let a = shoelace(&k, &t);
-                assert!(a > 1e-3, "flat or clockwise triangle {t:?}: {a}");
-                used.extend(t);
-                a
-            })
-            .sum();
-        assert!((area - 1.0).abs() < 1e-12);
-        used.sort_unstable();
-        used.dedup();
-        assert_eq!(
-            used,
-            [0, 1, 2, 3, 4, 5],
-            "every vertex of the hexagon is used"
-        );
-    }
-}
+mod tests;
