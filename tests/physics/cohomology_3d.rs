@@ -23,6 +23,7 @@
 //!   them: edge e along a carries c_a h_a with weight |⋆e|/|e| =
 //!   h_b h_c / h_a, and there are n₀n₁n₂ edges along each axis).
 
+use crate::forms_dec::{max_abs, residuals};
 use approx::assert_abs_diff_eq;
 use hasse_complex::dual::DualKind;
 use hasse_complex::generate::{hollow_box, torus_flat_box, uniform_axis};
@@ -46,10 +47,6 @@ const BARYCENTRIC: Star = Star::Diagonal(DualKind::Barycentric);
 /// 8³ torus, for both degrees). 1e-12 leaves a factor 40 of margin without
 /// hiding an O(h) or solver-tolerance error, which would be ≥ 1e-8.
 const ROUNDING: f64 = 1e-12;
-
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |m, x| m.max(x.abs()))
-}
 
 /// A box of `n` × `n` × `layers` unit cubes with the cubes whose (i, j)
 /// lie in `hole` × `hole` removed through every layer: a tunnel along z,
@@ -141,27 +138,6 @@ fn rank_modulo_exact(complex: &Complex, k: usize, generators: &[Vec<f64>]) -> us
         }
     }
     rank(&both.to_csc(), Numbers::Rationals) - rank(&lower.to_csc(), Numbers::Rationals)
-}
-
-/// ‖d h‖_∞ / ‖h‖_∞ and ‖d_{k−1}ᵀ ⋆ h‖_∞ / ‖⋆h‖_∞ from the matrices.
-fn residuals(forms: &Forms<'_>, k: usize, h: &[f64]) -> Result<(f64, f64)> {
-    let d = forms.d(k)?;
-    let dh: Vec<f64> = d
-        .outer_iterator()
-        .map(|row| row.iter().map(|(j, &s)| f64::from(s) * h[j]).sum())
-        .collect();
-    let weighted = forms.star(k)?.apply(h);
-    let lower = forms.d(k - 1)?;
-    let mut divergence = vec![0.0; lower.cols()];
-    for (row, w) in lower.outer_iterator().zip(&weighted) {
-        for (v, &s) in row.iter() {
-            divergence[v] += f64::from(s) * w;
-        }
-    }
-    Ok((
-        max_abs(&dh) / max_abs(h),
-        max_abs(&divergence) / max_abs(&weighted),
-    ))
 }
 
 /// Every degree on the three shapes: β_k generators (known topology and

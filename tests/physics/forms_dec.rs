@@ -31,17 +31,18 @@ use hasse_solver::physics::forms::{Forms, Star};
 use std::error::Error;
 use std::f64::consts::PI;
 
-type Result<T = ()> = std::result::Result<T, Box<dyn Error>>;
+pub(crate) type Result<T = ()> = std::result::Result<T, Box<dyn Error>>;
 
 const CIRCUMCENTRIC: Star = Star::Diagonal(DualKind::Circumcentric);
 const BARYCENTRIC: Star = Star::Diagonal(DualKind::Barycentric);
 
-fn max_abs(v: &[f64]) -> f64 {
+pub(crate) fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
-/// ‖d h‖_∞ / ‖h‖_∞ and ‖d_{k−1}ᵀ ⋆ h‖_∞ / ‖⋆h‖_∞ from the matrices.
-fn residuals(forms: &Forms<'_>, k: usize, h: &[f64]) -> Result<(f64, f64)> {
+/// ‖d h‖_∞ / ‖h‖_∞ and ‖d_{k−1}ᵀ ⋆ h‖_∞ / ‖⋆h‖_∞ from the matrices
+/// (shared with the 3D cohomology tests).
+pub(crate) fn residuals(forms: &Forms<'_>, k: usize, h: &[f64]) -> Result<(f64, f64)> {
     let d = forms.d(k)?;
     let dh: Vec<f64> = d
         .outer_iterator()

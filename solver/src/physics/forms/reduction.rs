@@ -77,44 +77,24 @@ fn combine(a: i64, x: &[(usize, i64)], b: i64, y: &[(usize, i64)]) -> Result<Col
     let mut out = Vec::with_capacity(x.len() + y.len());
     let (mut i, mut j) = (0, 0);
     while i < x.len() || j < y.len() {
-        let (row, value) = match (x.get(i), y.get(j)) {
-            (Some(&(rx, vx)), Some(&(ry, _))) if rx < ry => {
-                i += 1;
-                (rx, a.checked_mul(vx).ok_or_else(overflow)?)
-            }
-            (Some(&(rx, _)), Some(&(ry, vy))) if ry < rx => {
-                j += 1;
-                (
-                    ry,
-                    b.checked_mul(vy)
-                        .ok_or_else(overflow)?
-                        .checked_neg()
-                        .ok_or_else(overflow)?,
-                )
-            }
-            (Some(&(rx, vx)), Some(&(_, vy))) => {
-                i += 1;
-                j += 1;
-                let ax = a.checked_mul(vx).ok_or_else(overflow)?;
-                let by = b.checked_mul(vy).ok_or_else(overflow)?;
-                (rx, ax.checked_sub(by).ok_or_else(overflow)?)
-            }
-            (Some(&(rx, vx)), None) => {
-                i += 1;
-                (rx, a.checked_mul(vx).ok_or_else(overflow)?)
-            }
-            (None, Some(&(ry, vy))) => {
-                j += 1;
-                (
-                    ry,
-                    b.checked_mul(vy)
-                        .ok_or_else(overflow)?
-                        .checked_neg()
-                        .ok_or_else(overflow)?,
-                )
-            }
+        let (rx, ry) = (x.get(i).map(|e| e.0), y.get(j).map(|e| e.0));
+        // The next row in either column; each column whose next entry sits
+        // there contributes to it.
+        let row = match (rx, ry) {
+            (Some(r), Some(q)) => r.min(q),
+            (Some(r), None) | (None, Some(r)) => r,
             (None, None) => break,
         };
+        let mut value = 0i64;
+        if rx == Some(row) {
+            value = a.checked_mul(x[i].1).ok_or_else(overflow)?;
+            i += 1;
+        }
+        if ry == Some(row) {
+            let by = b.checked_mul(y[j].1).ok_or_else(overflow)?;
+            value = value.checked_sub(by).ok_or_else(overflow)?;
+            j += 1;
+        }
         if value != 0 {
             out.push((row, value));
         }
