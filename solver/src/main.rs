@@ -414,6 +414,7 @@ fn run_case(
     result
         .warnings
         .extend(run::unwritten_fields(&case, &result));
+    let writing_started = std::time::Instant::now();
     let written = if writing {
         progress.phase("writing output");
         if let Some(e) = stream.as_ref().and_then(run::LevelStream::stopped) {
@@ -445,7 +446,13 @@ fn run_case(
             ))
         });
         match written {
-            Ok(files) => Some(files),
+            Ok(files) => {
+                // The summary's figure only: the report inside the file
+                // was complete before its own writing was.
+                let seconds = writing_started.elapsed().as_secs_f64();
+                result.timings.push(("output".into(), seconds));
+                Some(files)
+            }
             Err(e) => {
                 progress.finish();
                 eprintln!("error: writing output: {e}");

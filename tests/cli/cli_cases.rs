@@ -194,6 +194,19 @@ fn poisson_multigrid_matches_the_direct_solve() {
     assert!((1.0..=15.0).contains(&iterations), "{multigrid}");
     // The timing line names the multigrid setup for what it is.
     assert!(reported(&multigrid, "timing", "preconditioner setup") >= 0.0);
+    // Written output gets its own phase, after post-processing.
+    let timing = multigrid
+        .lines()
+        .find(|l| l.starts_with("timing"))
+        .unwrap_or("");
+    assert!(
+        timing.ends_with(" s") && timing.contains("post-processing"),
+        "{timing}"
+    );
+    assert!(
+        reported(&multigrid, "timing", ", output") >= 0.0,
+        "{timing}"
+    );
     assert!(!multigrid.contains("factorisation"), "{multigrid}");
 }
 
