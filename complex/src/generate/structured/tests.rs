@@ -5,40 +5,43 @@ use super::super::grid::{grid_general, kuhn_general};
 use super::super::{graded_axis, grid, kuhn, uniform_axis};
 use super::*;
 
-fn u(n: usize) -> Vec<f64> {
-    uniform_axis(n, 0.0, 1.0).unwrap()
+/// Tests return errors instead of unwrapping, so a failure names its cause.
+type TestResult<T = ()> = Result<T, Box<dyn std::error::Error>>;
+
+fn u(n: usize) -> TestResult<Vec<f64>> {
+    Ok(uniform_axis(n, 0.0, 1.0)?)
 }
 
 /// Axes of every shape the comparison runs on: 1D to 3D, one-cell sides,
 /// uneven counts, graded and shifted axes, and a medium 20³ grid.
-fn shapes() -> Vec<Vec<Vec<f64>>> {
-    let graded = graded_axis(6, 0.0, 3.0, 1.3).unwrap();
-    let shifted = uniform_axis(5, -1.0, 2.0).unwrap();
-    let fine_end = graded_axis(4, -2.0, 0.5, 0.6).unwrap();
-    vec![
-        vec![u(1)],
-        vec![u(3)],
+fn shapes() -> TestResult<Vec<Vec<Vec<f64>>>> {
+    let graded = graded_axis(6, 0.0, 3.0, 1.3)?;
+    let shifted = uniform_axis(5, -1.0, 2.0)?;
+    let fine_end = graded_axis(4, -2.0, 0.5, 0.6)?;
+    Ok(vec![
+        vec![u(1)?],
+        vec![u(3)?],
         vec![graded.clone()],
-        vec![u(1), u(1)],
-        vec![u(3), u(2)],
-        vec![u(1), u(4)],
-        vec![u(4), u(1)],
-        vec![u(17), u(9)],
+        vec![u(1)?, u(1)?],
+        vec![u(3)?, u(2)?],
+        vec![u(1)?, u(4)?],
+        vec![u(4)?, u(1)?],
+        vec![u(17)?, u(9)?],
         vec![graded.clone(), shifted.clone()],
-        vec![u(1), u(1), u(1)],
-        vec![u(2), u(1), u(1)],
-        vec![u(1), u(3), u(2)],
-        vec![u(3), u(1), u(4)],
-        vec![u(6), u(5), u(4)],
+        vec![u(1)?, u(1)?, u(1)?],
+        vec![u(2)?, u(1)?, u(1)?],
+        vec![u(1)?, u(3)?, u(2)?],
+        vec![u(3)?, u(1)?, u(4)?],
+        vec![u(6)?, u(5)?, u(4)?],
         vec![graded, shifted, fine_end],
-        vec![u(20), u(20), u(20)],
-    ]
+        vec![u(20)?, u(20)?, u(20)?],
+    ])
 }
 
 /// Every part of the two complexes, part by part (so that a failure names
 /// the part), then as a whole (which also covers anything added later to
 /// `Complex`'s equality).
-fn assert_same(direct: &Complex, general: &Complex, label: &str) {
+fn assert_same(direct: &Complex, general: &Complex, label: &str) -> TestResult {
     assert_eq!(
         direct.cell_counts(),
         general.cell_counts(),
@@ -47,8 +50,8 @@ fn assert_same(direct: &Complex, general: &Complex, label: &str) {
     assert_eq!(direct.vertices(), general.vertices(), "{label}: vertices");
     for p in 1..=general.dim() {
         let (a, b) = (
-            direct.lar().characteristic(p).unwrap(),
-            general.lar().characteristic(p).unwrap(),
+            direct.lar().characteristic(p)?,
+            general.lar().characteristic(p)?,
         );
         assert_eq!(a.shape(), b.shape(), "{label}: M_{p} shape");
         assert_eq!(
@@ -75,29 +78,32 @@ fn assert_same(direct: &Complex, general: &Complex, label: &str) {
     );
     assert_eq!(direct.tags(), general.tags(), "{label}: tags");
     assert!(direct == general, "{label}: complexes differ");
+    Ok(())
 }
 
 #[test]
-fn cuboidal_grids_equal_the_general_path_exactly() {
+fn cuboidal_grids_equal_the_general_path_exactly() -> TestResult {
     // The general path (facet extraction, filtered LAR products, geometric
     // signs) is the reference: the direct builder must reproduce it bit
     // for bit on every shape.
-    for axes in shapes() {
-        let layout = Layout::new(&axes).unwrap();
+    for axes in shapes()? {
+        let layout = Layout::new(&axes)?;
         let label = format!("grid {:?}", layout.counts);
-        let direct = build(&layout, Family::Cuboid).unwrap();
-        assert_same(&direct, &grid_general(&layout).unwrap(), &label);
+        let direct = build(&layout, Family::Cuboid)?;
+        assert_same(&direct, &grid_general(&layout)?, &label)?;
     }
+    Ok(())
 }
 
 #[test]
-fn kuhn_grids_equal_the_general_path_exactly() {
-    for axes in shapes() {
-        let layout = Layout::new(&axes).unwrap();
+fn kuhn_grids_equal_the_general_path_exactly() -> TestResult {
+    for axes in shapes()? {
+        let layout = Layout::new(&axes)?;
         let label = format!("kuhn {:?}", layout.counts);
-        let direct = build(&layout, Family::Kuhn).unwrap();
-        assert_same(&direct, &kuhn_general(&layout).unwrap(), &label);
+        let direct = build(&layout, Family::Kuhn)?;
+        assert_same(&direct, &kuhn_general(&layout)?, &label)?;
     }
+    Ok(())
 }
 
 /// Cell counts of an n_x × n_y × n_z cuboidal grid by counting cells of
@@ -133,17 +139,17 @@ fn kuhn_counts(n: &[usize]) -> Vec<usize> {
 }
 
 #[test]
-fn direct_grids_are_chain_complexes_of_a_ball() {
+fn direct_grids_are_chain_complexes_of_a_ball() -> TestResult {
     // ∂_{p−1} ∂_p = 0 exactly, χ = 1 (a ball), and the cell counts of the
     // closed-form counting above.
-    for axes in shapes() {
-        let layout = Layout::new(&axes).unwrap();
+    for axes in shapes()? {
+        let layout = Layout::new(&axes)?;
         let n: Vec<usize> = layout.counts.iter().map(|c| c - 1).collect();
         for (family, expected) in [
             (Family::Cuboid, cuboid_counts(&n)),
             (Family::Kuhn, kuhn_counts(&n)),
         ] {
-            let k = build(&layout, family).unwrap();
+            let k = build(&layout, family)?;
             let label = format!("{family:?} {n:?}");
             assert_eq!(k.cell_counts(), expected, "{label}");
             assert_eq!(k.euler_characteristic(), 1, "{label}");
@@ -158,6 +164,7 @@ fn direct_grids_are_chain_complexes_of_a_ball() {
             }
         }
     }
+    Ok(())
 }
 
 fn dense(m: &CsMat<i8>) -> Vec<Vec<i8>> {
@@ -169,13 +176,13 @@ fn dense(m: &CsMat<i8>) -> Vec<Vec<i8>> {
 }
 
 #[test]
-fn unit_square_matrices_by_hand() {
-    let axes = [u(1), u(1)];
-    let layout = Layout::new(&axes).unwrap();
+fn unit_square_matrices_by_hand() -> TestResult {
+    let axes = [u(1)?, u(1)?];
+    let layout = Layout::new(&axes)?;
     // Vertices 0 (0,0), 1 (1,0), 2 (0,1), 3 (1,1). Edges by vertex list:
     // e0 {0,1} bottom, e1 {0,2} left, e2 {1,3} right, e3 {2,3} top, each
     // from its lower to its higher vertex.
-    let quad = build(&layout, Family::Cuboid).unwrap();
+    let quad = build(&layout, Family::Cuboid)?;
     assert_eq!(
         dense(quad.boundary(1)),
         vec![
@@ -195,7 +202,7 @@ fn unit_square_matrices_by_hand() {
     // e4 {2,3}; triangles t0 [0,1,3] (counter-clockwise as listed) and
     // t1 [0,2,3] (clockwise as listed, so flagged −1). Counter-clockwise
     // boundaries: t0 = 0→1→3→0 = e0 + e3 − e2, t1 = 0→3→2→0 = e2 − e4 − e1.
-    let tris = build(&layout, Family::Kuhn).unwrap();
+    let tris = build(&layout, Family::Kuhn)?;
     assert_eq!(tris.top_orientation(), &[1, -1]);
     assert_eq!(
         dense(tris.boundary(2)),
@@ -207,12 +214,16 @@ fn unit_square_matrices_by_hand() {
             vec![0, -1]
         ]
     );
-    assert_eq!(tris.tag("xmin").unwrap().cells, vec![1]);
-    assert_eq!(tris.tag("boundary").unwrap().cells, vec![0, 1, 3, 4]);
+    assert_eq!(tris.tag("xmin").ok_or("no xmin tag")?.cells, vec![1]);
+    assert_eq!(
+        tris.tag("boundary").ok_or("no boundary tag")?.cells,
+        vec![0, 1, 3, 4]
+    );
+    Ok(())
 }
 
 #[test]
-fn unit_cube_top_boundary_by_hand() {
+fn unit_cube_top_boundary_by_hand() -> TestResult {
     // Faces by vertex list: f0 {0,1,2,3} (z = 0), f1 {0,1,4,5} (y = 0),
     // f2 {0,2,4,6} (x = 0), f3 {1,3,5,7} (x = 1), f4 {2,3,6,7} (y = 1),
     // f5 {4,5,6,7} (z = 1). Each face's frame follows its axes in
@@ -220,29 +231,31 @@ fn unit_cube_top_boundary_by_hand() {
     // normal against n_xy = +z, n_xz = −y, n_yz = +x: z = 0 has outward −z
     // (−1), y = 0 has outward −y (+1), x = 0 has −x (−1), and the far
     // sides the opposite.
-    let axes = [u(1), u(1), u(1)];
-    let layout = Layout::new(&axes).unwrap();
-    let cube = build(&layout, Family::Cuboid).unwrap();
+    let axes = [u(1)?, u(1)?, u(1)?];
+    let layout = Layout::new(&axes)?;
+    let cube = build(&layout, Family::Cuboid)?;
     assert_eq!(
         dense(cube.boundary(3)),
         vec![vec![-1], vec![1], vec![-1], vec![1], vec![-1], vec![1]]
     );
     // The six Kuhn tetrahedra are flagged with the signs of the axis
     // permutations (012, 021, 102, 120, 201, 210).
-    let tets = build(&layout, Family::Kuhn).unwrap();
+    let tets = build(&layout, Family::Kuhn)?;
     assert_eq!(tets.top_orientation(), &[1, -1, -1, 1, 1, -1]);
+    Ok(())
 }
 
 #[test]
-fn thin_cells_go_through_the_general_path() {
+fn thin_cells_go_through_the_general_path() -> TestResult {
     // A spacing of 1e-9 against a unit diagonal is below THINNEST (1e-6):
     // the public generators must hand such grids to the general path,
     // whose own checks decide on them.
-    let thin = vec![vec![0.0, 1e-9, 1.0], u(1)];
-    let layout = Layout::new(&thin).unwrap();
+    let thin = vec![vec![0.0, 1e-9, 1.0], u(1)?];
+    let layout = Layout::new(&thin)?;
     assert!(!well_shaped(&layout));
-    assert_eq!(grid(&thin).unwrap(), grid_general(&layout).unwrap());
-    assert_eq!(kuhn(&thin).unwrap(), kuhn_general(&layout).unwrap());
-    let layout_ok = [u(3), u(2)];
-    assert!(well_shaped(&Layout::new(&layout_ok).unwrap()));
+    assert_eq!(grid(&thin)?, grid_general(&layout)?);
+    assert_eq!(kuhn(&thin)?, kuhn_general(&layout)?);
+    let layout_ok = [u(3)?, u(2)?];
+    assert!(well_shaped(&Layout::new(&layout_ok)?));
+    Ok(())
 }

@@ -4,6 +4,9 @@
 use super::*;
 use hasse_complex::{generate, TopCells, Vertices};
 
+/// Tests return errors instead of unwrapping, so a failure names its cause.
+type TestResult<T = ()> = Result<T, Box<dyn std::error::Error>>;
+
 fn shoelace(complex: &Complex, cycle: &[usize]) -> f64 {
     (0..cycle.len())
         .map(|k| {
@@ -16,17 +19,23 @@ fn shoelace(complex: &Complex, cycle: &[usize]) -> f64 {
 }
 
 #[test]
-fn unit_quad_is_cyclic_with_positive_area() {
-    let k = generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
-    let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
+fn unit_quad_is_cyclic_with_positive_area() -> TestResult {
+    let k = generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0])?;
+    let grid = grid_topology(&k, 2, Polygons::Keep)?;
     assert_eq!(grid.uniform, Some(("Quadrilateral", 4)));
     let quad: Vec<usize> = grid.connectivity.iter().map(|&v| v as usize).collect();
     // Tensor order 0,1,2,3 = (0,0),(1,0),(0,1),(1,1); cyclic means the
     // diagonal pairs {0,3} and {1,2} sit at distance two in the cycle.
-    let at = |v: usize| quad.iter().position(|&x| x == v).unwrap();
-    assert_eq!((at(0) as i64 - at(3) as i64).abs(), 2);
-    assert_eq!((at(1) as i64 - at(2) as i64).abs(), 2);
+    let at = |v: usize| {
+        quad.iter()
+            .position(|&x| x == v)
+            .map(|i| i as i64)
+            .ok_or(format!("vertex {v} is not in the quad {quad:?}"))
+    };
+    assert_eq!((at(0)? - at(3)?).abs(), 2);
+    assert_eq!((at(1)? - at(2)?).abs(), 2);
     assert!((shoelace(&k, &quad) - 1.0).abs() < 1e-12);
+    Ok(())
 }
 
 /// Volume of a VTK-ordered hexahedron split into the five tetrahedra of
@@ -45,9 +54,9 @@ fn vtk_hex_volume(p: &[[f64; 3]; 8]) -> f64 {
 }
 
 #[test]
-fn unit_hex_has_positive_vtk_volume() {
-    let k = generate::box3(1, 1, 1, [0.0, 1.0], [0.0, 2.0], [0.0, 3.0]).unwrap();
-    let grid = grid_topology(&k, 3, Polygons::Keep).unwrap();
+fn unit_hex_has_positive_vtk_volume() -> TestResult {
+    let k = generate::box3(1, 1, 1, [0.0, 1.0], [0.0, 2.0], [0.0, 3.0])?;
+    let grid = grid_topology(&k, 3, Polygons::Keep)?;
     assert_eq!(grid.uniform, Some(("Hexahedron", 8)));
     let hex: Vec<usize> = grid.connectivity.iter().map(|&v| v as usize).collect();
     let p: [[f64; 3]; 8] = std::array::from_fn(|i| point3(&k, hex[i]));
@@ -62,10 +71,11 @@ fn unit_hex_has_positive_vtk_volume() {
         let d = Vector3::from(p[(i + 1) % 4]) - Vector3::from(p[i]);
         assert_eq!(d.iter().filter(|x| x.abs() > 0.0).count(), 1);
     }
+    Ok(())
 }
 
 #[test]
-fn mixed_polygons_use_polygon_codes() {
+fn mixed_polygons_use_polygon_codes() -> TestResult {
     // A pentagon and a triangle sharing the edge (1, 2).
     let v = Vertices::from_points(&[
         [0.0, 0.0],
@@ -74,10 +84,9 @@ fn mixed_polygons_use_polygon_codes() {
         [1.0, 2.0],
         [0.0, 1.0],
         [3.0, 0.5],
-    ])
-    .unwrap();
-    let k = Complex::build(v, TopCells::polygons([vec![0, 1, 2, 3, 4], vec![1, 5, 2]])).unwrap();
-    let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
+    ])?;
+    let k = Complex::build(v, TopCells::polygons([vec![0, 1, 2, 3, 4], vec![1, 5, 2]]))?;
+    let grid = grid_topology(&k, 2, Polygons::Keep)?;
     assert_eq!(grid.uniform, None);
     assert_eq!(grid.connectivity.len(), (2 + 5) + (1 + 3));
     let pentagon: Vec<usize> = grid.connectivity[2..7]
@@ -87,10 +96,11 @@ fn mixed_polygons_use_polygon_codes() {
     assert_eq!(&grid.connectivity[..2], &[code::POLYGON, 5]);
     assert_eq!(grid.connectivity[7], code::TRIANGLE);
     assert!((shoelace(&k, &pentagon) - 3.0).abs() < 1e-12);
+    Ok(())
 }
 
 #[test]
-fn general_polyhedron_becomes_positive_tetrahedra() {
+fn general_polyhedron_becomes_positive_tetrahedra() -> TestResult {
     // A triangular prism: 2 triangles, 3 quads.
     let v = Vertices::from_points(&[
         [0.0, 0.0, 0.0],
@@ -99,8 +109,7 @@ fn general_polyhedron_becomes_positive_tetrahedra() {
         [0.0, 0.0, 1.0],
         [1.0, 0.0, 1.0],
         [0.0, 1.0, 1.0],
-    ])
-    .unwrap();
+    ])?;
     let prism = vec![
         vec![0, 2, 1],
         vec![3, 4, 5],
@@ -108,10 +117,13 @@ fn general_polyhedron_becomes_positive_tetrahedra() {
         vec![1, 2, 5, 4],
         vec![2, 0, 3, 5],
     ];
-    let k = Complex::build(v, TopCells::polyhedra([prism])).unwrap();
-    let grid = grid_topology(&k, 3, Polygons::Keep).unwrap();
+    let k = Complex::build(v, TopCells::polyhedra([prism]))?;
+    let grid = grid_topology(&k, 3, Polygons::Keep)?;
     assert_eq!(grid.uniform, Some(("Tetrahedron", 4)));
-    let ids = grid.cell_ids.clone().unwrap();
+    let ids = grid
+        .cell_ids
+        .clone()
+        .ok_or("no cell ids for a split polyhedron")?;
     assert!(ids.iter().all(|&c| c == 0));
     let volume: f64 = grid
         .connectivity
@@ -124,10 +136,11 @@ fn general_polyhedron_becomes_positive_tetrahedra() {
         })
         .sum();
     assert!((volume - 0.5).abs() < 1e-12);
+    Ok(())
 }
 
 #[test]
-fn hanging_vertices_are_triangulated_without_flat_triangles() {
+fn hanging_vertices_are_triangulated_without_flat_triangles() -> TestResult {
     // The unit square with a hanging vertex in the middle of its bottom
     // and of its right side (a neighbour on each was cut): a hexagon
     // whose fan from the corner (0, 0) would hold two flat triangles.
@@ -139,20 +152,21 @@ fn hanging_vertices_are_triangulated_without_flat_triangles() {
         [1.0, 1.0],
         [0.0, 1.0],
         [2.0, 0.0],
-    ])
-    .unwrap();
+    ])?;
     let k = Complex::build(
         v,
         TopCells::polygons([vec![0, 1, 2, 3, 4, 5], vec![2, 6, 3]]),
-    )
-    .unwrap();
-    let kept = grid_topology(&k, 2, Polygons::Keep).unwrap();
+    )?;
+    let kept = grid_topology(&k, 2, Polygons::Keep)?;
     assert_eq!(&kept.connectivity[..2], &[code::POLYGON, 6]);
     assert_eq!(kept.cell_ids, None);
 
-    let grid = grid_topology(&k, 2, Polygons::Triangulate).unwrap();
+    let grid = grid_topology(&k, 2, Polygons::Triangulate)?;
     assert_eq!(grid.uniform, Some(("Triangle", 3)));
-    let ids = grid.cell_ids.clone().unwrap();
+    let ids = grid
+        .cell_ids
+        .clone()
+        .ok_or("no cell ids for triangulated polygons")?;
     // Four triangles for the hexagon (k − 2), one for the triangle.
     assert_eq!(ids, [0, 0, 0, 0, 1]);
     let mut used = Vec::new();
@@ -174,6 +188,7 @@ fn hanging_vertices_are_triangulated_without_flat_triangles() {
         [0, 1, 2, 3, 4, 5],
         "every vertex of the hexagon is used"
     );
+    Ok(())
 }
 
 /// The sorted vertex ids of each element of a `Mixed` array, with its code.
@@ -199,13 +214,13 @@ fn mixed_elements(connectivity: &[i64]) -> Vec<(i64, Vec<usize>)> {
 }
 
 #[test]
-fn a_grid_of_several_tasks_stays_uniform_and_in_cell_order() {
+fn a_grid_of_several_tasks_stays_uniform_and_in_cell_order() -> TestResult {
     // 60 × 40 squares of side 0.05: more cells than one task builds, so
     // the grid is joined from runs. Each element must be the cell of its
     // index (same vertex set as row i of M_2) with area 0.05² > 0.
-    let k = generate::rectangle(60, 40, [0.0, 3.0], [0.0, 2.0]).unwrap();
+    let k = generate::rectangle(60, 40, [0.0, 3.0], [0.0, 2.0])?;
     assert!(k.cell_count(2) > TASK_CELLS);
-    let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
+    let grid = grid_topology(&k, 2, Polygons::Keep)?;
     assert_eq!(grid.uniform, Some(("Quadrilateral", 4)));
     assert_eq!(grid.element_count, 2400);
     assert_eq!(grid.cell_ids, None);
@@ -217,10 +232,11 @@ fn a_grid_of_several_tasks_stays_uniform_and_in_cell_order() {
         assert_eq!(sorted, k.cell_vertices(2, i), "element {i}");
         assert!((shoelace(&k, &quad) - 0.0025).abs() < 1e-12, "element {i}");
     }
+    Ok(())
 }
 
 #[test]
-fn a_kind_met_in_a_later_task_makes_the_whole_grid_mixed() {
+fn a_kind_met_in_a_later_task_makes_the_whole_grid_mixed() -> TestResult {
     // A strip of n unit squares (more than one task's cells) closed by one
     // triangle: every element, the earlier tasks' quads too, must carry
     // its code, n times 5 (quadrilateral) and once 4 (triangle).
@@ -231,12 +247,8 @@ fn a_kind_met_in_a_later_task_makes_the_whole_grid_mixed() {
     let top = |i: usize| n + 1 + i;
     let mut cells: Vec<Vec<usize>> = (0..n).map(|i| vec![i, i + 1, top(i + 1), top(i)]).collect();
     cells.push(vec![n, 2 * n + 2, top(n)]);
-    let k = Complex::build(
-        Vertices::from_points(&points).unwrap(),
-        TopCells::polygons(cells),
-    )
-    .unwrap();
-    let grid = grid_topology(&k, 2, Polygons::Keep).unwrap();
+    let k = Complex::build(Vertices::from_points(&points)?, TopCells::polygons(cells))?;
+    let grid = grid_topology(&k, 2, Polygons::Keep)?;
     assert_eq!(grid.uniform, None);
     assert_eq!(grid.element_count, n + 1);
     assert_eq!(grid.connectivity.len(), 5 * n + 4);
@@ -248,4 +260,5 @@ fn a_kind_met_in_a_later_task_makes_the_whole_grid_mixed() {
     for (i, (_, vertices)) in elements.iter().enumerate() {
         assert_eq!(vertices, k.cell_vertices(2, i), "element {i}");
     }
+    Ok(())
 }
