@@ -166,3 +166,89 @@ fn probes_outside_the_mesh_are_refused_with_their_point() {
         "{stderr}"
     );
 }
+
+/// The Hodge decomposition of the constant field F = (2, −1) on the unit
+/// square: ω = R₁F is exact (F = ∇(2x − y) and the square has β₁ = 0), so
+/// the exact part is ω and the coexact and harmonic parts vanish. The
+/// Whitney map reproduces constant 1-forms on every triangle, and the
+/// least-squares vector of a square is exact for constant fields, so a
+/// probe of `omega` and of `exact` anywhere is (2, −1) to rounding of the
+/// Poisson solve (≈ 1e-15 × cond; 1e-10 leaves room for it at h = 1/8),
+/// and the other parts are 0 to the same tolerance.
+#[test]
+fn form_probes_reproduce_a_constant_field_by_its_whitney_vector() {
+    let dir = Scratch::new("probes_forms");
+    std::fs::create_dir_all(&*dir).unwrap();
+    for (cells, method) in [
+        ("simplex", "dec-barycentric"),
+        ("cuboid", "dec-barycentric"),
+    ] {
+        let case = dir.join(format!("decomposition-{cells}.toml"));
+        std::fs::write(
+            &case,
+            format!(
+                r#"[mesh]
+generator = "rectangle"
+n = [8, 8]
+cells = "{cells}"
+
+[problem]
+kind = "hodge-decomposition"
+method = "{method}"
+field = ["2", "-1"]
+
+[[output.probe]]
+name = "inside"
+at = [0.3, 0.7]
+
+[[output.probe]]
+name = "diagonal"
+from = [0.0, 0.0]
+to = [1.0, 1.0]
+points = 5
+"#
+            ),
+        )
+        .unwrap();
+        let stem = dir.join(format!("out-{cells}"));
+        let rows = probe_rows(case.to_str().unwrap(), &stem, &[]);
+        assert_eq!(rows.len(), 6, "{rows:?}");
+        let mut name = stem.file_name().unwrap().to_os_string();
+        name.push(".probes.csv");
+        let csv = std::fs::read_to_string(stem.with_file_name(name)).unwrap();
+        let header = csv.lines().next().unwrap();
+        assert_eq!(
+            header,
+            "probe,point,x,y,omega_x,omega_y,exact_x,exact_y,coexact_x,coexact_y,harmonic_x,harmonic_y",
+            "{cells}"
+        );
+        for row in &rows {
+            let v: Vec<f64> = row[4..].iter().map(|s| s.parse().unwrap()).collect();
+            let expected = [2.0, -1.0, 2.0, -1.0, 0.0, 0.0, 0.0, 0.0];
+            for (got, want) in v.iter().zip(expected) {
+                assert!((got - want).abs() < 1e-10, "{cells}: {row:?}");
+            }
+        }
+    }
+}
+
+/// Probes of an elasticity case are refused by `hasse check` with the
+/// kinds that have them.
+#[test]
+fn probes_of_kinds_without_them_are_refused() {
+    let dir = Scratch::new("probes_refused");
+    let case = case_with(
+        &dir,
+        "cases/elasticity-square.toml",
+        "[[output.probe]]\nat = [0.5, 0.5]\n",
+    );
+    let out = hasse(&["check", &case]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(
+            "probes are evaluated for diffusion and heat problems, and for the forms of maxwell"
+        ),
+        "{stderr}"
+    );
+}

@@ -255,16 +255,28 @@ impl Case {
         if self.output.probes.is_empty() {
             return;
         }
-        if !matches!(
-            self.problem,
-            super::Problem::Diffusion(_) | super::Problem::Heat(_)
-        ) {
+        let form_degree = crate::frontend::run::probes::form_degree(&self.problem);
+        if form_degree.is_none()
+            && !matches!(
+                self.problem,
+                super::Problem::Diffusion(_) | super::Problem::Heat(_)
+            )
+        {
             collector.error(
                 None,
                 &self.output.probes[0].key,
-                "probes are evaluated for diffusion and heat problems",
+                "probes are evaluated for diffusion and heat problems, and for the forms of maxwell, hodge-laplacian, cohomology and hodge-decomposition",
                 Some("remove the [[output.probe]] tables of this case".into()),
             );
+            return;
+        }
+        // A form is probed through its proxy: a function, a vector field
+        // or a density (not, e.g., a 2-form on a 4-complex).
+        if let Some(Err(e)) = form_degree
+            .filter(|&k| k <= complex.dim())
+            .map(|k| crate::physics::forms::whitney_map::ProxyKind::of(complex, k))
+        {
+            collector.error(None, &self.output.probes[0].key, e.to_string(), None);
             return;
         }
         let locator = match crate::physics::probe::PointLocator::new(complex) {

@@ -58,7 +58,7 @@ mod hodge;
 mod maxwell;
 mod nonlinear;
 mod petsc;
-mod probes;
+pub(crate) mod probes;
 mod quantities;
 pub mod refine;
 mod restart;
@@ -158,7 +158,7 @@ pub fn solve(
     complex: &Complex,
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
-    match &case.problem {
+    let mut result = match &case.problem {
         Problem::Diffusion(spec) if spec.is_nonlinear() => {
             nonlinear::solve(case, spec, complex, phase)
         }
@@ -173,7 +173,11 @@ pub fn solve(
         Problem::Elasticity(spec) => elasticity::solve(case, spec, complex, phase),
         Problem::Coupled(spec) => coupled::solve(case, spec, complex, phase),
         Problem::Transport(spec) => transport::solve(case, spec, complex, phase),
+    }?;
+    if let Some(k) = probes::form_degree(&case.problem) {
+        probes::attach_form_probes(case, complex, k, &mut result)?;
     }
+    Ok(result)
 }
 
 /// The case's data evaluated on `complex` where the solve evaluates them

@@ -432,10 +432,11 @@ fn whitney_value(
     })
 }
 
-/// A probe of a k-cochain: the Whitney form at the point `x` of a mesh
-/// that fills its space, in the top simplex `locator` finds for it
-/// ([`crate::physics::probe::PointLocator`]); `None` outside the mesh.
-/// For a 1-cochain this is its Whitney vector at `x`.
+/// A probe of a k-cochain: its value at the point `x` of a mesh that
+/// fills its space, in the top cell `locator` finds for it
+/// ([`crate::physics::probe::PointLocator`]), by [`value_in_cell`]: on a
+/// simplex the Whitney form, so for a 1-cochain its Whitney vector at `x`;
+/// `None` outside the mesh.
 ///
 /// ```
 /// use hasse_complex::generate::{kuhn, uniform_axis};
@@ -458,9 +459,68 @@ pub fn probe(
     x: &[f64],
 ) -> Result<Option<Proxy>, FormsError> {
     match locator.locate(x) {
-        Some(cell) => interpolate(complex, k, cochain, cell, x).map(Some),
+        Some(cell) => value_in_cell(complex, k, cochain, cell, x).map(Some),
         None => Ok(None),
     }
+}
+
+/// The value at `x` of a k-cochain in top cell `cell` of any shape: the
+/// Whitney form ([`interpolate`]) on a simplex; on another cell, the
+/// function of a 0-cochain interpolated by the cell's nodal shape
+/// functions (Q1 on quadrilaterals and hexahedra, as
+/// [`crate::physics::probe::value_at`] does for nodal fields), the density
+/// c_T/|T| of an n-cochain, and for a vector proxy the cell's constant
+/// least-squares vector of [`cell_vectors`] (exact for constant fields:
+/// on a box, the mean of opposite edges or faces).
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_solver::physics::forms::whitney_map::{de_rham, value_in_cell, Field, Proxy};
+/// use hasse_solver::physics::probe::PointLocator;
+/// let k = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+/// let p = [0.3, 0.4];
+/// let cell = PointLocator::new(&k).unwrap().locate(&p).unwrap();
+/// // A constant field on squares comes back exactly.
+/// let c = de_rham(&k, 1, Field::Vector(&|_| [0.5, -2.0, 0.0])).unwrap();
+/// let Proxy::Vector(v) = value_in_cell(&k, 1, &c, cell, &p).unwrap() else { panic!() };
+/// assert!((v[0] - 0.5).abs() < 1e-14 && (v[1] + 2.0).abs() < 1e-14);
+/// // A bilinear function, by its vertex values, is reproduced by Q1.
+/// let f = de_rham(&k, 0, Field::Scalar(&|x| 1.0 + x[0] * x[1])).unwrap();
+/// let Proxy::Scalar(u) = value_in_cell(&k, 0, &f, cell, &p).unwrap() else { panic!() };
+/// assert!((u - 1.12).abs() < 1e-14);
+/// ```
+pub fn value_in_cell(
+    complex: &Complex,
+    k: usize,
+    cochain: &[f64],
+    cell: usize,
+    x: &[f64],
+) -> Result<Proxy, FormsError> {
+    let n = complex.dim();
+    if cell < complex.cell_count(n) && complex.cell_vertices(n, cell).len() == n + 1 {
+        return interpolate(complex, k, cochain, cell, x);
+    }
+    let kind = ProxyKind::of(complex, k)?;
+    check_length(complex, k, cochain)?;
+    if cell >= complex.cell_count(n) {
+        return Err(FormsError::Field(format!(
+            "top cell {cell} does not exist (the complex has {})",
+            complex.cell_count(n)
+        )));
+    }
+    Ok(match kind {
+        ProxyKind::Function => Proxy::Scalar(crate::physics::probe::value_at(
+            complex,
+            crate::metric::Location::Nodal,
+            cochain,
+            None,
+            cell,
+            x,
+        )),
+        ProxyKind::Density => Proxy::Scalar(cochain[cell] / complex.measure(n)[cell]),
+        ProxyKind::Tangent => Proxy::Vector(least_squares_vector(complex, cell, cochain)?),
+        ProxyKind::Flux => Proxy::Vector(least_squares_flux(complex, cell, cochain)?),
+    })
 }
 
 /// The vector proxy of a k-cochain (k = 1, or k = 2 on a 3-complex) per
