@@ -151,3 +151,72 @@ fn heat_with_a_conductivity_per_region_settles_on_the_two_material_profile() {
         assert!(error < 1e-12, "heat {method}: max error {error:e}");
     }
 }
+
+/// Mixed Darcy with a permeability per region (`left` = 1, `right` = 20,
+/// split at x = 1, a mesh line) and pressures 0 and 1 at the ends: the
+/// exact pressure is piecewise linear, p = 20x/21 then 20/21 + (x − 1)/21,
+/// with the same flux 20/21 in both (continuity of K p'). The mimetic and
+/// barycentric flux masses reproduce a constant flux and a cell-wise linear
+/// pressure, so both errors are rounding (ulps of p ≤ 1 times condition
+/// numbers ~ 20 · n², far below 1e-12). A cell without a permeability is
+/// refused by `hasse check` with the mesh's regions.
+#[test]
+fn darcy_takes_a_permeability_per_region() {
+    let dir = crate::scratch::Scratch::new("regions_darcy");
+    std::fs::create_dir_all(&*dir).unwrap();
+    let case = dir.join("darcy-two-materials.toml");
+    std::fs::write(
+        &case,
+        r#"[mesh]
+generator = "rectangle"
+n = [8, 4]
+x = [0, 2]
+
+[regions]
+left = "x < 1"
+right = "x > 1"
+
+[problem]
+kind = "darcy"
+method = "mimetic"
+permeability = { left = 1, right = 20 }
+source = { left = 0, default = 0 }
+
+[[boundary]]
+tag = "xmin"
+type = "pressure"
+value = 0
+
+[[boundary]]
+tag = "xmax"
+type = "pressure"
+value = 1
+
+[exact]
+solution = "if(x < 1, 20*x/21, 20/21 + (x - 1)/21)"
+gradient = ["if(x < 1, 20/21, 1/21)", "0"]
+"#,
+    )
+    .unwrap();
+    let case = case.to_str().unwrap();
+    for method in ["mimetic", "dec-barycentric"] {
+        let set = format!("problem.method=\"{method}\"");
+        let stdout = summary(case, &[&set]);
+        let error = max_error_of(case, &[&set]);
+        assert!(error < 1e-12, "{method}: max error {error:e}\n{stdout}");
+        let flux = stdout
+            .lines()
+            .find_map(|l| l.strip_prefix("flux error L2 "))
+            .and_then(|v| v.trim().parse::<f64>().ok())
+            .unwrap_or_else(|| panic!("no flux error in\n{stdout}"));
+        assert!(flux < 1e-12, "{method}: flux error {flux:e}\n{stdout}");
+    }
+    let out = hasse(&["check", case, "--set", "problem.permeability={ left = 1 }"]);
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{e}");
+    assert!(
+        e.contains("`problem.permeability`")
+            && e.contains("the mesh's tags of top cells: left, right"),
+        "{e}"
+    );
+}

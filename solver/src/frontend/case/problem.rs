@@ -770,8 +770,13 @@ impl Problem {
                     all.push(("problem.poisson".into(), poisson));
                 }
             },
+            Problem::Darcy(d) => {
+                if let Coefficient::Scalar(e) = &d.permeability {
+                    all.push(("problem.permeability".into(), e));
+                }
+                all.push(("problem.source".into(), &d.source));
+            }
             Problem::Gradient(_)
-            | Problem::Darcy(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
             | Problem::Cohomology(_)

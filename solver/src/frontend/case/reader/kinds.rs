@@ -328,28 +328,8 @@ impl Reader {
             None,
         );
         let permeability = self.coefficient(table, "permeability", scope);
-        // Darcy's flux mass takes K⁻¹ per cell from a function of position;
-        // a permeability per region is not wired into it yet.
-        let permeability = match permeability {
-            Some(Coefficient::Scalar(e)) if e.regions().is_some() => {
-                let span = self
-                    .entry(table, "problem", "permeability")
-                    .and_then(|e| e.span());
-                self.error(
-                    span,
-                    "problem.permeability",
-                    "values per region are not accepted here".to_string(),
-                    Some(format!(
-                        "{}; give one expression (`if(…)` can tell places apart)",
-                        super::REGIONAL_KEYS
-                    )),
-                );
-                None
-            }
-            other => other,
-        };
         let source = match self.entry(table, "problem", "source") {
-            Some(_) => self.expression_at(table, "problem", "source", scope),
+            Some(_) => self.expression_or_regions_at(table, "problem", "source", scope),
             None => scope.parse("0").ok(),
         };
         let boundary = self.boundary(root, scope, Conditions::Darcy);
