@@ -42,8 +42,10 @@ use crate::metric::Location;
 use crate::operator::block::{Block, BlockError, BlockSystem, Symmetry};
 use crate::operator::{BlockMetric, Canonical, CanonicalError};
 use crate::physics::diffusion::{Diffusion, DiffusionError};
+use crate::physics::regions::{RegionError, Regional};
 use crate::physics::ScalarFn;
 use hasse_complex::Complex;
+use std::sync::Arc;
 
 /// One of the two fields: a name and its diffusion problem (method, D,
 /// source, boundary conditions).
@@ -166,6 +168,25 @@ pub struct Coupled {
     pub reaction: Reaction,
     /// Direct factorisation (default LLᵀ).
     pub factorization: Factorization,
+    /// a, b or c per region of top cells, in place of the uniform ones
+    /// ([`Coupled::with_reaction_by_region`]).
+    pub reaction_by_region: Option<Arc<RegionalReaction>>,
+}
+
+/// Reaction coefficients given per region of top cells (tags): each that
+/// is `Some` replaces the function of [`Reaction`]. On cell-centred fields
+/// a cell's lumped mass takes its region's value at its centroid; on nodal
+/// fields the vertex volume Σ_c |c|/#vertices(c) is summed cell by cell,
+/// each share with its cell's region's value at the vertex, so a vertex on
+/// a region boundary mixes the regions around it by volume.
+#[derive(Clone, Default)]
+pub struct RegionalReaction {
+    /// a per region.
+    pub a: Option<Regional<ScalarFn>>,
+    /// b per region.
+    pub b: Option<Regional<ScalarFn>>,
+    /// c per region.
+    pub c: Option<Regional<ScalarFn>>,
 }
 
 /// Why a coupled problem could not be assembled or solved.
@@ -207,6 +228,14 @@ pub enum CoupledError {
         name: String,
         /// Its method's name.
         method: &'static str,
+    },
+    /// a, b or c given per region does not fit the complex's tags.
+    #[error("coupling coefficient {what}: {source}")]
+    Region {
+        /// `"a"`, `"b"` or `"c"`.
+        what: &'static str,
+        /// Why.
+        source: RegionError,
     },
     /// a, b or c is NaN or ±∞ at an unknown.
     #[error("coupling coefficient {what} is not finite at {location:?}")]
@@ -331,7 +360,14 @@ impl Coupled {
             fields: [first, second],
             reaction,
             factorization: Factorization::Llt,
+            reaction_by_region: None,
         }
+    }
+
+    /// The same problem with reaction coefficients per region.
+    pub fn with_reaction_by_region(mut self, reaction: RegionalReaction) -> Self {
+        self.reaction_by_region = Some(Arc::new(reaction));
+        self
     }
 
     /// Assemble and solve once.
@@ -421,9 +457,43 @@ impl Coupled {
                 })
                 .collect()
         };
-        let aw = coefficient(&self.reaction.a, "a")?;
-        let bw = coefficient(&self.reaction.b, "b")?;
-        let cw = coefficient(&self.reaction.c, "c")?;
+        // A coefficient per region: its lumped mass share by share.
+        let regional = |f: &Regional<ScalarFn>, what: &'static str| {
+            let pieces = f
+                .per_cell(complex)
+                .map_err(|source| CoupledError::Region { what, source })?;
+            let volume = complex.measure(n);
+            let mut out = vec![0.0; weights.len()];
+            for (c, f) in pieces.iter().enumerate() {
+                let unknowns: &[usize] = match location {
+                    Location::Nodal => complex.cell_vertices(n, c),
+                    _ => std::slice::from_ref(&c),
+                };
+                let share = volume[c] / unknowns.len() as f64;
+                for &u in unknowns {
+                    let x = points[u];
+                    let value = f(x);
+                    if !value.is_finite() {
+                        return Err(CoupledError::NonFinite {
+                            what,
+                            location: x.to_vec(),
+                        });
+                    }
+                    out[u] += share * value;
+                }
+            }
+            Ok(out)
+        };
+        let by_region = self.reaction_by_region.as_deref();
+        let pick = |uniform: &ScalarFn,
+                    per_region: Option<&Regional<ScalarFn>>,
+                    what: &'static str| match per_region {
+            Some(f) => regional(f, what),
+            None => coefficient(uniform, what),
+        };
+        let aw = pick(&self.reaction.a, by_region.and_then(|r| r.a.as_ref()), "a")?;
+        let bw = pick(&self.reaction.b, by_region.and_then(|r| r.b.as_ref()), "b")?;
+        let cw = pick(&self.reaction.c, by_region.and_then(|r| r.c.as_ref()), "c")?;
         let parts = [part(first, complex)?, part(second, complex)?];
 
         let [first_selection, second_selection] = [0, 1].map(|i| parts[i].split.selection());

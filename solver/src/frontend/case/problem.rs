@@ -750,6 +750,9 @@ impl Problem {
                 all.push(("problem.source".into(), &t.source));
             }
             Problem::Coupled(c) => {
+                for (key, e) in [("a", &c.a), ("b", &c.b), ("c", &c.c)] {
+                    all.push((format!("problem.{key}"), e));
+                }
                 for (i, f) in c.fields.iter().enumerate() {
                     let prefix = format!("field[{i}]");
                     diffusion(

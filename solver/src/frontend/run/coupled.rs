@@ -9,7 +9,7 @@ use crate::frontend::case::{Case, CoupledSpec};
 use crate::frontend::output::Cochain;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::metric::Location;
-use crate::physics::coupled::{Coupled, CoupledError, CoupledField, Reaction};
+use crate::physics::coupled::{Coupled, CoupledError, CoupledField, Reaction, RegionalReaction};
 use hasse_complex::Complex;
 use std::time::Instant;
 
@@ -38,6 +38,9 @@ fn run_error(case: &Case, spec: &CoupledSpec, e: CoupledError) -> RunError {
             message,
             Some(super::FINITE_HELP.into()),
         ),
+        CoupledError::Region { what, .. } => {
+            RunError::input_at(case, &format!("problem.{what}"), message, None)
+        }
         _ => RunError::input(case, message),
     };
     located.because(e)
@@ -62,6 +65,16 @@ pub(super) fn solve(
             c: scalar_fn(&spec.c),
         },
     );
+    if [&spec.a, &spec.b, &spec.c]
+        .iter()
+        .any(|e| e.regions().is_some())
+    {
+        problem = problem.with_reaction_by_region(RegionalReaction {
+            a: super::regional_fn(&spec.a),
+            b: super::regional_fn(&spec.b),
+            c: super::regional_fn(&spec.c),
+        });
+    }
     if let Some(f) = case.solver.factorization {
         problem.factorization = f;
     }

@@ -26,7 +26,7 @@ impl Reader {
         scope: &Scope,
     ) -> Option<Problem> {
         let coefficient = |reader: &mut Self, key: &str| match reader.entry(table, "problem", key) {
-            Some(_) => reader.expression_at(table, "problem", key, scope),
+            Some(_) => reader.expression_or_regions_at(table, "problem", key, scope),
             None => {
                 reader.error(
                     header.clone(),

@@ -648,7 +648,7 @@ pub(super) fn format_number(v: f64) -> String {
 }
 
 /// Where values per region are accepted, as messages say it.
-pub(super) const REGIONAL_KEYS: &str = "values per region are accepted by the conductivity and source of diffusion and heat problems (and of coupled fields), the permeability and source of Darcy problems and the Lamé parameters of elasticity";
+pub(super) const REGIONAL_KEYS: &str = "values per region are accepted by the conductivity and source of diffusion and heat problems (and of coupled fields, and their reaction coefficients a, b, c), the permeability and source of Darcy problems and the Lamé parameters of elasticity";
 
 pub(super) fn expression_help(e: &ExprError, scope: &Scope) -> String {
     match e {
