@@ -255,7 +255,8 @@ fn relative_harmonic_form_of_the_annulus() -> Result {
 /// summary prints it with 11 significant digits.
 #[test]
 fn relative_hollow_box_case_counts_lefschetz_duals() -> Result {
-    for (k, count, dual) in [(0, 0, 0), (1, 1, 2), (2, 0, 1), (3, 1, 0)] {
+    for (k, count) in [(0, 0), (1, 1), (2, 0), (3, 1)] {
+        let dual = 3 - k;
         let degree = format!("problem.degree={k}");
         let out = summary("cases/cohomology-relative-hollow-box.toml", &[&degree]);
         assert!(
