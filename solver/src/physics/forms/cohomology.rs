@@ -454,9 +454,12 @@ impl Forms<'_> {
     }
 
     /// [`Forms::exact_part`] with a boundary condition: `Essential` holds α
-    /// = 0 on the boundary's vertices (the relative complex), so the exact
-    /// part vanishes on the boundary's edges, and pins a vertex only in
-    /// components without boundary.
+    /// = 0 on the boundary's (k−1)-cells (the relative complex), so the
+    /// exact part vanishes on the boundary's k-cells. For k = 1 it pins a
+    /// vertex only in components without boundary; for k ≥ 2 it holds α = 0
+    /// also off a set of interior (k−1)-cells whose columns of the
+    /// restricted d_{k−1} are a basis of its image (the relative
+    /// reduction), which makes the solve definite.
     pub fn exact_part_with(
         &self,
         k: usize,
@@ -587,13 +590,14 @@ impl Forms<'_> {
     /// use hasse_complex::{dual::DualKind, generate::hollow_box};
     /// use hasse_solver::physics::forms::{Boundary, Forms, Star};
     /// // Box with a cavity: β(K, ∂K) = (0, 1, 0, 1), Lefschetz dual to β = (1, 0, 1, 0).
-    /// let k = hollow_box(3, [1, 2]).unwrap();
+    /// let k = hollow_box(3, [1, 2])?;
     /// let forms = Forms::new(&k, Star::Diagonal(DualKind::Barycentric));
     /// for (degree, count) in [(0, 0), (1, 1), (2, 0), (3, 1)] {
-    ///     let basis = forms.harmonic_basis_with(degree, Boundary::Essential).unwrap();
+    ///     let basis = forms.harmonic_basis_with(degree, Boundary::Essential)?;
     ///     assert_eq!((basis.forms.len(), basis.betti), (count, count));
     ///     assert!(basis.closed.iter().chain(&basis.coclosed).all(|r| *r < 1e-12));
     /// }
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```
     pub fn harmonic_basis_with(
         &self,

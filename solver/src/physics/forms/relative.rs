@@ -23,12 +23,13 @@
 //! use hasse_solver::physics::forms::relative_cocycle_generators;
 //! // A box with a cavity (β = 1, 0, 1, 0): β₁(K, ∂K) = β₂(K) = 1, the
 //! // class of a path from the cavity to the outer surface.
-//! let k = hollow_box(3, [1, 2]).unwrap();
-//! let generators = relative_cocycle_generators(&k, 1).unwrap();
+//! let k = hollow_box(3, [1, 2])?;
+//! let generators = relative_cocycle_generators(&k, 1)?;
 //! assert_eq!(generators.len(), 1);
 //! // It vanishes on the boundary's edges.
 //! let wall = k.boundary_subcomplex();
 //! assert!((0..k.cell_count(1)).all(|e| !wall.contains(1, e) || generators[0][e] == 0.0));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 use super::reduction::{self, Coboundaries};
