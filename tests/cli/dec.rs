@@ -173,9 +173,9 @@ fn sphere_decomposition_is_orthogonal() -> Result {
     Ok(())
 }
 
-/// The Whitney star of a decomposition, an `[exact]` table for
-/// cohomology and a field of the wrong dimension are refused by `hasse
-/// check` (exit 2) at their keys.
+/// The Whitney star of a decomposition, an `[exact]` or `[[boundary]]`
+/// table for cohomology and a field of the wrong dimension are refused by
+/// `hasse check` (exit 2) at their keys.
 #[test]
 fn check_refuses_what_is_not_computed() -> Result {
     let refused = [
@@ -188,6 +188,11 @@ fn check_refuses_what_is_not_computed() -> Result {
             "cases/cohomology-torus.toml",
             vec!["exact.solution=\"0\""],
             "`exact`: kind = \"cohomology\" compares with no exact solution",
+        ),
+        (
+            "cases/cohomology-relative-hollow-box.toml",
+            vec!["boundary=[{tag=\"outer\", type=\"dirichlet\", value=0}]"],
+            "`boundary`: kind = \"cohomology\" takes no [[boundary]] tables: its one condition holds on the whole boundary and is `problem.boundary`",
         ),
         (
             "cases/hodge-decomposition-sphere.toml",

@@ -46,9 +46,13 @@ impl Reader {
             self.error(
                 k.span(),
                 "boundary",
-                format!("kind = \"{kind}\" takes no boundary conditions (absolute conditions: no cochain is constrained)"),
+                if kind == "cohomology" {
+                    "kind = \"cohomology\" takes no [[boundary]] tables: its one condition holds on the whole boundary and is `problem.boundary` (natural: absolute, nothing constrained; essential: relative, the forms vanish on the boundary)".to_string()
+                } else {
+                    format!("kind = \"{kind}\" takes no boundary conditions (absolute conditions: no cochain is constrained)")
+                },
                 Some(if kind == "cohomology" {
-                    "remove the [[boundary]] tables; for relative classes (forms vanishing on the whole boundary) set boundary = \"essential\" under [problem]".into()
+                    "remove the [[boundary]] tables; for relative classes set boundary = \"essential\" under [problem]".into()
                 } else {
                     "remove the [[boundary]] tables".into()
                 }),
