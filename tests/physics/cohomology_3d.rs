@@ -51,7 +51,7 @@ const ROUNDING: f64 = 1e-12;
 /// A box of `n` × `n` × `layers` unit cubes with the cubes whose (i, j)
 /// lie in `hole` × `hole` removed through every layer: a tunnel along z,
 /// so the solid is a thickened circle, β = (1, 1, 0, 0).
-fn tunnel_box(n: usize, layers: usize, hole: std::ops::Range<usize>) -> Result<Complex> {
+pub(crate) fn tunnel_box(n: usize, layers: usize, hole: std::ops::Range<usize>) -> Result<Complex> {
     let index = |i: usize, j: usize, k: usize| i + (n + 1) * (j + (n + 1) * k);
     let mut coords = Vec::new();
     for k in 0..=layers {

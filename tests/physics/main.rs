@@ -11,6 +11,7 @@
 mod orders;
 
 mod cohomology_3d;
+mod cohomology_relative;
 mod converge;
 mod converge_any;
 mod coupled;

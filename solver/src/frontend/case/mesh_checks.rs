@@ -10,8 +10,8 @@ use hasse_complex::Complex;
 
 impl Case {
     /// A DEC kind's degree must be at most the mesh's dimension (cohomology
-    /// generators are computed for every degree; relative ones for degree 1
-    /// on 2-dimensional meshes), and the
+    /// generators, absolute and relative, are computed for every degree),
+    /// and the
     /// circumcentric and Whitney stars need simplices. Only these kinds
     /// measure a periodic mesh unwrapped.
     pub(super) fn check_hodge(&self, complex: &Complex, collector: &mut Collector) {
@@ -60,16 +60,6 @@ impl Case {
                         "k-forms live on k-cells; choose a degree from 0 to {n}"
                     )),
                 );
-            } else if let Problem::Cohomology(spec) = &self.problem {
-                let relative = spec.boundary == crate::physics::forms::Boundary::Essential;
-                if relative && !(degree == 1 && n == 2) {
-                    collector.error(
-                        span.clone(),
-                        "problem.degree",
-                        format!("relative (essential) harmonic forms are computed for degree 1 on 2-dimensional meshes, not degree {degree} on a {n}-dimensional one"),
-                        Some("use boundary = \"natural\", or degree 1 on a surface or planar mesh".into()),
-                    );
-                }
             }
         }
         if matches!(self.problem, Problem::Decomposition(_)) && n != 2 {

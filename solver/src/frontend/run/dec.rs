@@ -89,6 +89,18 @@ pub(super) fn cohomology(
         Boundary::Natural => format!("β_{k}"),
         Boundary::Essential => format!("β_{k}(K, ∂K)"),
     };
+    // An independent figure for relative classes: on an orientable
+    // n-manifold with boundary Lefschetz duality gives β_k(K, ∂K) =
+    // β_{n−k}(K), from the absolute ranks (a different matrix rank).
+    let n = complex.dim();
+    let lefschetz = match spec.boundary {
+        Boundary::Natural => String::new(),
+        Boundary::Essential => format!(
+            " (Lefschetz duality on an orientable manifold: β_{} = {})",
+            n - k,
+            complex.betti_numbers().get(n - k).copied().unwrap_or(0)
+        ),
+    };
     let seconds = started.elapsed().as_secs_f64();
     let count = basis.forms.len();
     let mut warnings = Vec::new();
@@ -159,7 +171,7 @@ pub(super) fn cohomology(
         (
             "cohomology".to_string(),
             format!(
-                "{count} harmonic {k}-forms from {count} cocycle generators, {betti_name} = {}{}",
+                "{count} harmonic {k}-forms from {count} cocycle generators, {betti_name} = {}{}{lefschetz}",
                 basis.betti,
                 if count == basis.betti {
                     ""

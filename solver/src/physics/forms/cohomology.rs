@@ -31,11 +31,16 @@
 //!   h = ⋆_n⁻¹ z / ⟨z, ⋆_n⁻¹ z⟩, the normalised volume form (co-closed:
 //!   dᵀ ⋆ h ∝ ∂z = 0). On a component with boundary H^n is zero.
 //!
-//! Relative classes, H¹(K, ∂K) for k = 1 on a 2-complex
-//! ([`Forms::harmonic_basis_with`] and [`Boundary::Essential`]), come from
-//! the same construction with the boundary's vertices as one ground node
-//! of the tree and the boundary's edges held at 0; their harmonic forms
-//! vanish on the boundary and are co-closed at the interior vertices.
+//! Relative classes, Hᵏ(K, ∂K) ([`Forms::harmonic_basis_with`] and
+//! [`Boundary::Essential`]), every degree: for k = 1 on a surface or
+//! planar 2-complex the same tree–cotree with the boundary's vertices as
+//! one ground node of the tree and the boundary's edges held at 0; for
+//! every other (k, n) the integer reduction of the relative coboundaries
+//! (`relative.rs`). Their harmonic forms h = z − dα (α a relative
+//! (k−1)-cochain, 0 on the boundary) vanish on the boundary and are
+//! co-closed at the interior (k−1)-cells; for k = n that makes ⋆h
+//! constant over each component with boundary (a multiple of the volume
+//! form: h_σ = |σ|/|K| on the diagonal star).
 //!
 //! - Every other degree (k = 1 and 2 on 3-complexes, k = 1 on 2-complexes
 //!   that are not surfaces): integer column reduction of the coboundary
@@ -449,9 +454,12 @@ impl Forms<'_> {
     }
 
     /// [`Forms::exact_part`] with a boundary condition: `Essential` holds α
-    /// = 0 on the boundary's vertices (the relative complex), so the exact
-    /// part vanishes on the boundary's edges, and pins a vertex only in
-    /// components without boundary.
+    /// = 0 on the boundary's (k−1)-cells (the relative complex), so the
+    /// exact part vanishes on the boundary's k-cells. For k = 1 it pins a
+    /// vertex only in components without boundary; for k ≥ 2 it holds α = 0
+    /// also off a set of interior (k−1)-cells whose columns of the
+    /// restricted d_{k−1} are a basis of its image (the relative
+    /// reduction), which makes the solve definite.
     pub fn exact_part_with(
         &self,
         k: usize,
@@ -488,17 +496,26 @@ impl Forms<'_> {
                 .into_iter()
                 .map(|independent| !independent)
                 .collect(),
-            (_, Boundary::Essential) => {
-                return Err(FormsError::Cohomology(format!(
-                    "the relative (essential) exact part is computed for 1-cochains, not for degree {k}"
-                )))
-            }
+            // The same in the relative complex: α is 0 on the boundary's
+            // (k−1)-cells and off a basis of im δ^{k−1}_rel.
+            (_, Boundary::Essential) => super::relative::relative_gauge(complex, k)?,
         };
         if k >= 2 && self.star.is_diagonal() {
             // A zero weight (a dual edge of length 0, e.g. inside a cube of
             // Kuhn tetrahedra with the circumcentric dual) leaves the gauged
-            // operator singular: name the star rather than the solve.
-            self.positive_diagonal(k, None, "the harmonic projection dᵀ⋆d α = dᵀ⋆c")?;
+            // operator singular: name the star rather than the solve. With
+            // essential conditions only the interior k-cells' weights enter
+            // (d α vanishes on the boundary's k-cells).
+            let interior: Vec<usize>;
+            let cells = match boundary {
+                Boundary::Natural => None,
+                Boundary::Essential => {
+                    let wall = super::relative::wall_mask(complex, k);
+                    interior = (0..wall.len()).filter(|&c| !wall[c]).collect();
+                    Some(interior.as_slice())
+                }
+            };
+            self.positive_diagonal(k, cells, "the harmonic projection dᵀ⋆d α = dᵀ⋆c")?;
         }
         let split = FixedSplit::from_mask(pinned);
         let lower = complex.coboundary(k - 1);
@@ -558,10 +575,30 @@ impl Forms<'_> {
     }
 
     /// [`Forms::harmonic_basis`] with a boundary condition: `Essential`
-    /// (relative: the forms vanish on the boundary's edges) is computed
-    /// for k = 1 on 2-complexes, from the relative tree–cotree cocycles
-    /// of H¹(K, ∂K), and the count is the relative Betti number; the
-    /// co-closedness residual is then measured at the interior vertices.
+    /// (relative: the forms vanish on the boundary subcomplex's k-cells)
+    /// for every degree, one per class of Hᵏ(K, ∂K): the relative
+    /// tree–cotree cocycles for k = 1 on a surface or planar 2-complex,
+    /// the relative integer reduction
+    /// ([`super::relative_cocycle_generators`]) otherwise, each made
+    /// harmonic by h = z − dα with α a relative (k−1)-cochain (0 on ∂K).
+    /// The count must equal the relative Betti number β_k(K, ∂K) (from
+    /// ranks over Q of the restricted coboundaries, a separate
+    /// computation), and the co-closedness residual is measured at the
+    /// interior (k−1)-cells, where the equations dᵀ⋆h = 0 hold.
+    ///
+    /// ```
+    /// use hasse_complex::{dual::DualKind, generate::hollow_box};
+    /// use hasse_solver::physics::forms::{Boundary, Forms, Star};
+    /// // Box with a cavity: β(K, ∂K) = (0, 1, 0, 1), Lefschetz dual to β = (1, 0, 1, 0).
+    /// let k = hollow_box(3, [1, 2])?;
+    /// let forms = Forms::new(&k, Star::Diagonal(DualKind::Barycentric));
+    /// for (degree, count) in [(0, 0), (1, 1), (2, 0), (3, 1)] {
+    ///     let basis = forms.harmonic_basis_with(degree, Boundary::Essential)?;
+    ///     assert_eq!((basis.forms.len(), basis.betti), (count, count));
+    ///     assert!(basis.closed.iter().chain(&basis.coclosed).all(|r| *r < 1e-12));
+    /// }
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn harmonic_basis_with(
         &self,
         k: usize,
@@ -571,19 +608,17 @@ impl Forms<'_> {
         let complex = self.complex;
         let n = complex.dim();
         let relative = boundary == Boundary::Essential;
-        if relative && !(k == 1 && n == 2) {
-            return Err(FormsError::Cohomology(format!(
-                "relative (essential) harmonic forms are computed for degree 1 on 2-complexes, not degree {k} on a {n}-complex"
-            )));
-        }
-        let generators = if relative {
+        let generators = if !relative {
+            cocycle_generators(complex, k)?
+        } else if k == 1 && n == 2 && is_surface(complex) {
             tree_cotree(complex, true)?
         } else {
-            cocycle_generators(complex, k)?
+            super::relative::relative_cocycle_generators(complex, k)?
         };
         let forms: Vec<Vec<f64>> = if k == 0 {
+            // No (−1)-cochains: a closed 0-cochain is its own harmonic form.
             generators.clone()
-        } else if k == n {
+        } else if k == n && !relative {
             // h = ⋆⁻¹ z / ⟨z, ⋆⁻¹ z⟩: ⋆_n is SPD (diagonal for every star
             // here, one block per cell), solved as the operator Iᵀ ⋆ I.
             let mass =
@@ -608,6 +643,13 @@ impl Forms<'_> {
         };
         let d = self.d(k)?;
         let star = self.star(k)?;
+        // Only interior (k−1)-cells carry the co-closedness equation under
+        // essential conditions.
+        let lower_wall = if relative && k > 0 {
+            super::relative::wall_mask(complex, k - 1)
+        } else {
+            Vec::new()
+        };
         let mut closed = Vec::new();
         let mut coclosed = Vec::new();
         for h in &forms {
@@ -618,15 +660,11 @@ impl Forms<'_> {
             } else {
                 let weighted = star.apply(h);
                 let mut divergence = multiply_transpose(&*self.d(k - 1)?, &weighted);
-                if relative {
-                    // Only interior (k−1)-cells carry the equation.
-                    let (ground, _) = wall_masks(complex);
-                    divergence
-                        .iter_mut()
-                        .zip(ground)
-                        .filter(|(_, wall)| *wall)
-                        .for_each(|(v, _)| *v = 0.0);
-                }
+                divergence
+                    .iter_mut()
+                    .zip(&lower_wall)
+                    .filter(|(_, wall)| **wall)
+                    .for_each(|(v, _)| *v = 0.0);
                 max_abs(&divergence) / max_abs(&weighted).max(f64::MIN_POSITIVE)
             });
         }

@@ -343,6 +343,19 @@ impl HodgeLaplacian {
     /// [`FormModes::kernel`].
     pub fn modes(&self, count: usize, options: &Options) -> Result<FormModes, FormsError> {
         let available = self.unknowns();
+        if available == 0 {
+            // Essential conditions on a complex whose k-cells all lie on
+            // the boundary (e.g. a solid one cell thick): no relative
+            // k-cochains, so the spectrum and the kernel are empty, as
+            // β_k(K, ∂K) = 0 says.
+            return Ok(FormModes {
+                eigenvalues: Vec::new(),
+                fields: Vec::new(),
+                harmonic: Vec::new(),
+                kernel: 0,
+                residuals: Vec::new(),
+            });
+        }
         let wanted = (count + self.betti).min(available);
         let project = |z: &mut [f64]| -> Result<(), crate::la::direct::SolveError> {
             if let Some((factor, coupling)) = &self.constraint {

@@ -9,6 +9,7 @@
 //! | [`Forms::codifferential`] | δ_k = ⋆_{k−1}⁻¹ d_{k−1}ᵀ ⋆_k (diagonal stars) | canonical coupling d_{k−1}ᵀ ⋆_k, scaled by 1/⋆_{k−1} |
 //! | [`Forms::hodge_laplacian`] | Δ_k as the pencil (K, M) | [`laplacian::HodgeLaplacian`] |
 //! | [`Forms::harmonic_basis`] | harmonic k-forms, one per cohomology class | integer cocycles ([`cohomology`]) made harmonic by one Poisson solve |
+//! | [`Forms::harmonic_basis_with`] | the same for Hᵏ(K, ∂K) (essential conditions) | relative integer cocycles ([`relative`]), α = 0 on the boundary |
 //! | [`Forms::hodge_decomposition`] | ω = dα + δβ + h for 1-cochains on 2-complexes | two Poisson solves ([`decomposition`]) |
 //! | [`whitney_map::de_rham`], [`whitney_map::interpolate`] | fields ↔ cochains | quadrature over k-cells; Whitney forms |
 //!
@@ -33,11 +34,13 @@ pub mod cohomology;
 pub mod decomposition;
 pub mod laplacian;
 mod reduction;
+pub mod relative;
 pub mod whitney_map;
 
 pub use cohomology::{cocycle_generators, ExactPart, HarmonicBasis};
 pub use decomposition::Decomposition;
 pub use laplacian::{Boundary, FormModes, HodgeLaplacian};
+pub use relative::relative_cocycle_generators;
 
 use crate::la::direct::SolveError;
 use crate::la::eigen::EigenError;

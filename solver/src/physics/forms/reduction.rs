@@ -41,6 +41,7 @@
 use super::FormsError;
 use hasse_complex::Complex;
 use sprs::CsMat;
+use std::sync::Arc;
 
 /// A sparse integer column: (row, value), rows increasing, values nonzero.
 type Column = Vec<(usize, i64)>;
@@ -178,28 +179,59 @@ pub(super) fn reduce(
     })
 }
 
-/// δᵏ of the complex, or the empty 0 × |K_n| matrix for k = n.
-fn coboundary(complex: &Complex, k: usize) -> CsMat<i8> {
-    if k >= complex.dim() {
-        CsMat::zero((0, complex.cell_count(k)))
-    } else {
-        (**complex.coboundary(k)).clone()
+/// The coboundaries δ⁰ … δⁿ of a cochain complex as integer matrices
+/// (δᵖ: (p+1)-cells × p-cells; δⁿ the empty 0 × |K_n|): the complex's own
+/// (absolute cochains) or restricted to the cells off the boundary
+/// subcomplex (relative cochains, `relative.rs`). The reduction reads
+/// only these, so both cohomologies come from the same code.
+pub(super) struct Coboundaries(Vec<Arc<CsMat<i8>>>);
+
+impl Coboundaries {
+    /// δ⁰ … δⁿ of the complex itself (shared, no copy).
+    pub(super) fn absolute(complex: &Complex) -> Self {
+        let n = complex.dim();
+        Self(
+            (0..=n)
+                .map(|p| {
+                    if p == n {
+                        Arc::new(CsMat::zero((0, complex.cell_count(n))))
+                    } else {
+                        Arc::clone(complex.coboundary(p))
+                    }
+                })
+                .collect(),
+        )
+    }
+
+    /// Given matrices, δ⁰ … δⁿ in order; δᵖ must have as many columns as
+    /// δ^{p−1} has rows (checked by the caller that builds them).
+    pub(super) fn new(matrices: Vec<CsMat<i8>>) -> Self {
+        Self(matrices.into_iter().map(Arc::new).collect())
+    }
+
+    /// δᵖ (p ≤ n).
+    fn delta(&self, p: usize) -> &CsMat<i8> {
+        // Every caller has p ≤ n (degrees are checked before); clamping
+        // keeps a wrong degree from panicking (δⁿ has no rows, so nothing
+        // above n is ever reduced).
+        let last = self.0.len().saturating_sub(1);
+        &self.0[p.min(last)]
+    }
+
+    /// How many p-cells the cochain complex has.
+    fn cells(&self, p: usize) -> usize {
+        self.delta(p).cols()
     }
 }
 
 /// The reduction of δ^{k−1} with clearing from the degrees below: which
 /// k-cells are paired, and which (k−1)-cells have independent columns.
 /// None for k = 0.
-pub(super) fn reduce_below(complex: &Complex, k: usize) -> Result<Option<Reduction>, FormsError> {
+fn reduce_below(deltas: &Coboundaries, k: usize) -> Result<Option<Reduction>, FormsError> {
     let mut last: Option<Reduction> = None;
     for p in 0..k {
         let skip = last.as_ref().map(|r| r.paired.clone()).unwrap_or_default();
-        last = Some(reduce(
-            &coboundary(complex, p),
-            complex.cell_count(p + 1),
-            &skip,
-            false,
-        )?);
+        last = Some(reduce(deltas.delta(p), deltas.cells(p + 1), &skip, false)?);
     }
     Ok(last)
 }
@@ -207,14 +239,20 @@ pub(super) fn reduce_below(complex: &Complex, k: usize) -> Result<Option<Reducti
 /// Integer cocycles of a basis of Hᵏ(K; Q), any degree, any complex (see
 /// the module docs); each is verified closed in integers.
 pub(super) fn cocycles(complex: &Complex, k: usize) -> Result<Vec<Vec<f64>>, FormsError> {
-    let cells = complex.cell_count(k);
-    let paired = reduce_below(complex, k)?
+    cocycles_of(&Coboundaries::absolute(complex), k)
+}
+
+/// Integer cocycles of a basis of Hᵏ of the cochain complex `deltas`, as
+/// cochains on its k-cells; each is verified closed in integers.
+pub(super) fn cocycles_of(deltas: &Coboundaries, k: usize) -> Result<Vec<Vec<f64>>, FormsError> {
+    let cells = deltas.cells(k);
+    let paired = reduce_below(deltas, k)?
         .map(|r| r.paired)
         .unwrap_or_else(|| vec![false; cells]);
-    let delta = coboundary(complex, k);
+    let delta = deltas.delta(k);
     let rows = delta.rows();
-    let reduction = reduce(&delta, rows, &paired, true)?;
-    let full = columns(&delta);
+    let reduction = reduce(delta, rows, &paired, true)?;
+    let full = columns(delta);
     reduction
         .cycles
         .into_iter()
@@ -250,7 +288,12 @@ pub(super) fn cocycles(complex: &Complex, k: usize) -> Result<Vec<Vec<f64>>, For
 /// (k ≥ 1): holding α = 0 on the others makes d_{k−1}ᵀ ⋆ d_{k−1} definite
 /// without changing the exact part d α it can reach.
 pub(super) fn exact_gauge(complex: &Complex, k: usize) -> Result<Vec<bool>, FormsError> {
-    Ok(reduce_below(complex, k)?
+    exact_gauge_of(&Coboundaries::absolute(complex), k)
+}
+
+/// [`exact_gauge`] of the cochain complex `deltas`, on its (k−1)-cells.
+pub(super) fn exact_gauge_of(deltas: &Coboundaries, k: usize) -> Result<Vec<bool>, FormsError> {
+    Ok(reduce_below(deltas, k)?
         .map(|r| r.independent)
         .unwrap_or_default())
 }

@@ -30,8 +30,9 @@ impl Reader {
         (method, span)
     }
 
-    /// Refuse `[[boundary]]` tables (these kinds use absolute, natural,
-    /// conditions only) and `[exact]` (nothing is compared with it).
+    /// Refuse `[[boundary]]` tables (these kinds constrain no tagged
+    /// boundary: cohomology takes its one condition from
+    /// `problem.boundary`) and `[exact]` (nothing is compared with it).
     fn refuse_boundary_tables(&mut self, root: &dyn TableLike, kind: &str) {
         if let Some((k, _)) = root.get_key_value("exact") {
             self.error(
@@ -45,8 +46,16 @@ impl Reader {
             self.error(
                 k.span(),
                 "boundary",
-                format!("kind = \"{kind}\" takes no boundary conditions (absolute conditions: no cochain is constrained)"),
-                Some("remove the [[boundary]] tables".into()),
+                if kind == "cohomology" {
+                    "kind = \"cohomology\" takes no [[boundary]] tables: its one condition holds on the whole boundary and is `problem.boundary` (natural: absolute, nothing constrained; essential: relative, the forms vanish on the boundary)".to_string()
+                } else {
+                    format!("kind = \"{kind}\" takes no boundary conditions (absolute conditions: no cochain is constrained)")
+                },
+                Some(if kind == "cohomology" {
+                    "remove the [[boundary]] tables; for relative classes set boundary = \"essential\" under [problem]".into()
+                } else {
+                    "remove the [[boundary]] tables".into()
+                }),
             );
         }
     }
@@ -63,7 +72,7 @@ impl Reader {
             "degree",
             0,
             header,
-            "the degree k of the harmonic forms, 0 to the mesh's dimension (1 or 2 on a 3-dimensional mesh)",
+            "the degree k of the harmonic forms, 0 to the mesh's dimension (absolute or, with boundary = \"essential\", relative)",
         );
         let boundary = self.choice(
             table,
