@@ -203,7 +203,10 @@ pub(super) fn check(
     let (wanted, help) = if proxy.is_vector() {
         (d, format!("give {d} expressions, one per coordinate"))
     } else {
-        (1, "give one expression (a string), not an array".to_string())
+        (
+            1,
+            "give one expression (a string), not an array".to_string(),
+        )
     };
     if spec.field.len() != wanted {
         return Err(RunError::input_at(
@@ -314,9 +317,11 @@ pub(super) fn decomposition(
             "the parts are ⋆-orthogonal only to {worst:.1e} of ‖ω‖², above {RESIDUAL_WARNING:.0e}"
         ));
     }
-    let mut fields = vec![Cochain::new("omega", k, omega.clone()).with_description(format!(
-        "ω = R_{k}F, the de Rham cochain of the field on the {k}-cells"
-    ))];
+    let mut fields = vec![
+        Cochain::new("omega", k, omega.clone()).with_description(format!(
+            "ω = R_{k}F, the de Rham cochain of the field on the {k}-cells"
+        )),
+    ];
     fields.extend(vector_fields(case, complex, k, "omega", &omega, "ω")?);
     let descriptions = [
         "the exact part dα",
@@ -331,10 +336,8 @@ pub(super) fn decomposition(
     // γ for k < n).
     if k >= 1 {
         fields.push(
-            Cochain::new("potential", k - 1, split.potential.clone()).with_description(format!(
-                "α on the {}-cells, exact part = dα",
-                k - 1
-            )),
+            Cochain::new("potential", k - 1, split.potential.clone())
+                .with_description(format!("α on the {}-cells, exact part = dα", k - 1)),
         );
     }
     if k < n {
@@ -404,7 +407,7 @@ pub(super) fn decomposition(
         flux_error: None,
         relative_residual: Some(worst),
         factorization: Some(if mixed {
-            Factorization::Lblt
+            Factorization::Lu
         } else {
             Factorization::Llt
         }),

@@ -109,7 +109,7 @@ impl Reader {
         let field = match self.entry(table, "problem", "field") {
             Some(e) if e.item.as_array().is_some() => self.expression_list(&e, scope),
             Some(e) => self
-                .expression_of(&e.item, "problem.field", e.span(), scope)
+                .expression_of(e.item, "problem.field", e.span(), scope)
                 .map(|f| vec![f]),
             None => {
                 self.error(

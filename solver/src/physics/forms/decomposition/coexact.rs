@@ -41,8 +41,8 @@
 //! q = ⋆_k⁻¹ d_kᵀ γ and d_k ⋆_k⁻¹ d_kᵀ γ = d_k ω, the canonical operator
 //! A = ∂_{k+1} E, Ω = ⋆_k⁻¹, factored by LLᵀ ([`CoexactSolve::Eliminated`]).
 //! Otherwise (the Whitney mass, or on request) the block system above is
-//! factored whole by LBLᵀ (Bunch–Kaufman, symmetric indefinite) and never
-//! inverts M_k ([`CoexactSolve::Mixed`]). Both take one step of iterative
+//! factored whole by sparse LU with partial pivoting and never inverts
+//! M_k ([`CoexactSolve::Mixed`]). Both take one step of iterative
 //! refinement on their residual.
 
 use super::super::cohomology::{multiply, multiply_transpose, top_cycles};
@@ -63,7 +63,8 @@ pub enum CoexactSolve {
     /// d_k ⋆_k⁻¹ d_kᵀ γ = d_k ω; needs a diagonal star, positive on every
     /// k-cell.
     Eliminated,
-    /// The saddle-point block system [[M_k, −d_kᵀ], [−d_k, 0]]; any star.
+    /// The saddle-point block system [[M_k, −d_kᵀ], [−d_k, 0]] by sparse
+    /// LU; any star.
     Mixed,
 }
 
@@ -152,7 +153,8 @@ impl Forms<'_> {
         let up = complex.cell_count(k + 1);
         let mass = Canonical::new(CsMat::<i8>::eye(cells), self.star(k)?)?;
         // −d_kᵀ E as Aᵀ Ω B: A = d_k, Ω = −I on the (k+1)-cells, B = E.
-        let coupling = Canonical::coupling(d, BlockMetric::diagonal(&vec![-1.0; up]), split.selection())?;
+        let coupling =
+            Canonical::coupling(d, BlockMetric::diagonal(&vec![-1.0; up]), split.selection())?;
         let mut system = BlockSystem::new(
             &[cells, free],
             Symmetry::Symmetric,
@@ -161,15 +163,21 @@ impl Forms<'_> {
                 (0, 1, Block::Canonical(coupling)),
             ],
         )?;
-        let factor = system.factorize(Factorization::Lblt)?;
-        let rhs: Vec<f64> = std::iter::repeat(0.0)
-            .take(cells)
+        // LU with partial pivoting: faer's LBLᵀ pivots only inside a
+        // supernode, and the fill-reducing ordering puts γ unknowns (zero
+        // diagonal) where no partner is at hand: it reported a singular
+        // pivot on every mesh tried, while the system is not singular.
+        let factor = system.factorize(Factorization::Lu)?;
+        let rhs: Vec<f64> = std::iter::repeat_n(0.0, cells)
             .chain(split.restrict(&curl).iter().map(|v| -v))
             .collect();
         // K x for x = (q, γ_E): (M q − d_kᵀ γ, −E ᵀ d_k q).
         let apply = |x: &[f64]| -> Vec<f64> {
             let (q, gamma) = x.split_at(cells);
-            let top = subtract(&mass.apply(q), &multiply_transpose(d, &split.lift(gamma, &[])));
+            let top = subtract(
+                &mass.apply(q),
+                &multiply_transpose(d, &split.lift(gamma, &[])),
+            );
             let bottom = split.restrict(&multiply(d, q));
             top.into_iter().chain(bottom.iter().map(|v| -v)).collect()
         };
