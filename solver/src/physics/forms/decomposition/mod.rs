@@ -109,16 +109,19 @@ impl Forms<'_> {
     /// use hasse_complex::generate::{kuhn, uniform_axis};
     /// use hasse_solver::physics::forms::whitney_map::{de_rham, Field};
     /// use hasse_solver::physics::forms::{Forms, Star};
-    /// let x = uniform_axis(3, 0.0, 1.0).unwrap();
-    /// let k = kuhn(&[x.clone(), x.clone(), x]).unwrap();
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// let x = uniform_axis(3, 0.0, 1.0)?;
+    /// let k = kuhn(&[x.clone(), x.clone(), x])?;
     /// let forms = Forms::new(&k, Star::Whitney);
     /// // The flux of a gradient through the faces: a 2-form with d ω = 0
     /// // wherever div F = 0; here F = ∇(x² − y²), harmonic, so ω is closed.
-    /// let omega = de_rham(&k, 2, Field::Vector(&|p| [2.0 * p[0], -2.0 * p[1], 0.0])).unwrap();
-    /// let parts = forms.decompose(2, &omega).unwrap();
+    /// let omega = de_rham(&k, 2, Field::Vector(&|p| [2.0 * p[0], -2.0 * p[1], 0.0]))?;
+    /// let parts = forms.decompose(2, &omega)?;
     /// // Closed: the coexact part (the one d sees) vanishes.
     /// let scale = omega.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     /// assert!(parts.coexact.iter().all(|q| q.abs() < 1e-12 * scale));
+    /// # Ok(())
+    /// # }
     /// ```
     pub fn decompose(&self, k: usize, omega: &[f64]) -> Result<Decomposition, FormsError> {
         self.decompose_with(k, omega, CoexactSolve::Auto)
