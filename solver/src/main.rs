@@ -264,7 +264,11 @@ fn describe_problem(case: &Case) -> String {
             c.boundary.name()
         ),
         Problem::Decomposition(d) => {
-            format!("hodge-decomposition of a 1-cochain, {}", d.method.name())
+            format!(
+                "hodge-decomposition of a {}-cochain, {}",
+                d.degree,
+                d.method.name()
+            )
         }
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
         Problem::Transport(t) => match &t.time {

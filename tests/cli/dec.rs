@@ -173,16 +173,17 @@ fn sphere_decomposition_is_orthogonal() -> Result {
     Ok(())
 }
 
-/// The Whitney star of a decomposition, an `[exact]` or `[[boundary]]`
-/// table for cohomology and a field of the wrong dimension are refused by
+/// A decomposition's degree above the mesh's dimension, an `[exact]` or
+/// `[[boundary]]` table for cohomology and a field that does not fit the
+/// degree are refused by
 /// `hasse check` (exit 2) at their keys.
 #[test]
 fn check_refuses_what_is_not_computed() -> Result {
     let refused = [
         (
             "cases/hodge-decomposition-sphere.toml",
-            vec!["problem.method=\"whitney\""],
-            "`problem.method`: the coexact part ⋆₁⁻¹ d₁ᵀ γ needs a diagonal Hodge star",
+            vec!["problem.degree=3"],
+            "degree 3 is out of range: the mesh is 2-dimensional, so 0 ≤ degree ≤ 2",
         ),
         (
             "cases/cohomology-torus.toml",
@@ -197,7 +198,7 @@ fn check_refuses_what_is_not_computed() -> Result {
         (
             "cases/hodge-decomposition-sphere.toml",
             vec!["problem.field=[\"x\", \"y\"]"],
-            "`problem.field`: 2 components, but the mesh lives in R^3",
+            "`problem.field`: 2 expression(s), but 1-cochains on this 2-dimensional mesh in R^3 are the de Rham map of a vector field",
         ),
     ];
     for (case, sets, message) in refused {

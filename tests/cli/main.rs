@@ -32,6 +32,7 @@ mod doc_commands;
 mod fuzz_regressions;
 mod heat_solvers;
 mod hodge;
+mod hodge_decomposition;
 mod interrupted_output;
 mod lar_files;
 mod method_warnings;

@@ -20,6 +20,7 @@ mod diffusion;
 mod elasticity;
 mod forms;
 mod forms_dec;
+mod hodge_decomposition;
 mod maxwell;
 mod nonlinear;
 mod refinement;

@@ -42,8 +42,11 @@ pub struct CohomologySpec {
     pub boundary: crate::physics::forms::Boundary,
 }
 
-/// The Hodge decomposition of a 1-cochain given as a vector field
-/// (`kind = "hodge-decomposition"`).
+/// The Hodge decomposition of a k-cochain given as a field
+/// (`kind = "hodge-decomposition"`): a vector field for k = 1 (line
+/// integrals along the edges) and for k = 2 on 3-dimensional meshes
+/// (fluxes through the faces), a scalar one for k = 0 (vertex values) and
+/// k = n (integrals over the top cells).
 ///
 /// ```
 /// use hasse_solver::frontend::case::{Case, Problem};
@@ -58,15 +61,21 @@ pub struct CohomologySpec {
 /// "#;
 /// let case = Case::from_text("split.toml", text, &[]).unwrap();
 /// let Problem::Decomposition(spec) = &case.problem else { panic!() };
-/// assert_eq!(spec.field.len(), 3);
+/// assert_eq!((spec.field.len(), spec.degree), (3, 1));
 /// ```
 #[derive(Clone, Debug)]
 pub struct DecompositionSpec {
-    /// The star (`problem.method`): a diagonal one.
+    /// The star (`problem.method`): diagonal (the coexact part eliminated)
+    /// or Whitney (the mixed saddle-point solve).
     pub method: HodgeMethod,
     /// Where `problem.method` is written.
     pub method_span: Option<Range<usize>>,
-    /// The vector field F (`problem.field`), one expression per
-    /// coordinate; ω = R₁ F, its line integrals along the edges.
+    /// The degree k (`problem.degree`, default 1).
+    pub degree: usize,
+    /// Where `problem.degree` is written, for the check against the mesh.
+    pub degree_span: Option<Range<usize>>,
+    /// The field F (`problem.field`): one expression per coordinate for a
+    /// vector proxy, one expression for a scalar one; ω = R_k F, its de
+    /// Rham cochain.
     pub field: Vec<Expression>,
 }

@@ -10,8 +10,8 @@ use hasse_complex::Complex;
 
 impl Case {
     /// A DEC kind's degree must be at most the mesh's dimension (cohomology
-    /// generators, absolute and relative, are computed for every degree),
-    /// and the
+    /// generators, absolute and relative, and Hodge decompositions are
+    /// computed for every degree), and the
     /// circumcentric and Whitney stars need simplices. Only these kinds
     /// measure a periodic mesh unwrapped.
     pub(super) fn check_hodge(&self, complex: &Complex, collector: &mut Collector) {
@@ -27,7 +27,11 @@ impl Case {
                 &spec.method_span,
                 Some((spec.degree, &spec.degree_span)),
             ),
-            Problem::Decomposition(spec) => (spec.method, &spec.method_span, None),
+            Problem::Decomposition(spec) => (
+                spec.method,
+                &spec.method_span,
+                Some((spec.degree, &spec.degree_span)),
+            ),
             _ => {
                 // Only the stars and Whitney forms read a cell's geometry from
                 // its unwrapped points; every other kind's metrics, loads and
@@ -61,14 +65,6 @@ impl Case {
                     )),
                 );
             }
-        }
-        if matches!(self.problem, Problem::Decomposition(_)) && n != 2 {
-            collector.error(
-                self.mesh_spans.get("").cloned(),
-                "mesh",
-                format!("the Hodge decomposition of 1-cochains is computed on 2-dimensional meshes (surfaces and planar domains); this mesh is {n}-dimensional"),
-                Some("use a surface (sphere, torus) or a planar mesh".into()),
-            );
         }
         if method != super::HodgeMethod::DecBarycentric {
             if let Some(c) =

@@ -1,6 +1,6 @@
 //! Running the DEC kinds of the k-form layer besides the Hodge Laplacian:
 //! `cohomology` (a basis of harmonic k-forms from cohomology generators)
-//! and `hodge-decomposition` (a 1-cochain split into exact, coexact and
+//! and `hodge-decomposition` (a k-cochain split into exact, coexact and
 //! harmonic parts). Both write their cochains and, where the degree's
 //! proxy is a vector field, its Whitney vector per top cell
 //! (`NAME_x`, `NAME_y`, `NAME_z`).
@@ -201,34 +201,56 @@ pub(super) fn cohomology(
     })
 }
 
-/// The field must have one expression per coordinate and be finite at
-/// the edges' midpoints (where `hasse check` can see it).
+/// The field must fit the degree's proxy (one expression per coordinate
+/// for a vector one, one expression for a scalar one) and be finite at
+/// the k-cells' centroids (where `hasse check` can see it).
 pub(super) fn check(
     case: &Case,
     spec: &DecompositionSpec,
     complex: &Complex,
 ) -> Result<(), RunError> {
+    let k = spec.degree;
     let d = complex.embedding_dim();
-    if spec.field.len() != d {
+    let proxy = ProxyKind::of(complex, k).map_err(|e| run_error(case, e))?;
+    let (wanted, help) = if proxy.is_vector() {
+        (d, format!("give {d} expressions, one per coordinate"))
+    } else {
+        (
+            1,
+            "give one expression (a string), not an array".to_string(),
+        )
+    };
+    if spec.field.len() != wanted {
         return Err(RunError::input_at(
             case,
             "problem.field",
             format!(
-                "{} components, but the mesh lives in R^{d}",
-                spec.field.len()
+                "{} expression(s), but {k}-cochains on this {}-dimensional mesh in R^{d} are the de Rham map of {}",
+                spec.field.len(),
+                complex.dim(),
+                match proxy {
+                    ProxyKind::Function => "a function (its vertex values)",
+                    ProxyKind::Density => "a density (its integrals over the top cells)",
+                    ProxyKind::Tangent => "a vector field (its line integrals along the edges)",
+                    ProxyKind::Flux => "a vector field (its fluxes through the faces)",
+                }
             ),
-            Some(format!("give {d} expressions, one per coordinate")),
+            Some(help),
         ));
     }
-    let f = vector_fn(&spec.field);
-    let centroids = complex.centroid(1);
-    for e in 0..complex.cell_count(1) {
-        let x = &centroids[e * d..(e + 1) * d];
-        if f(x)[..d].iter().any(|v| !v.is_finite()) {
+    let centroids = complex.centroid(k);
+    for c in 0..complex.cell_count(k) {
+        let x = &centroids[c * d..(c + 1) * d];
+        let finite = if proxy.is_vector() {
+            vector_fn(&spec.field)(x)[..d].iter().all(|v| v.is_finite())
+        } else {
+            spec.field[0].eval(x, 0.0).is_finite()
+        };
+        if !finite {
             return Err(RunError::input_at(
                 case,
                 "problem.field",
-                format!("the field is not finite at {x:?} (the midpoint of edge {e})"),
+                format!("the field is not finite at {x:?} (the centroid of {k}-cell {c})"),
                 Some("the field must be defined on the whole mesh".into()),
             ));
         }
@@ -243,16 +265,28 @@ pub(super) fn decomposition(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     check(case, spec, complex)?;
-    phase("de Rham map and two Poisson solves");
+    let k = spec.degree;
+    let n = complex.dim();
+    let star = spec.method.star();
+    let mixed = !star.is_diagonal();
+    phase(if mixed {
+        "de Rham map, Poisson solve and mixed saddle-point solve"
+    } else {
+        "de Rham map and two Poisson solves"
+    });
     let started = Instant::now();
-    let f = vector_fn(&spec.field);
-    let omega = de_rham(complex, 1, Field::Vector(&*f)).map_err(|e| run_error(case, e))?;
-    let forms = Forms::new(complex, spec.method.star());
-    let split = forms
-        .hodge_decomposition(&omega)
-        .map_err(|e| run_error(case, e))?;
+    let omega = if ProxyKind::of(complex, k).is_ok_and(|p| p.is_vector()) {
+        let f = vector_fn(&spec.field);
+        de_rham(complex, k, Field::Vector(&*f))
+    } else {
+        let f = &spec.field[0];
+        de_rham(complex, k, Field::Scalar(&|x| f.eval(x, 0.0)))
+    }
+    .map_err(|e| run_error(case, e))?;
+    let forms = Forms::new(complex, star);
+    let split = forms.decompose(k, &omega).map_err(|e| run_error(case, e))?;
     let seconds = started.elapsed().as_secs_f64();
-    let inner = |a: &[f64], b: &[f64]| forms.inner(1, a, b).map_err(|e| run_error(case, e));
+    let inner = |a: &[f64], b: &[f64]| forms.inner(k, a, b).map_err(|e| run_error(case, e));
     let total = inner(&omega, &omega)?;
     let scale = total.max(f64::MIN_POSITIVE);
     let names = ["exact", "coexact", "harmonic"];
@@ -295,30 +329,45 @@ pub(super) fn decomposition(
             "the parts are ⋆-orthogonal only to {worst:.1e} of ‖ω‖², above {RESIDUAL_WARNING:.0e}"
         ));
     }
-    let mut fields = vec![Cochain::new("omega", 1, omega.clone())
-        .with_description("ω = R₁F, the line integrals of the field along the edges")];
-    fields.extend(vector_fields(case, complex, 1, "omega", &omega, "ω")?);
+    let mut fields = vec![
+        Cochain::new("omega", k, omega.clone()).with_description(format!(
+            "ω = R_{k}F, the de Rham cochain of the field on the {k}-cells"
+        )),
+    ];
+    fields.extend(vector_fields(case, complex, k, "omega", &omega, "ω")?);
     let descriptions = [
         "the exact part dα",
-        "the coexact part ⋆₁⁻¹ d₁ᵀ γ (δβ)",
+        "the coexact part M_k⁻¹ d_kᵀ γ (δβ)",
         "the harmonic part",
     ];
     for ((name, part), what) in names.iter().zip(parts).zip(descriptions) {
-        fields.push(Cochain::new(*name, 1, part.to_vec()).with_description(what));
-        fields.extend(vector_fields(case, complex, 1, name, part, what)?);
+        fields.push(Cochain::new(*name, k, part.to_vec()).with_description(what));
+        fields.extend(vector_fields(case, complex, k, name, part, what)?);
     }
-    fields.push(
-        Cochain::new("potential", 0, split.potential.clone())
-            .with_description("α on the vertices, exact part = dα"),
-    );
-    fields.push(
-        Cochain::new("copotential", 2, split.copotential.clone())
-            .with_description("γ = ⋆₂β on the faces, coexact part = ⋆₁⁻¹ d₁ᵀ γ"),
-    );
+    // The potentials exist only where their degree does (α for k ≥ 1,
+    // γ for k < n).
+    if k >= 1 {
+        fields.push(
+            Cochain::new("potential", k - 1, split.potential.clone())
+                .with_description(format!("α on the {}-cells, exact part = dα", k - 1)),
+        );
+    }
+    if k < n {
+        fields.push(
+            Cochain::new("copotential", k + 1, split.copotential.clone()).with_description(
+                format!(
+                    "γ = ⋆_{}β on the {}-cells, coexact part = M_{k}⁻¹ d_{k}ᵀ γ",
+                    k + 1,
+                    k + 1
+                ),
+            ),
+        );
+    }
     let mut report = serde_json::Map::new();
     report.insert(
         "decomposition".into(),
         serde_json::json!({
+            "degree": k,
             "norm": total.sqrt(),
             "exact": norms[0],
             "coexact": norms[1],
@@ -330,27 +379,50 @@ pub(super) fn decomposition(
             "remainder": remainder_norm,
         }),
     );
+    let lower = if k >= 1 {
+        format!("Poisson on {} {}-cells", complex.cell_count(k - 1), k - 1)
+    } else {
+        "no exact part (degree 0)".to_string()
+    };
+    let upper = match (k < n, mixed) {
+        (false, _) => format!("no coexact part (degree {n} = the top degree)"),
+        (true, false) => format!("Poisson on {} {}-cells", complex.cell_count(k + 1), k + 1),
+        (true, true) => format!(
+            "mixed saddle-point system on {} {k}-cells and {} {}-cells",
+            complex.cell_count(k),
+            complex.cell_count(k + 1),
+            k + 1
+        ),
+    };
     let notes = vec![
         (
             "split".to_string(),
             format!(
-                "ω = R₁F on {} edges = exact + coexact + harmonic (Poisson on {} vertices, on {} faces)",
-                complex.cell_count(1),
-                complex.cell_count(0),
-                complex.cell_count(2)
+                "ω = R_{k}F on {} {k}-cells = exact + coexact + harmonic ({lower}; {upper})",
+                complex.cell_count(k),
             ),
         ),
         ("parts".to_string(), table),
     ];
+    let unknowns = if k >= 1 { complex.cell_count(k - 1) } else { 0 }
+        + if k < n {
+            complex.cell_count(k + 1) + if mixed { complex.cell_count(k) } else { 0 }
+        } else {
+            0
+        };
     Ok(RunResult {
         problem: "hodge-decomposition".into(),
         method: Some(spec.method.name().to_string()),
-        unknowns: complex.cell_count(0) + complex.cell_count(2),
+        unknowns,
         fields,
         errors: None,
         flux_error: None,
         relative_residual: Some(worst),
-        factorization: Some(Factorization::Llt),
+        factorization: Some(if mixed {
+            Factorization::Lu
+        } else {
+            Factorization::Llt
+        }),
         ordering: None,
         timings: vec![("de Rham map + two solves".to_string(), seconds)],
         warnings,

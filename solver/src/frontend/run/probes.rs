@@ -56,7 +56,8 @@ pub(super) fn probe_values(
 /// (`None` for the kinds whose probes are scalar solutions).
 pub(crate) fn form_degree(problem: &Problem) -> Option<usize> {
     match problem {
-        Problem::Maxwell(_) | Problem::Decomposition(_) => Some(1),
+        Problem::Maxwell(_) => Some(1),
+        Problem::Decomposition(spec) => Some(spec.degree),
         Problem::Hodge(spec) => Some(spec.degree),
         Problem::Cohomology(spec) => Some(spec.degree),
         _ => None,

@@ -10,7 +10,7 @@
 //! | [`Forms::hodge_laplacian`] | Δ_k as the pencil (K, M) | [`laplacian::HodgeLaplacian`] |
 //! | [`Forms::harmonic_basis`] | harmonic k-forms, one per cohomology class | integer cocycles ([`cohomology`]) made harmonic by one Poisson solve |
 //! | [`Forms::harmonic_basis_with`] | the same for Hᵏ(K, ∂K) (essential conditions) | relative integer cocycles ([`relative`]), α = 0 on the boundary |
-//! | [`Forms::hodge_decomposition`] | ω = dα + δβ + h for 1-cochains on 2-complexes | two Poisson solves ([`decomposition`]) |
+//! | [`Forms::decompose`] | ω = dα + δβ + h for k-cochains, any degree and dimension | a Poisson solve for dα; ⋆⁻¹ eliminated or a mixed saddle-point block system for δβ ([`decomposition`]) |
 //! | [`whitney_map::de_rham`], [`whitney_map::interpolate`] | fields ↔ cochains | quadrature over k-cells; Whitney forms |
 //!
 //! Every matrix is a canonical operator Aᵀ Ω B with A, B exact incidence

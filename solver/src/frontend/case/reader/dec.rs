@@ -102,30 +102,41 @@ impl Reader {
         scope: &Scope,
     ) -> Option<Problem> {
         let (method, method_span) = self.star_method(table, header.clone());
-        if method == Some(HodgeMethod::Whitney) {
-            self.error(
-                method_span.clone(),
-                "problem.method",
-                "the coexact part ⋆₁⁻¹ d₁ᵀ γ needs a diagonal Hodge star; the Whitney mass is not diagonal",
-                Some("use method = \"dec\" (well-centred triangles) or \"dec-barycentric\"".into()),
-            );
-        }
+        // Every star is accepted: a diagonal one has its coexact part
+        // eliminated, the Whitney mass is solved in mixed form.
+        let degree = if table.get("degree").is_some() {
+            self.count(
+                table,
+                "degree",
+                0,
+                header.clone(),
+                "the degree k of the cochain, 0 to the mesh's dimension",
+            )
+        } else {
+            Some((1, None))
+        };
         let field = match self.entry(table, "problem", "field") {
-            Some(e) => self.expression_list(&e, scope),
+            Some(e) if e.item.as_array().is_some() => self.expression_list(&e, scope),
+            Some(e) => self
+                .expression_of(e.item, "problem.field", e.span(), scope)
+                .map(|f| vec![f]),
             None => {
                 self.error(
                     header,
                     "problem.field",
-                    "missing: the vector field whose line integrals along the edges are the 1-cochain ω",
-                    Some("e.g. field = [\"-y\", \"x\"] (one expression per coordinate)".into()),
+                    "missing: the field whose de Rham cochain is ω (line integrals along the edges for degree 1)",
+                    Some("e.g. field = [\"-y\", \"x\"] (one expression per coordinate; one expression for degree 0 or the top degree)".into()),
                 );
                 None
             }
         };
         self.refuse_boundary_tables(root, "hodge-decomposition");
+        let (degree, degree_span) = degree?;
         Some(Problem::Decomposition(DecompositionSpec {
-            method: method.filter(|m| *m != HodgeMethod::Whitney)?,
+            method: method?,
             method_span,
+            degree,
+            degree_span,
             field: field?,
         }))
     }

@@ -104,7 +104,7 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
         &["method", "degree", "modes", "boundary"],
     ),
     ("cohomology", &["method", "degree", "boundary"]),
-    ("hodge-decomposition", &["method", "field"]),
+    ("hodge-decomposition", &["method", "degree", "field"]),
     (
         "elasticity",
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],
