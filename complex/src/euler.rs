@@ -114,7 +114,9 @@ pub fn hasse_matrix(boundaries: &[CsMat<i8>]) -> CsMat<i8> {
 ///
 /// Errors name the cell when p is out of range, `cell` does not exist, a
 /// moved index is not a facet of `cell`, or the selection is empty, all of
-/// ∂c, or (p ≥ 2) has zero boundary.
+/// ∂c, or (p ≥ 2) has zero boundary or one that bounds no cell: the new
+/// edge must have two end points, the new polygon one simple closed cycle
+/// of edges, so that both pieces are cells.
 ///
 /// ```
 /// use hasse_complex::euler::make;
@@ -225,6 +227,79 @@ pub(crate) struct SplitPlan {
     pub new_face_boundary: Vec<(usize, i32)>,
 }
 
+/// Why ∂N = ∂ρ is not the boundary of a (p−1)-cell, if it is not: a new
+/// edge (p = 2) has two end points, one +1 and one −1; a new polygon
+/// (p = 3) is bounded by one simple closed cycle of edges (each end point
+/// on exactly two of them, all connected). ρ lies on the boundary sphere
+/// of c, so when ∂ρ is such a sphere both pieces are balls (Jordan–
+/// Schoenflies on the 2-sphere for p = 3, a path and its complement on the
+/// circle for p = 2): the new pieces are cells.
+fn not_a_sphere(boundaries: &[CsMat<i8>], p: usize, chain: &[(usize, i32)]) -> Option<String> {
+    match p {
+        2 => {
+            let signs: Vec<i32> = chain.iter().map(|&(_, v)| v).collect();
+            (signs.len() != 2 || signs.iter().sum::<i32>() != 0).then(|| {
+                format!(
+                    "the moved edges form no path: the new edge would have {} end points (a path between two vertices has 2)",
+                    signs.len()
+                )
+            })
+        }
+        3 => {
+            let edges = boundaries[0].to_csc();
+            // Each vertex's cycle edges, and the edges' end points.
+            let mut ends: Vec<[usize; 2]> = Vec::with_capacity(chain.len());
+            let mut by_vertex: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+            for (k, &(e, _)) in chain.iter().enumerate() {
+                let vertices: Vec<usize> = edges
+                    .outer_view(e)
+                    .map(|col| col.indices().to_vec())
+                    .unwrap_or_default();
+                let [a, b] = vertices[..] else {
+                    return Some(format!("edge {e} of the cut does not have two end points"));
+                };
+                ends.push([a, b]);
+                by_vertex.entry(a).or_default().push(k);
+                by_vertex.entry(b).or_default().push(k);
+            }
+            if let Some((v, on)) = by_vertex.iter().find(|(_, on)| on.len() != 2) {
+                return Some(format!(
+                    "the moved faces' boundary is not a simple cycle: vertex {v} is on {} of its edges (a polygon's boundary passes each of its vertices once)",
+                    on.len()
+                ));
+            }
+            // Walk the cycle from the first edge: it must take every edge.
+            let mut seen = vec![false; chain.len()];
+            let (mut edge, mut at) = (0, ends[0][1]);
+            seen[0] = true;
+            let mut walked = 1;
+            loop {
+                let next = by_vertex[&at].iter().copied().find(|&k| k != edge);
+                match next {
+                    Some(k) if !seen[k] => {
+                        seen[k] = true;
+                        walked += 1;
+                        at = if ends[k][0] == at {
+                            ends[k][1]
+                        } else {
+                            ends[k][0]
+                        };
+                        edge = k;
+                    }
+                    _ => break,
+                }
+            }
+            (walked != chain.len()).then(|| {
+                format!(
+                    "the moved faces' boundary is {} edges in more than one cycle (the first has {walked}): the new face would not be one polygon",
+                    chain.len()
+                )
+            })
+        }
+        _ => None,
+    }
+}
+
 /// Validates a make operator and computes ρ, ν and ∂N (see [`make`] for
 /// the errors).
 pub(crate) fn plan(
@@ -304,6 +379,9 @@ pub(crate) fn plan(
             return Err(bad(
                 "the moved facets do not bound a cell with unit incidences".into(),
             ));
+        }
+        if let Some(reason) = not_a_sphere(boundaries, p, &merged) {
+            return Err(bad(reason));
         }
         merged
     } else {

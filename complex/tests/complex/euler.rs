@@ -624,3 +624,88 @@ fn hasse_blocks_round_trip_and_shape_errors() -> TestResult {
     ));
     Ok(())
 }
+
+/// make refuses cuts whose new cell would not be a cell. On the unit
+/// square, two opposite edges end at four vertices (no path), two adjacent
+/// ones at two (a path: the diagonal cut). On the unit cube, one face, two
+/// adjacent faces, three faces around a corner and a U of three faces are
+/// discs bounded by one cycle of 4, 6, 6 and 8 edges; two opposite faces
+/// are bounded by two 4-cycles, and the band of four side faces by the top
+/// and bottom squares (an annulus): both refused. Counts by hand.
+#[test]
+fn make_refuses_cuts_that_bound_no_cell() -> TestResult {
+    let square = boundaries_of(&rectangle(1, 1, [0.0, 1.0], [0.0, 1.0])?);
+    let facets = |b: &[CsMat<i8>], p: usize| -> Vec<usize> {
+        let col = b[p - 1].to_csc();
+        col.outer_view(0)
+            .map(|c| c.indices().to_vec())
+            .unwrap_or_default()
+    };
+    let edges = facets(&square, 2);
+    let d1 = square[0].to_csc();
+    let ends = |e: usize| -> Vec<usize> {
+        d1.outer_view(e)
+            .map(|c| c.indices().to_vec())
+            .unwrap_or_default()
+    };
+    let shares = |a: usize, b: usize| ends(a).iter().any(|v| ends(b).contains(v));
+    let opposite = edges
+        .iter()
+        .copied()
+        .find(|&e| e != edges[0] && !shares(e, edges[0]))
+        .ok_or("no opposite edge")?;
+    let adjacent = edges
+        .iter()
+        .copied()
+        .find(|&e| e != edges[0] && shares(e, edges[0]))
+        .ok_or("no adjacent edge")?;
+    assert!(matches!(
+        make(&square, 2, 0, &[edges[0], opposite]),
+        Err(SplitError::BadFacetSelection { .. })
+    ));
+    check_make(&square, 2, 0, &[edges[0], adjacent]);
+
+    let cube = boundaries_of(&box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0])?);
+    let faces = facets(&cube, 3);
+    assert_eq!(faces.len(), 6);
+    // A face's axis: the coordinate its centroid pins to 0 or 1, read from
+    // the face's vertices through the generated complex.
+    let k = box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0])?;
+    let side = |f: usize| -> (usize, bool) {
+        let c = k.centroid_of(2, f);
+        let axis = (0..3)
+            .find(|&a| (c[a] - 0.5).abs() > 0.25)
+            .unwrap_or(usize::MAX);
+        (axis, c.get(axis).is_some_and(|&x| x > 0.5))
+    };
+    let face = |axis: usize, high: bool| -> Result<usize, String> {
+        faces
+            .iter()
+            .copied()
+            .find(|&f| side(f) == (axis, high))
+            .ok_or_else(|| format!("no face on axis {axis}"))
+    };
+    let (x0, x1, y0, y1, z0, z1) = (
+        face(0, false)?,
+        face(0, true)?,
+        face(1, false)?,
+        face(1, true)?,
+        face(2, false)?,
+        face(2, true)?,
+    );
+    for disc in [vec![z0], vec![z0, x0], vec![z0, x0, y0], vec![z0, x0, x1]] {
+        check_make(&cube, 3, 0, &disc);
+    }
+    for (cut, why) in [
+        (vec![z0, z1], "two cycles"),
+        (vec![x0, x1, y0, y1], "an annulus"),
+    ] {
+        match make(&cube, 3, 0, &cut) {
+            Err(SplitError::BadFacetSelection { reason, .. }) => {
+                assert!(reason.contains("more than one cycle"), "{why}: {reason}")
+            }
+            other => panic!("{why}: {:?}", other.map(|_| ())),
+        }
+    }
+    Ok(())
+}
