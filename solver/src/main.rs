@@ -274,6 +274,9 @@ fn describe_problem(case: &Case) -> String {
                 time.steps,
                 time.dt
             ),
+            None if t.method == hasse_solver::metric::Method::Fe => {
+                format!("transport, method fe, {}, steady", t.stabilisation.name())
+            }
             None => "transport, method fv, upwind, steady".to_string(),
         },
         Problem::Coupled(c) => format!(
