@@ -24,4 +24,5 @@ mod nonlinear;
 mod refinement;
 mod transient;
 mod transport;
+mod transport_fe;
 mod whitney_map;
