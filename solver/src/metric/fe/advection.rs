@@ -65,7 +65,9 @@
 //! ```
 //!
 //! is the assembled advection (+ SUPG) matrix: topology in P, exact
-//! integers, and the velocity, τ and quadrature in Ω.
+//! integers, and the velocity, τ and quadrature in Ω. A time derivative
+//! is tested the same way, ∫ u̇ (w + τ_T v·∇w), a second metric on the
+//! same P (the consistent mass plus its SUPG part).
 
 use super::field::{nodal_rule, Degree};
 use super::load::{evaluate, LoadFn};
@@ -123,6 +125,9 @@ pub struct Advection {
     pub incidence: CsMat<i8>,
     /// Ω: one dense block per top cell over its rows of P.
     pub metric: BlockMetric,
+    /// The Petrov–Galerkin mass ∫ (φ_i + τ_T v·∇φ_i) φ_j of a time
+    /// derivative, one dense block per top cell over the same rows of P.
+    pub mass: BlockMetric,
     /// τ_T Σ ∫_T (v·∇φ_i) f per vertex (zero without SUPG or source).
     pub load: Vec<f64>,
     /// τ_T per top cell (zero without SUPG).
@@ -206,6 +211,7 @@ pub fn cell_vertex_incidence(complex: &Complex) -> Result<CsMat<i8>, MetricError
 /// One cell's block and figures.
 struct CellBlock {
     values: Vec<f64>,
+    mass: Vec<f64>,
     load: Vec<f64>,
     tau: f64,
     length: f64,
@@ -251,12 +257,14 @@ pub fn advection_metric<'a>(
     let characteristic = complex.lar().characteristic(n).map_err(MetricError::from)?;
     let offsets = characteristic.indptr().to_proper().to_vec();
     let mut metric = BlockMetric::new(incidence.rows());
+    let mut mass = BlockMetric::new(incidence.rows());
     let mut load = vec![0.0; complex.cell_count(0)];
     let mut rows = Vec::new();
     for (c, block) in blocks.iter().enumerate() {
         rows.clear();
         rows.extend(offsets[c]..offsets[c + 1]);
         metric.push_block(&rows, &rows, &block.values);
+        mass.push_block(&rows, &rows, &block.mass);
         for (&v, l) in characteristic.indices()[offsets[c]..offsets[c + 1]]
             .iter()
             .zip(&block.load)
@@ -267,6 +275,7 @@ pub fn advection_metric<'a>(
     Ok(Advection {
         incidence,
         metric,
+        mass,
         load,
         tau: blocks.iter().map(|b| b.tau).collect(),
         length: blocks.iter().map(|b| b.length).collect(),
@@ -354,6 +363,7 @@ fn cell_block(
         Stabilisation::None => 0.0,
     };
     let mut values = vec![0.0; m * m];
+    let mut mass = vec![0.0; m * m];
     let mut load = vec![0.0; m];
     let mut streamline = vec![0.0; m];
     for (p, v) in points.iter().zip(&v_at) {
@@ -365,6 +375,7 @@ fn cell_block(
             let test = p.weight * (p.values[i] + tau * streamline[i]);
             for j in 0..m {
                 values[i * m + j] += test * streamline[j];
+                mass[i * m + j] += test * p.values[j];
             }
         }
         if let (Some(f), true) = (source, tau > 0.0) {
@@ -376,6 +387,7 @@ fn cell_block(
     }
     Ok(CellBlock {
         values,
+        mass,
         load,
         tau,
         length,

@@ -26,6 +26,9 @@
 //! row of M sums to zero: δ⁰1 = 0 and P1 hits Σ_j v·∇φ_j = 0) and the
 //! problem is refused.
 //!
+//! In time, [`NodalTransport::solve_transient`] steps the θ-scheme with
+//! the Petrov–Galerkin mass on the same P.
+//!
 //! M is nonsymmetric; the Dirichlet vertices are eliminated
 //! ([`FixedSplit`]) and the free system solved by LU or a Krylov method,
 //! as [`Transport::solver`](super::Transport) chooses for finite volumes.
@@ -95,6 +98,12 @@ pub struct NodalSystem {
     pub diffusion: SparseColMat<usize, f64>,
     /// The advection part Pᵀ Ω_v P (with the SUPG terms).
     pub advection: SparseColMat<usize, f64>,
+    /// δ⁰ᵀ Ω_K δ⁰ as a canonical operator (boundary rows included).
+    pub diffusion_operator: Canonical,
+    /// Pᵀ Ω_v P as a canonical operator.
+    pub advection_operator: Canonical,
+    /// The Petrov–Galerkin mass Pᵀ Ω_m P of a time derivative.
+    pub mass_operator: Canonical,
     /// FE load, SUPG load and boundary data.
     pub rhs: Vec<f64>,
     /// Vertices held at a Dirichlet value.
@@ -122,6 +131,17 @@ pub struct NodalSolution {
     pub unknowns: usize,
     /// Stored entries of the free system's matrix.
     pub nonzeros: usize,
+}
+
+/// A θ-scheme run on nodal elements.
+#[derive(Clone, Debug)]
+pub struct NodalTransient {
+    /// (t, u per vertex) at t = 0 and every kept step.
+    pub levels: Vec<(f64, Vec<f64>)>,
+    /// Element Péclet numbers |v̄| h_T / (2 K_v).
+    pub peclet: Peclet,
+    /// The largest τ_T (zero for Galerkin).
+    pub tau_max: f64,
 }
 
 impl NodalTransport {
@@ -202,7 +222,9 @@ impl NodalTransport {
                 .fold(f64::INFINITY, f64::min),
             max: advection.peclet.iter().copied().fold(0.0, f64::max),
         };
-        let operator = Canonical::new(advection.incidence, advection.metric)?;
+        let incidence = Arc::new(advection.incidence);
+        let operator = Canonical::new(Arc::clone(&incidence), advection.metric)?;
+        let mass_operator = Canonical::new(incidence, advection.mass)?;
         let advective = operator.assemble();
         let matrix = faer::sparse::ops::add(assembled.matrix.as_ref(), advective.as_ref())
             .map_err(|_| direct::SolveError::OutOfMemory)?;
@@ -214,6 +236,9 @@ impl NodalTransport {
             matrix,
             diffusion: assembled.matrix,
             advection: advective,
+            diffusion_operator: assembled.canonical,
+            advection_operator: operator,
+            mass_operator,
             rhs,
             fixed: assembled.fixed,
             tau: advection.tau,
@@ -251,6 +276,120 @@ impl NodalTransport {
             relative_residual,
             unknowns: matrix.nrows(),
             nonzeros: matrix.compute_nnz(),
+        })
+    }
+
+    /// Step M_m u̇ + M u = b from u(0) = `initial` with the θ-scheme:
+    ///
+    /// ```text
+    ///     (M_m/Δt + θ M) u^{k+1} = (M_m/Δt − (1 − θ) M) u^k + b
+    /// ```
+    ///
+    /// with M_m the Petrov–Galerkin mass ∫ u̇ (w + τ_T v·∇w) (consistent,
+    /// with the steady τ_T), the Dirichlet vertices held at their values
+    /// from the first level on, and the step matrix — one canonical
+    /// operator, the sum (1/Δt) M_m + θ δ⁰ᵀΩ_Kδ⁰ + θ PᵀΩ_vP — factorised
+    /// once (LU) or solved by the Krylov method of [`NodalTransport::solver`]
+    /// at every step (the multigrid preconditioner needs the diffusion
+    /// part alone and is refused here). θ = 1 is backward Euler; θ < 1/2
+    /// is only conditionally stable, which is not checked. Levels are kept
+    /// every `keep_every` steps and at the last.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::physics::transport::nodal::NodalTransport;
+    /// use hasse_solver::physics::{BoundaryKind, Conductivity};
+    /// use std::sync::Arc;
+    /// // u = 2 everywhere and on the inflow side stays 2 (M 1 = 0).
+    /// let mesh = rectangle(4, 4, [0.0, 1.0], [0.0, 1.0]).unwrap();
+    /// let run = NodalTransport::new(Conductivity::Scalar(Arc::new(|_| 0.01)),
+    ///     Arc::new(|_| [1.0, 0.0, 0.0]), Arc::new(|_| 0.0))
+    ///     .with_boundary("xmin", BoundaryKind::Dirichlet(Arc::new(|_| 2.0)))
+    ///     .solve_transient(&mesh, &|_| 2.0, 0.1, 5, 1.0, 5)
+    ///     .unwrap();
+    /// assert_eq!(run.levels.len(), 2);
+    /// assert!(run.levels[1].1.iter().all(|u| (u - 2.0).abs() < 1e-14));
+    /// ```
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_transient(
+        &self,
+        complex: &Complex,
+        initial: &dyn Fn(&[f64]) -> f64,
+        dt: f64,
+        steps: usize,
+        theta: f64,
+        keep_every: usize,
+    ) -> Result<NodalTransient, TransportError> {
+        if !(dt > 0.0 && dt.is_finite() && (0.0..=1.0).contains(&theta) && steps >= 1) {
+            return Err(TransportError::Stepping { dt, steps, theta });
+        }
+        if matches!(
+            self.solver,
+            LinearSolver::Krylov {
+                preconditioner: super::KrylovPreconditioner::DiffusionMultigrid(_),
+                ..
+            }
+        ) {
+            return Err(TransportError::NoDiffusion);
+        }
+        let system = self.assemble(complex)?;
+        let mut u = Vec::with_capacity(complex.cell_count(0));
+        for v in 0..complex.cell_count(0) {
+            let x = complex.vertices().point(v);
+            let value = match system.fixed[v] {
+                Some(g) => g,
+                None => initial(x),
+            };
+            if !value.is_finite() {
+                return Err(TransportError::NonFiniteData {
+                    what: "the initial value",
+                    point: x.to_vec(),
+                });
+            }
+            u.push(value);
+        }
+        let step = Canonical::sum(&[
+            (1.0 / dt, &system.mass_operator),
+            (theta, &system.diffusion_operator),
+            (theta, &system.advection_operator),
+        ])?
+        .assemble();
+        let split = FixedSplit::new(&system.fixed);
+        let free = split.free_block(&step);
+        let factor = match (&self.solver, free.nrows()) {
+            (LinearSolver::Lu, rows) if rows > 0 => Some(
+                direct::DirectSolver::analyze(free.as_ref(), Factorization::Lu)?
+                    .factorize(free.as_ref())?,
+            ),
+            _ => None,
+        };
+        let keep_every = keep_every.max(1);
+        let mut levels = vec![(0.0, u.clone())];
+        for k in 1..=steps {
+            // (M_m/Δt − (1 − θ) M) u^k + b, by the operators' products.
+            let mass = system.mass_operator.apply(&u);
+            let diffusion = system.diffusion_operator.apply(&u);
+            let advection = system.advection_operator.apply(&u);
+            let rhs: Vec<f64> = (0..u.len())
+                .map(|i| {
+                    mass[i] / dt - (1.0 - theta) * (diffusion[i] + advection[i]) + system.rhs[i]
+                })
+                .collect();
+            let reduced = split.reduced_rhs(&step, &rhs, &system.fixed);
+            let x = match &factor {
+                Some(factor) => factor.solve(&reduced)?,
+                None if reduced.is_empty() => Vec::new(),
+                None => solve_system(&free, None, &reduced, &self.solver)?.0,
+            };
+            u = split.lift(&x, &system.fixed);
+            if k % keep_every == 0 || k == steps {
+                levels.push((k as f64 * dt, u.clone()));
+            }
+        }
+        Ok(NodalTransient {
+            levels,
+            peclet: system.peclet,
+            tau_max: system.tau.iter().copied().fold(0.0, f64::max),
         })
     }
 
