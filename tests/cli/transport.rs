@@ -168,6 +168,25 @@ fn supg_case_is_exact_at_the_vertices_and_galerkin_oscillates() -> Result {
     let error = reported(&galerkin, "error", "max")?;
     assert!(error > 0.5, "{galerkin}");
     assert!(galerkin.contains("plain Galerkin oscillates"), "{galerkin}");
+    // In time from u = x, backward Euler with dt = 0.01: the slowest mode
+    // of the operator decays at a rate ≥ Pe²/4 = 10⁴, so each step damps
+    // it by 1/(1 + 100) and 50 steps leave the steady, nodally exact
+    // solution to rounding.
+    let stepped = summary(
+        SUPG,
+        &[
+            "problem.initial=\"x\"",
+            "time.dt=0.01",
+            "time.steps=50",
+            "time.theta=1",
+        ],
+    );
+    let error = reported(&stepped, "error", "max")?;
+    assert!(error <= 1e-12, "{stepped}");
+    assert!(
+        stepped.contains("50 steps of dt = 0.01 (nodal elements, SUPG"),
+        "{stepped}"
+    );
     Ok(())
 }
 

@@ -8,8 +8,9 @@ use crate::physics::transport::Scheme;
 
 /// −∇·(K∇u) + ∇·(v u) = f (`kind = "transport"`) on cell-centred
 /// finite volumes (`method = "fv"`), steady, or in time with a `[time]`
-/// table; or steady on nodal finite elements (`method = "fe"`), Galerkin
-/// or with SUPG (`stabilisation = "supg"`, the default, or `"none"`).
+/// table; or on nodal finite elements (`method = "fe"`, steady or with
+/// the θ-scheme of `[time]`), Galerkin or with SUPG (`stabilisation =
+/// "supg"`, the default, or `"none"`).
 ///
 /// ```
 /// use hasse_solver::frontend::case::{Case, Problem};

@@ -429,6 +429,9 @@ fn solve_nodal(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     let nodal = nodal_problem(case, spec)?;
+    if let Some(time) = &spec.time {
+        return step_nodal(case, spec, complex, &nodal, time, phase);
+    }
     let started = Instant::now();
     phase("assembling and solving (transport, nodal elements)");
     let solution = nodal.solve(complex).map_err(|e| run_error(case, spec, e))?;
@@ -511,6 +514,129 @@ fn solve_nodal(
         warnings,
         pure_neumann: false,
         series: Vec::new(),
+        notes,
+        report,
+    })
+}
+
+/// A θ-scheme run on nodal elements: u per vertex at every saved level.
+fn step_nodal(
+    case: &Case,
+    spec: &TransportSpec,
+    complex: &Complex,
+    nodal: &NodalTransport,
+    time: &crate::frontend::case::TimeSpec,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    let Some(initial) = &spec.initial else {
+        return Err(RunError::input_at(
+            case,
+            "problem.initial",
+            "missing: u at t = 0",
+            None,
+        ));
+    };
+    let initial = scalar_fn(initial);
+    let started = Instant::now();
+    phase("assembling and stepping (transport, nodal elements)");
+    let keep_every = if time.save_every == 0 {
+        time.steps
+    } else {
+        time.save_every
+    };
+    let run = nodal
+        .solve_transient(
+            complex,
+            &|x| initial(x),
+            time.dt,
+            time.steps,
+            time.theta,
+            keep_every,
+        )
+        .map_err(|e| run_error(case, spec, e))?;
+    let total = started.elapsed().as_secs_f64();
+    let exact = case.exact.as_ref().and_then(|e| e.solution.as_ref());
+    let points = field_points(complex, 0);
+    let weights = lumped_vertex_volumes(complex);
+    let mut series = Vec::new();
+    let mut errors = None;
+    for (t, u) in &run.levels {
+        let t = time.start + t;
+        if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+            return Err(RunError::solve(
+                case,
+                format!("u is not finite at vertex {i} at t = {t}"),
+                Some("take a smaller time.dt, or θ = 1".into()),
+            ));
+        }
+        let mut fields = vec![Cochain::new("u", 0, u.clone())
+            .with_description("the transported quantity per vertex (P1/Q1)")];
+        if let Some(solution) = exact {
+            let values: Vec<f64> = points.iter().map(|x| solution.eval(x, t)).collect();
+            let (difference, l2, max) = weighted_errors(u, &values, &weights);
+            fields.push(
+                Cochain::new("u_exact", 0, values)
+                    .with_description("the exact solution at the vertices"),
+            );
+            fields.push(Cochain::new("error", 0, difference).with_description("u − u_exact"));
+            errors = Some(Errors::sampled(l2, max));
+        }
+        series.push((t, fields));
+    }
+    let fields = series.last().map(|(_, f)| f.clone()).unwrap_or_default();
+    let (lo, hi) = run
+        .levels
+        .last()
+        .map(|(_, u)| {
+            u.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(*v), b.max(*v))
+                })
+        })
+        .unwrap_or((0.0, 0.0));
+    let scheme = match spec.stabilisation {
+        Stabilisation::Supg => "SUPG (optimal τ)",
+        Stabilisation::None => "Galerkin (no stabilisation)",
+    };
+    let notes = vec![(
+        "transport".to_string(),
+        format!(
+            "{} steps of dt = {} (nodal elements, {scheme}, θ = {}), {} levels saved\nelement Péclet |v|h/(2K) {:.3e} to {:.3e}, largest τ {:.3e}\nu in [{lo:.3e}, {hi:.6}] at the last level",
+            time.steps,
+            time.dt,
+            time.theta,
+            run.levels.len(),
+            run.peclet.min,
+            run.peclet.max,
+            run.tau_max
+        ),
+    )];
+    let mut report = serde_json::Map::new();
+    report.insert(
+        "transport".into(),
+        serde_json::json!({
+            "scheme": spec.stabilisation.name(),
+            "theta": time.theta,
+            "peclet_min": run.peclet.min,
+            "peclet_max": run.peclet.max,
+            "tau_max": run.tau_max,
+        }),
+    );
+    Ok(RunResult {
+        problem: "transport".into(),
+        method: Some("fe".into()),
+        unknowns: complex.cell_count(0),
+        fields,
+        errors,
+        flux_error: None,
+        relative_residual: None,
+        factorization: (nodal.solver == LinearSolver::Lu)
+            .then_some(crate::la::direct::Factorization::Lu),
+        ordering: None,
+        timings: vec![("assembly + stepping".into(), total)],
+        warnings: Vec::new(),
+        pure_neumann: false,
+        series,
         notes,
         report,
     })

@@ -1,6 +1,6 @@
 //! Reading `kind = "transport"`: advection–diffusion on cell-centred
-//! finite volumes, steady or with `[time]`, or steady on nodal finite
-//! elements with or without SUPG.
+//! finite volumes or on nodal finite elements (with or without SUPG),
+//! steady or with `[time]`.
 
 use super::kinds::Conditions;
 use super::{join, Reader};
@@ -130,21 +130,14 @@ impl Reader {
             (None, false) => Some(None),
         };
         if nodal {
-            // The nodal path is steady, with a diffusion part.
+            // The nodal path needs a diffusion part; in time it is the
+            // θ-scheme of `[time]`, without a `scheme`.
             if zero {
                 self.error(
                     span_of("conductivity"),
                     "problem.conductivity",
                     "nodal finite elements (method = \"fe\") need a positive conductivity: the Galerkin/SUPG operator of pure advection is not solved here",
                     Some("give conductivity > 0, or use method = \"fv\" for pure advection".into()),
-                );
-            }
-            if transient {
-                self.error(
-                    header.clone(),
-                    "time",
-                    "nodal finite-element transport (method = \"fe\") is steady only",
-                    Some("remove [time], or use method = \"fv\" for a transient run".into()),
                 );
             }
             if table.get("scheme").is_some() {
