@@ -272,12 +272,22 @@ fn describe_problem(case: &Case) -> String {
         }
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
         Problem::Transport(t) => match &t.time {
+            Some(time) if t.method == hasse_solver::metric::Method::Fe => format!(
+                "transport, method fe, {}, θ = {}, {} steps of dt = {}",
+                t.stabilisation.name(),
+                time.theta,
+                time.steps,
+                time.dt
+            ),
             Some(time) => format!(
                 "transport, method fv, {} scheme, {} steps of dt = {}",
                 t.scheme.name(),
                 time.steps,
                 time.dt
             ),
+            None if t.method == hasse_solver::metric::Method::Fe => {
+                format!("transport, method fe, {}, steady", t.stabilisation.name())
+            }
             None => "transport, method fv, upwind, steady".to_string(),
         },
         Problem::Coupled(c) => format!(

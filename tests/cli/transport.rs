@@ -1,8 +1,9 @@
 //! Advection–diffusion through the `hasse` binary: the shipped boundary
 //! layer against its exact profile (first order, LU = GMRES = BiCGStab),
 //! the rotating case keeps u in [0, 1] and its mass, and `hasse check`
-//! refuses a method other than fv, a velocity of the wrong dimension and
-//! an inflow face without a Dirichlet value.
+//! refuses a method other than fv or fe, SUPG keys on fv, a velocity of
+//! the wrong dimension and an inflow face without a Dirichlet value; the
+//! shipped SUPG case is exact at the vertices where Galerkin oscillates.
 
 use crate::hasse::{hasse, summary};
 
@@ -10,6 +11,7 @@ type Result<T = ()> = std::result::Result<T, Box<dyn std::error::Error>>;
 
 const LAYER: &str = "cases/transport-boundary-layer.toml";
 const ROTATING: &str = "cases/transport-rotating.toml";
+const SUPG: &str = "cases/transport-supg.toml";
 
 /// The number after `label` on the summary line starting with `line`.
 fn reported(stdout: &str, line: &str, label: &str) -> Result<f64> {
@@ -144,6 +146,50 @@ fn rotating_case_keeps_mass_and_bounds() -> Result {
     Ok(())
 }
 
+/// The shipped SUPG case: Q1 elements on the boundary layer at element
+/// Péclet 5 (Pe = 200, h = 1/20, Pe_h = Pe h/2). SUPG with the optimal τ
+/// is nodally exact in 1D (Brooks & Hughes 1982), and the Q1 strip with
+/// insulated long sides is the 1D problem: the max vertex error is
+/// rounding (≤ 1e-12). Plain Galerkin is central differencing there: the
+/// nodal ratio (1 + Pe_h)/(1 − Pe_h) = −3/2 < 0 makes it oscillate, with
+/// an error of order 1 (measured max 0.67 at the vertices), and the run
+/// warns.
+#[test]
+fn supg_case_is_exact_at_the_vertices_and_galerkin_oscillates() -> Result {
+    let supg = summary(SUPG, &[]);
+    let error = reported(&supg, "error", "max")?;
+    assert!(error <= 1e-12, "{supg}");
+    assert!(
+        supg.contains("element Péclet |v|h/(2K) 5.000e0 to 5.000e0"),
+        "{supg}"
+    );
+    assert!(supg.contains("SUPG (optimal τ)"), "{supg}");
+    let galerkin = summary(SUPG, &["problem.stabilisation=\"none\""]);
+    let error = reported(&galerkin, "error", "max")?;
+    assert!(error > 0.5, "{galerkin}");
+    assert!(galerkin.contains("plain Galerkin oscillates"), "{galerkin}");
+    // In time from u = x, backward Euler with dt = 0.01: the slowest mode
+    // of the operator decays at a rate ≥ Pe²/4 = 10⁴, so each step damps
+    // it by 1/(1 + 100) and 50 steps leave the steady, nodally exact
+    // solution to rounding.
+    let stepped = summary(
+        SUPG,
+        &[
+            "problem.initial=\"x\"",
+            "time.dt=0.01",
+            "time.steps=50",
+            "time.theta=1",
+        ],
+    );
+    let error = reported(&stepped, "error", "max")?;
+    assert!(error <= 1e-12, "{stepped}");
+    assert!(
+        stepped.contains("50 steps of dt = 0.01 (nodal elements, SUPG"),
+        "{stepped}"
+    );
+    Ok(())
+}
+
 fn check_fails(sets: &[&str], expected: &str) -> Result {
     let mut args = vec!["check", LAYER];
     for s in sets {
@@ -159,8 +205,22 @@ fn check_fails(sets: &[&str], expected: &str) -> Result {
 #[test]
 fn check_refuses_bad_transport_input() -> Result {
     check_fails(
-        &["problem.method=fe"],
-        "transport is discretised by cell-centred finite volumes only",
+        &["problem.method=dec"],
+        "transport is discretised by cell-centred finite volumes (fv) or nodal finite elements (fe)",
+    )?;
+    // SUPG belongs to nodal elements; nodal elements are steady and need
+    // diffusion.
+    check_fails(
+        &["problem.stabilisation=\"supg\""],
+        "problem.stabilisation applies to nodal finite elements (method = \"fe\") only",
+    )?;
+    check_fails(
+        &["problem.method=fe", "problem.conductivity=0"],
+        "nodal finite elements (method = \"fe\") need a positive conductivity",
+    )?;
+    check_fails(
+        &["problem.method=fe", "problem.scheme=\"upwind\""],
+        "nodal elements (method = \"fe\") take problem.stabilisation",
     )?;
     check_fails(
         &["problem.velocity=[\"1\", \"0\", \"0\"]"],

@@ -26,4 +26,5 @@ mod nonlinear;
 mod refinement;
 mod transient;
 mod transport;
+mod transport_fe;
 mod whitney_map;

@@ -499,7 +499,7 @@ impl Case {
         match &self.problem {
             Problem::Diffusion(d) => Some(d.method),
             Problem::Heat(h) => Some(h.method),
-            Problem::Transport(_) => Some(Method::Fv),
+            Problem::Transport(t) => Some(t.method),
             Problem::Gradient(_)
             | Problem::Darcy(_)
             | Problem::Maxwell(_)

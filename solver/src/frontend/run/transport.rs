@@ -1,12 +1,17 @@
 //! Running a transport case (`kind = "transport"`): the library's
 //! advection–diffusion problem from the case, steady or stepped in time,
 //! with u per cell and the face fluxes as output and the cell Péclet and
-//! Courant numbers in the summary.
+//! Courant numbers in the summary; or, with `method = "fe"`, steady on
+//! nodal elements (Galerkin or SUPG) with u per vertex and the element
+//! Péclet number and largest τ in the summary.
 
 use super::*;
 use crate::frontend::case::{SolverKind, TransportSpec};
 use crate::la::krylov::KrylovOptions;
+use crate::metric::mass::lumped_vertex_volumes;
+use crate::metric::Method;
 use crate::multigrid::MultigridOptions;
+use crate::physics::transport::nodal::{NodalTransport, Stabilisation};
 use crate::physics::transport::{
     FaceFlux, KrylovMethod, KrylovPreconditioner, LinearSolver, Peclet, Scheme, TimeStepping,
     Transport, TransportError,
@@ -108,6 +113,13 @@ fn run_error(case: &Case, spec: &TransportSpec, error: TransportError) -> RunErr
         TransportError::Stepping { .. } => {
             RunError::input_at(case, "time", message, None).because(error)
         }
+        TransportError::NoFixedValue => RunError::input_at(
+            case,
+            "boundary",
+            message,
+            Some("add a [[boundary]] with type = \"dirichlet\" on the tag where the flow enters".into()),
+        )
+        .because(error),
         TransportError::NoDiffusion => {
             RunError::input_at(case, "solver.preconditioner", message, None).because(error)
         }
@@ -152,6 +164,9 @@ pub(super) fn solve(
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
     check_dimension(case, spec, complex)?;
+    if spec.method == Method::Fe {
+        return solve_nodal(case, spec, complex, phase);
+    }
     let transport = problem(case, spec)?;
     let n = complex.dim();
     let started = Instant::now();
@@ -371,7 +386,258 @@ pub(super) fn solve(
 /// that are not finite where they are evaluated.
 pub(super) fn check(case: &Case, spec: &TransportSpec, complex: &Complex) -> Result<(), RunError> {
     check_dimension(case, spec, complex)?;
+    if spec.method == Method::Fe {
+        return nodal_problem(case, spec)?
+            .check_data(complex)
+            .map_err(|e| run_error(case, spec, e));
+    }
     problem(case, spec)?
         .check_data(complex)
         .map_err(|e| run_error(case, spec, e))
+}
+
+/// The nodal (FE) problem of a case: the FV problem's boundary conditions
+/// and linear solver, with the stabilisation.
+fn nodal_problem(case: &Case, spec: &TransportSpec) -> Result<NodalTransport, RunError> {
+    let fv = problem(case, spec)?;
+    // The reader refuses conductivity = 0 with method = "fe".
+    let Some(k) = spec.conductivity.as_ref() else {
+        return Err(RunError::input_at(
+            case,
+            "problem.conductivity",
+            "nodal finite elements (method = \"fe\") need a positive conductivity",
+            None,
+        ));
+    };
+    let mut nodal = NodalTransport::new(
+        conductivity(k),
+        vector_fn(&spec.velocity),
+        scalar_fn(&spec.source),
+    )
+    .with_stabilisation(spec.stabilisation)
+    .with_solver(fv.solver);
+    nodal.boundary = fv.boundary;
+    Ok(nodal)
+}
+
+/// A steady run on nodal elements: u per vertex, the element Péclet number
+/// and τ in the summary.
+fn solve_nodal(
+    case: &Case,
+    spec: &TransportSpec,
+    complex: &Complex,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    let nodal = nodal_problem(case, spec)?;
+    if let Some(time) = &spec.time {
+        return step_nodal(case, spec, complex, &nodal, time, phase);
+    }
+    let started = Instant::now();
+    phase("assembling and solving (transport, nodal elements)");
+    let solution = nodal.solve(complex).map_err(|e| run_error(case, spec, e))?;
+    let mut warnings = Vec::new();
+    if solution.iterations.is_none() {
+        check_residual(case, solution.relative_residual, &mut warnings)?;
+    }
+    let total = started.elapsed().as_secs_f64();
+    let mut fields = vec![Cochain::new("u", 0, solution.values.clone())
+        .with_description("the transported quantity per vertex (P1/Q1)")];
+    let mut errors = None;
+    if let Some(exact) = case.exact.as_ref().and_then(|e| e.solution.as_ref()) {
+        let values: Vec<f64> = field_points(complex, 0)
+            .iter()
+            .map(|x| exact.eval(x, 0.0))
+            .collect();
+        let weights = lumped_vertex_volumes(complex);
+        let (difference, l2, max) = weighted_errors(&solution.values, &values, &weights);
+        fields.push(
+            Cochain::new("u_exact", 0, values)
+                .with_description("the exact solution at the vertices"),
+        );
+        fields.push(Cochain::new("error", 0, difference).with_description("u − u_exact"));
+        errors = Some(Errors::sampled(l2, max));
+    }
+    let solver_name = match &nodal.solver {
+        LinearSolver::Lu => "sparse LU (faer)".to_string(),
+        LinearSolver::Krylov {
+            method,
+            preconditioner,
+            ..
+        } => format!("{} with {}", method.name(), preconditioner.name()),
+    };
+    let iterations = solution
+        .iterations
+        .map(|r| format!(", {} iterations", r.iterations))
+        .unwrap_or_default();
+    let scheme = match spec.stabilisation {
+        Stabilisation::Supg => "SUPG (optimal τ)",
+        Stabilisation::None => "Galerkin (no stabilisation)",
+    };
+    if spec.stabilisation == Stabilisation::None && solution.peclet.max > 1.0 {
+        warnings.push(format!(
+            "the largest element Péclet number is {:.3} > 1: plain Galerkin oscillates in layers that the mesh does not resolve; stabilisation = \"supg\" does not",
+            solution.peclet.max
+        ));
+    }
+    let notes = vec![(
+        "transport".to_string(),
+        format!(
+            "steady, nodal elements (P1/Q1), {scheme}, {solver_name}{iterations}\nelement Péclet |v|h/(2K) {:.3e} to {:.3e}, largest τ {:.3e}",
+            solution.peclet.min, solution.peclet.max, solution.tau_max
+        ),
+    )];
+    let mut report = serde_json::Map::new();
+    report.insert(
+        "transport".into(),
+        serde_json::json!({
+            "scheme": spec.stabilisation.name(),
+            "peclet_min": solution.peclet.min,
+            "peclet_max": solution.peclet.max,
+            "tau_max": solution.tau_max,
+            "iterations": solution.iterations.map(|r| r.iterations),
+        }),
+    );
+    Ok(RunResult {
+        problem: "transport".into(),
+        method: Some("fe".into()),
+        unknowns: solution.unknowns,
+        fields,
+        errors,
+        flux_error: None,
+        relative_residual: Some(solution.relative_residual),
+        factorization: solution
+            .iterations
+            .is_none()
+            .then_some(crate::la::direct::Factorization::Lu),
+        ordering: None,
+        timings: vec![("assembly + solve".into(), total)],
+        warnings,
+        pure_neumann: false,
+        series: Vec::new(),
+        notes,
+        report,
+    })
+}
+
+/// A θ-scheme run on nodal elements: u per vertex at every saved level.
+fn step_nodal(
+    case: &Case,
+    spec: &TransportSpec,
+    complex: &Complex,
+    nodal: &NodalTransport,
+    time: &crate::frontend::case::TimeSpec,
+    phase: &mut dyn FnMut(&str),
+) -> Result<RunResult, RunError> {
+    let Some(initial) = &spec.initial else {
+        return Err(RunError::input_at(
+            case,
+            "problem.initial",
+            "missing: u at t = 0",
+            None,
+        ));
+    };
+    let initial = scalar_fn(initial);
+    let started = Instant::now();
+    phase("assembling and stepping (transport, nodal elements)");
+    let keep_every = if time.save_every == 0 {
+        time.steps
+    } else {
+        time.save_every
+    };
+    let run = nodal
+        .solve_transient(
+            complex,
+            &|x| initial(x),
+            time.dt,
+            time.steps,
+            time.theta,
+            keep_every,
+        )
+        .map_err(|e| run_error(case, spec, e))?;
+    let total = started.elapsed().as_secs_f64();
+    let exact = case.exact.as_ref().and_then(|e| e.solution.as_ref());
+    let points = field_points(complex, 0);
+    let weights = lumped_vertex_volumes(complex);
+    let mut series = Vec::new();
+    let mut errors = None;
+    for (t, u) in &run.levels {
+        let t = time.start + t;
+        if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+            return Err(RunError::solve(
+                case,
+                format!("u is not finite at vertex {i} at t = {t}"),
+                Some("take a smaller time.dt, or θ = 1".into()),
+            ));
+        }
+        let mut fields = vec![Cochain::new("u", 0, u.clone())
+            .with_description("the transported quantity per vertex (P1/Q1)")];
+        if let Some(solution) = exact {
+            let values: Vec<f64> = points.iter().map(|x| solution.eval(x, t)).collect();
+            let (difference, l2, max) = weighted_errors(u, &values, &weights);
+            fields.push(
+                Cochain::new("u_exact", 0, values)
+                    .with_description("the exact solution at the vertices"),
+            );
+            fields.push(Cochain::new("error", 0, difference).with_description("u − u_exact"));
+            errors = Some(Errors::sampled(l2, max));
+        }
+        series.push((t, fields));
+    }
+    let fields = series.last().map(|(_, f)| f.clone()).unwrap_or_default();
+    let (lo, hi) = run
+        .levels
+        .last()
+        .map(|(_, u)| {
+            u.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(*v), b.max(*v))
+                })
+        })
+        .unwrap_or((0.0, 0.0));
+    let scheme = match spec.stabilisation {
+        Stabilisation::Supg => "SUPG (optimal τ)",
+        Stabilisation::None => "Galerkin (no stabilisation)",
+    };
+    let notes = vec![(
+        "transport".to_string(),
+        format!(
+            "{} steps of dt = {} (nodal elements, {scheme}, θ = {}), {} levels saved\nelement Péclet |v|h/(2K) {:.3e} to {:.3e}, largest τ {:.3e}\nu in [{lo:.3e}, {hi:.6}] at the last level",
+            time.steps,
+            time.dt,
+            time.theta,
+            run.levels.len(),
+            run.peclet.min,
+            run.peclet.max,
+            run.tau_max
+        ),
+    )];
+    let mut report = serde_json::Map::new();
+    report.insert(
+        "transport".into(),
+        serde_json::json!({
+            "scheme": spec.stabilisation.name(),
+            "theta": time.theta,
+            "peclet_min": run.peclet.min,
+            "peclet_max": run.peclet.max,
+            "tau_max": run.tau_max,
+        }),
+    );
+    Ok(RunResult {
+        problem: "transport".into(),
+        method: Some("fe".into()),
+        unknowns: complex.cell_count(0),
+        fields,
+        errors,
+        flux_error: None,
+        relative_residual: None,
+        factorization: (nodal.solver == LinearSolver::Lu)
+            .then_some(crate::la::direct::Factorization::Lu),
+        ordering: None,
+        timings: vec![("assembly + stepping".into(), total)],
+        warnings: Vec::new(),
+        pure_neumann: false,
+        series,
+        notes,
+        report,
+    })
 }

@@ -29,6 +29,7 @@
 //! surface in R³): gradients are taken in the simplex's own tangent space.
 //! Q1 and the virtual element need cells that fill their space (n = d).
 
+pub mod advection;
 pub(crate) mod field;
 mod load;
 mod p1;

@@ -59,9 +59,18 @@
 //! gradient limited by Barth–Jespersen (the multidimensional minmod) gives
 //! the upwind face value, stepped by the two-stage strong-stability-
 //! preserving Runge–Kutta method (Heun). See [`transient`].
+//!
+//! # Nodal finite elements
+//!
+//! For comparison, [`nodal::NodalTransport`] solves the same equation
+//! (advective form v·∇u) on vertex unknowns: the FE diffusion of
+//! [`Method::Fe`] plus a Galerkin advection operator Pᵀ Ω_v P over the
+//! cell–vertex incidence P, stabilised by SUPG with the optimal τ. See
+//! [`nodal`] and [`crate::metric::fe::advection`].
 
 mod flux;
 mod limiter;
+pub mod nodal;
 mod steady;
 pub mod transient;
 
@@ -219,6 +228,10 @@ pub enum TransportError {
     /// preconditioner.
     #[error(transparent)]
     Iterative(#[from] CgError),
+    /// A nodal (FE) problem without a Dirichlet or Robin boundary: its
+    /// operator keeps constants in its kernel.
+    #[error("the nodal (fe) transport problem has no Dirichlet or Robin boundary: its solution is fixed only up to a constant; give a Dirichlet value where the flow enters")]
+    NoFixedValue,
     /// The multigrid preconditioner was asked for without a conductivity.
     #[error("the multigrid preconditioner acts on the diffusion part, and a pure advection problem has none; use ILU(0)")]
     NoDiffusion,

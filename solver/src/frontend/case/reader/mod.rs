@@ -80,6 +80,7 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "c",
     "velocity",
     "scheme",
+    "stabilisation",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -119,6 +120,7 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
             "velocity",
             "initial",
             "scheme",
+            "stabilisation",
         ],
     ),
 ];

@@ -1,17 +1,22 @@
 //! Reading `kind = "transport"`: advection–diffusion on cell-centred
-//! finite volumes, steady or with `[time]`.
+//! finite volumes or on nodal finite elements (with or without SUPG),
+//! steady or with `[time]`.
 
 use super::kinds::Conditions;
 use super::{join, Reader};
 use crate::frontend::case::expr::Scope;
 use crate::frontend::case::{BoundaryKindSpec, Coefficient, Problem, TransportSpec};
 use crate::metric::Method;
+use crate::physics::transport::nodal::Stabilisation;
 use crate::physics::transport::Scheme;
 use std::ops::Range;
 use toml_edit::TableLike;
 
 /// The spatial schemes by their case-file names.
 const SCHEMES: [Scheme; 2] = [Scheme::Upwind, Scheme::Limited];
+
+/// The stabilisations of nodal elements by their case-file names.
+const STABILISATIONS: [Stabilisation; 2] = [Stabilisation::Supg, Stabilisation::None];
 
 impl Reader {
     pub(super) fn transport(
@@ -23,17 +28,40 @@ impl Reader {
     ) -> Option<Problem> {
         let span_of = |key: &str| table.get_key_value(key).and_then(|(_, i)| i.span());
         let method = self.method(table, header.clone());
-        if let Some(m) = method.filter(|m| *m != Method::Fv) {
+        if let Some(m) = method.filter(|m| !matches!(m, Method::Fv | Method::Fe)) {
             self.error(
                 span_of("method"),
                 "problem.method",
                 format!(
-                    "transport is discretised by cell-centred finite volumes only; method \"{}\" is not available",
+                    "transport is discretised by cell-centred finite volumes (fv) or nodal finite elements (fe); method \"{}\" is not available",
                     m.name()
                 ),
-                Some("use method = \"fv\" (two-point diffusion, upwind or limited advection)".into()),
+                Some("use method = \"fv\" (two-point diffusion, upwind or limited advection) or \"fe\" (P1/Q1, SUPG)".into()),
             );
         }
+        let nodal = method == Some(Method::Fe);
+        // SUPG is a nodal-element stabilisation: finite volumes upwind by
+        // their face values (`scheme`) instead.
+        let stabilisation = match (table.get("stabilisation"), nodal) {
+            (Some(_), false) if method.is_some() => {
+                self.error(
+                    span_of("stabilisation"),
+                    "problem.stabilisation",
+                    "problem.stabilisation applies to nodal finite elements (method = \"fe\") only; finite volumes choose their face values with problem.scheme",
+                    Some("remove stabilisation, or use method = \"fe\"".into()),
+                );
+                None
+            }
+            _ => self.choice(
+                table,
+                "stabilisation",
+                &STABILISATIONS,
+                Stabilisation::name,
+                "stabilisation",
+                None,
+                Some(Stabilisation::Supg),
+            ),
+        };
         // The number 0 (or "0") means no diffusion: pure advection.
         let zero = table.get("conductivity").is_some_and(|item| {
             item.as_integer() == Some(0)
@@ -83,7 +111,7 @@ impl Reader {
                 .map(Some),
             (None, true) => {
                 self.error(
-                    header,
+                    header.clone(),
                     "problem.initial",
                     "missing: u(x, y, z) at t = 0 of the transient run",
                     Some("e.g. initial = \"exp(-100*((x-0.3)^2 + (y-0.5)^2))\"".into()),
@@ -101,7 +129,26 @@ impl Reader {
             }
             (None, false) => Some(None),
         };
-        if scheme == Some(Scheme::Limited) && !transient {
+        if nodal {
+            // The nodal path needs a diffusion part; in time it is the
+            // θ-scheme of `[time]`, without a `scheme`.
+            if zero {
+                self.error(
+                    span_of("conductivity"),
+                    "problem.conductivity",
+                    "nodal finite elements (method = \"fe\") need a positive conductivity: the Galerkin/SUPG operator of pure advection is not solved here",
+                    Some("give conductivity > 0, or use method = \"fv\" for pure advection".into()),
+                );
+            }
+            if table.get("scheme").is_some() {
+                self.error(
+                    span_of("scheme"),
+                    "problem.scheme",
+                    "problem.scheme chooses the face values of finite volumes; nodal elements (method = \"fe\") take problem.stabilisation",
+                    Some("remove scheme, or write stabilisation = \"supg\" or \"none\"".into()),
+                );
+            }
+        } else if scheme == Some(Scheme::Limited) && !transient {
             self.error(
                 span_of("scheme"),
                 "problem.scheme",
@@ -137,10 +184,10 @@ impl Reader {
                 Some("use x, y and z only".into()),
             );
         }
-        if method != Some(Method::Fv) {
-            return None;
-        }
+        let method = method.filter(|m| matches!(m, Method::Fv | Method::Fe))?;
         Some(Problem::Transport(TransportSpec {
+            method,
+            stabilisation: stabilisation?,
             conductivity: conductivity?,
             velocity: velocity?,
             source: source?,
