@@ -48,6 +48,29 @@ fn refused(sets: &[&str]) -> String {
     stderr
 }
 
+/// A case on [0, 2] × [0, 1] (8 × 4 squares) with the regions `left`
+/// (x < 1) and `right` (x > 1), then `body`, in a scratch directory (kept
+/// while the returned guard lives); its path.
+fn halves_case(name: &str, body: &str) -> (crate::scratch::Scratch, String) {
+    let dir = crate::scratch::Scratch::new(name);
+    std::fs::create_dir_all(&*dir).unwrap();
+    let path = dir.join("halves.toml");
+    std::fs::write(&path, format!("{HALVES}{body}")).unwrap();
+    let path = path.to_str().unwrap().to_string();
+    (dir, path)
+}
+
+const HALVES: &str = r#"[mesh]
+generator = "rectangle"
+n = [8, 4]
+x = [0, 2]
+
+[regions]
+left = "x < 1"
+right = "x > 1"
+
+"#;
+
 #[test]
 fn two_materials_are_exact_for_methods_that_reproduce_piecewise_linear_fields() {
     // fe: nodal values; fv and fv-mimetic: cell (and face) values. The
@@ -162,21 +185,9 @@ fn heat_with_a_conductivity_per_region_settles_on_the_two_material_profile() {
 /// refused by `hasse check` with the mesh's regions.
 #[test]
 fn darcy_takes_a_permeability_per_region() {
-    let dir = crate::scratch::Scratch::new("regions_darcy");
-    std::fs::create_dir_all(&*dir).unwrap();
-    let case = dir.join("darcy-two-materials.toml");
-    std::fs::write(
-        &case,
-        r#"[mesh]
-generator = "rectangle"
-n = [8, 4]
-x = [0, 2]
-
-[regions]
-left = "x < 1"
-right = "x > 1"
-
-[problem]
+    let (_dir, case) = halves_case(
+        "regions_darcy",
+        r#"[problem]
 kind = "darcy"
 method = "mimetic"
 permeability = { left = 1, right = 20 }
@@ -196,9 +207,8 @@ value = 1
 solution = "if(x < 1, 20*x/21, 20/21 + (x - 1)/21)"
 gradient = ["if(x < 1, 20/21, 1/21)", "0"]
 "#,
-    )
-    .unwrap();
-    let case = case.to_str().unwrap();
+    );
+    let case = case.as_str();
     for method in ["mimetic", "dec-barycentric"] {
         let set = format!("problem.method=\"{method}\"");
         let stdout = summary(case, &[&set]);
@@ -231,21 +241,9 @@ gradient = ["if(x < 1, 20/21, 1/21)", "0"]
 /// of order one (measured 0.13), so the test sees the regions.
 #[test]
 fn coupled_reaction_coefficients_per_region() {
-    let dir = crate::scratch::Scratch::new("regions_coupled");
-    std::fs::create_dir_all(&*dir).unwrap();
-    let case = dir.join("coupled-regions.toml");
-    std::fs::write(
-        &case,
-        r#"[mesh]
-generator = "rectangle"
-n = [8, 4]
-x = [0, 2]
-
-[regions]
-left = "x < 1"
-right = "x > 1"
-
-[problem]
+    let (_dir, case) = halves_case(
+        "regions_coupled",
+        r#"[problem]
 kind = "coupled"
 a = { left = 3, right = 5 }
 b = { left = 1, right = 2 }
@@ -273,9 +271,8 @@ tag = "boundary"
 type = "dirichlet"
 value = 0.5
 "#,
-    )
-    .unwrap();
-    let case = case.to_str().unwrap();
+    );
+    let case = case.as_str();
     let max_errors = |sets: &[&str]| -> Vec<f64> {
         summary(case, sets)
             .lines()

@@ -157,6 +157,29 @@ fn peclet_text(peclet: &Peclet) -> String {
     }
 }
 
+/// The parts every transport run's result shares: the method, the
+/// unknowns, whether LU factorised the system, and the one timing; the
+/// caller fills in what it computed.
+fn transport_result(method: &str, unknowns: usize, lu: bool, timing: (&str, f64)) -> RunResult {
+    RunResult {
+        problem: "transport".into(),
+        method: Some(method.into()),
+        unknowns,
+        fields: Vec::new(),
+        errors: None,
+        flux_error: None,
+        relative_residual: None,
+        factorization: lu.then_some(crate::la::direct::Factorization::Lu),
+        ordering: None,
+        timings: vec![(timing.0.into(), timing.1)],
+        warnings: Vec::new(),
+        pure_neumann: false,
+        series: Vec::new(),
+        notes: Vec::new(),
+        report: serde_json::Map::new(),
+    }
+}
+
 pub(super) fn solve(
     case: &Case,
     spec: &TransportSpec,
@@ -235,24 +258,18 @@ pub(super) fn solve(
             }),
         );
         return Ok(RunResult {
-            problem: "transport".into(),
-            method: Some("fv".into()),
-            unknowns: solution.unknowns,
             fields,
             errors,
-            flux_error: None,
             relative_residual: Some(solution.relative_residual),
-            factorization: solution
-                .iterations
-                .is_none()
-                .then_some(crate::la::direct::Factorization::Lu),
-            ordering: None,
-            timings: vec![("assembly + solve".into(), total)],
             warnings,
-            pure_neumann: false,
-            series: Vec::new(),
             notes,
             report,
+            ..transport_result(
+                "fv",
+                solution.unknowns,
+                solution.iterations.is_none(),
+                ("assembly + solve", total),
+            )
         });
     };
     let Some(initial) = &spec.initial else {
@@ -359,25 +376,21 @@ pub(super) fn solve(
                 .collect(),
         );
     }
+    let lu =
+        spec.scheme == Scheme::Upwind && time.theta > 0.0 && transport.solver == LinearSolver::Lu;
     Ok(RunResult {
-        problem: "transport".into(),
-        method: Some("fv".into()),
-        unknowns: complex.cell_count(n),
         fields,
         errors,
-        flux_error: None,
-        relative_residual: None,
-        factorization: (spec.scheme == Scheme::Upwind
-            && time.theta > 0.0
-            && transport.solver == LinearSolver::Lu)
-            .then_some(crate::la::direct::Factorization::Lu),
-        ordering: None,
-        timings: vec![("assembly + stepping".into(), total)],
         warnings,
-        pure_neumann: false,
         series,
         notes,
         report,
+        ..transport_result(
+            "fv",
+            complex.cell_count(n),
+            lu,
+            ("assembly + stepping", total),
+        )
     })
 }
 
@@ -498,24 +511,18 @@ fn solve_nodal(
         }),
     );
     Ok(RunResult {
-        problem: "transport".into(),
-        method: Some("fe".into()),
-        unknowns: solution.unknowns,
         fields,
         errors,
-        flux_error: None,
         relative_residual: Some(solution.relative_residual),
-        factorization: solution
-            .iterations
-            .is_none()
-            .then_some(crate::la::direct::Factorization::Lu),
-        ordering: None,
-        timings: vec![("assembly + solve".into(), total)],
         warnings,
-        pure_neumann: false,
-        series: Vec::new(),
         notes,
         report,
+        ..transport_result(
+            "fe",
+            solution.unknowns,
+            solution.iterations.is_none(),
+            ("assembly + solve", total),
+        )
     })
 }
 
@@ -623,21 +630,16 @@ fn step_nodal(
         }),
     );
     Ok(RunResult {
-        problem: "transport".into(),
-        method: Some("fe".into()),
-        unknowns: complex.cell_count(0),
         fields,
         errors,
-        flux_error: None,
-        relative_residual: None,
-        factorization: (nodal.solver == LinearSolver::Lu)
-            .then_some(crate::la::direct::Factorization::Lu),
-        ordering: None,
-        timings: vec![("assembly + stepping".into(), total)],
-        warnings: Vec::new(),
-        pure_neumann: false,
         series,
         notes,
         report,
+        ..transport_result(
+            "fe",
+            complex.cell_count(0),
+            nodal.solver == LinearSolver::Lu,
+            ("assembly + stepping", total),
+        )
     })
 }
