@@ -10,7 +10,7 @@ use std::error::Error;
 type Result<T = ()> = std::result::Result<T, Box<dyn Error>>;
 
 /// The numbers after `label` on the summary's lines that contain it.
-fn numbers_after(stdout: &str, label: &str) -> Vec<f64> {
+pub(crate) fn numbers_after(stdout: &str, label: &str) -> Vec<f64> {
     stdout
         .lines()
         .filter_map(|l| l.split_once(label))

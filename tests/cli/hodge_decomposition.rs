@@ -1,18 +1,11 @@
 //! `kind = "hodge-decomposition"` in every degree and with the Whitney
 //! star (the mixed saddle-point solve) through the `hasse` binary.
 
+use crate::dec::numbers_after;
 use crate::hasse::{hasse, summary};
 use std::error::Error;
 
 type Result<T = ()> = std::result::Result<T, Box<dyn Error>>;
-
-fn numbers_after(stdout: &str, label: &str) -> Vec<f64> {
-    stdout
-        .lines()
-        .filter_map(|l| l.split_once(label))
-        .filter_map(|(_, rest)| rest.split_whitespace().next()?.parse().ok())
-        .collect()
-}
 
 /// hodge-decomposition-box3d.toml (Kuhn box, Whitney star): the parts are
 /// M-orthogonal and their squared norms add up, to 1e-12 relative

@@ -157,6 +157,20 @@ fn peclet_text(peclet: &Peclet) -> String {
     }
 }
 
+/// The smallest and largest value of the last saved level ((0, 0) when
+/// none was saved), for the summary's maximum-principle line.
+fn last_level_range(levels: &[(f64, Vec<f64>)]) -> (f64, f64) {
+    levels
+        .last()
+        .map(|(_, u)| {
+            u.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(*v), b.max(*v))
+                })
+        })
+        .unwrap_or((0.0, 0.0))
+}
+
 /// The parts every transport run's result shares: the method, the
 /// unknowns, whether LU factorised the system, and the one timing; the
 /// caller fills in what it computed.
@@ -323,16 +337,7 @@ pub(super) fn solve(
         Scheme::Upwind => format!("upwind, θ = {}, {solver_name}", time.theta),
         Scheme::Limited => "limited (Barth–Jespersen), SSP-RK2".to_string(),
     };
-    let (lo, hi) = run
-        .levels
-        .last()
-        .map(|(_, u)| {
-            u.iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                    (a.min(*v), b.max(*v))
-                })
-        })
-        .unwrap_or((0.0, 0.0));
+    let (lo, hi) = last_level_range(&run.levels);
     let first = run.mass.first().copied().unwrap_or(0.0);
     let last = run.mass.last().copied().unwrap_or(0.0);
     notes.push((
@@ -591,16 +596,7 @@ fn step_nodal(
         series.push((t, fields));
     }
     let fields = series.last().map(|(_, f)| f.clone()).unwrap_or_default();
-    let (lo, hi) = run
-        .levels
-        .last()
-        .map(|(_, u)| {
-            u.iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                    (a.min(*v), b.max(*v))
-                })
-        })
-        .unwrap_or((0.0, 0.0));
+    let (lo, hi) = last_level_range(&run.levels);
     let scheme = match spec.stabilisation {
         Stabilisation::Supg => "SUPG (optimal τ)",
         Stabilisation::None => "Galerkin (no stabilisation)",
