@@ -202,16 +202,21 @@ fn check_refuses_what_is_not_computed() -> Result {
         ),
     ];
     for (case, sets, message) in refused {
-        let mut args = vec!["check", case];
-        for s in &sets {
-            args.extend(["--set", s]);
-        }
-        let out = hasse(&args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert_check_refuses(case, &sets, message);
     }
     Ok(())
+}
+
+/// `hasse check CASE --set …` exits 2 and says `message`.
+pub(crate) fn assert_check_refuses(case: &str, sets: &[&str], message: &str) {
+    let mut args = vec!["check", case];
+    for s in sets {
+        args.extend(["--set", s]);
+    }
+    let out = hasse(&args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(stderr.contains(message), "{args:?}: {stderr}");
 }
 
 /// `boundary = "essential"` on the annulus: one relative harmonic 1-form

@@ -1,8 +1,8 @@
 //! `kind = "hodge-decomposition"` in every degree and with the Whitney
 //! star (the mixed saddle-point solve) through the `hasse` binary.
 
-use crate::dec::numbers_after;
-use crate::hasse::{hasse, summary};
+use crate::dec::{assert_check_refuses, numbers_after};
+use crate::hasse::summary;
 use std::error::Error;
 
 type Result<T = ()> = std::result::Result<T, Box<dyn Error>>;
@@ -92,14 +92,7 @@ fn check_refuses_a_field_of_the_wrong_kind() -> Result {
         ),
     ];
     for (sets, message) in refused {
-        let mut args = vec!["check", "cases/hodge-decomposition-box3d.toml"];
-        for s in &sets {
-            args.extend(["--set", s]);
-        }
-        let out = hasse(&args);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
-        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert_check_refuses("cases/hodge-decomposition-box3d.toml", &sets, message);
     }
     Ok(())
 }

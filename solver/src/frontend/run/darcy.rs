@@ -115,19 +115,20 @@ fn source_integrals(
     Ok(source)
 }
 
-/// K at every top-cell centroid.
+/// K at every top-cell centroid (`regional`: the permeability's piece in
+/// each cell, when it is given per region).
 fn tensors(
     case: &Case,
     coefficient: &Coefficient,
+    regional: Option<&[&Expression]>,
     complex: &Complex,
 ) -> Result<Vec<Tensor>, RunError> {
     let n = complex.dim();
     let d = complex.embedding_dim();
-    let regional = regional_permeability(case, coefficient, complex)?;
     let mut out = Vec::with_capacity(complex.cell_count(n));
     for c in 0..complex.cell_count(n) {
         let x = complex.centroid_of(n, c);
-        let t = tensor_in(coefficient, regional.as_deref(), c, x, d);
+        let t = tensor_in(coefficient, regional, c, x, d);
         if let Some(&bad) = t.iter().flatten().find(|v| !v.is_finite()) {
             return Err(RunError::input_at(
                 case,
@@ -282,7 +283,8 @@ pub(super) fn solve(
     }
     phase("assembling");
     let started = Instant::now();
-    let permeability = tensors(case, &spec.permeability, complex)?;
+    let regional = regional_permeability(case, &spec.permeability, complex)?;
+    let permeability = tensors(case, &spec.permeability, regional.as_deref(), complex)?;
     let source = source_integrals(case, spec, complex)?;
     let bc = conditions(case, spec, complex)?;
     // Without a pressure face p is defined up to a constant: the solve
@@ -328,7 +330,6 @@ pub(super) fn solve(
                         .with_description("the exact pressure at the cell points"),
                 );
                 fields.push(Cochain::new("error", n, difference).with_description("p − p_exact"));
-                let regional = regional_permeability(case, &spec.permeability, complex)?;
                 let flux_error = exact.gradient.as_ref().map(|g| {
                     flux_error(
                         complex,
@@ -506,7 +507,8 @@ pub(super) fn check(case: &Case, spec: &DarcySpec, complex: &Complex) -> Result<
     }
     // Positive definite as the assembly will demand: a negative constant
     // permeability is refused here, not after `hasse check` said ok.
-    let permeability = tensors(case, &spec.permeability, complex)?;
+    let regional = regional_permeability(case, &spec.permeability, complex)?;
+    let permeability = tensors(case, &spec.permeability, regional.as_deref(), complex)?;
     crate::metric::check_tensors(&permeability, complex.cell_count(n), n)
         .map_err(|e| run_error(case, DarcyError::Metric(e)))?;
     source_integrals(case, spec, complex)?;

@@ -157,6 +157,14 @@ fn peclet_text(peclet: &Peclet) -> String {
     }
 }
 
+/// u at t = 0 of a run in time, which the case must give.
+fn initial_field(case: &Case, spec: &TransportSpec) -> Result<ScalarFn, RunError> {
+    spec.initial
+        .as_ref()
+        .map(scalar_fn)
+        .ok_or_else(|| RunError::input_at(case, "problem.initial", "missing: u at t = 0", None))
+}
+
 /// The smallest and largest value of the last saved level ((0, 0) when
 /// none was saved), for the summary's maximum-principle line.
 fn last_level_range(levels: &[(f64, Vec<f64>)]) -> (f64, f64) {
@@ -286,15 +294,7 @@ pub(super) fn solve(
             )
         });
     };
-    let Some(initial) = &spec.initial else {
-        return Err(RunError::input_at(
-            case,
-            "problem.initial",
-            "missing: u at t = 0",
-            None,
-        ));
-    };
-    let initial = scalar_fn(initial);
+    let initial = initial_field(case, spec)?;
     let stepping = TimeStepping {
         dt: time.dt,
         steps: time.steps,
@@ -540,15 +540,7 @@ fn step_nodal(
     time: &crate::frontend::case::TimeSpec,
     phase: &mut dyn FnMut(&str),
 ) -> Result<RunResult, RunError> {
-    let Some(initial) = &spec.initial else {
-        return Err(RunError::input_at(
-            case,
-            "problem.initial",
-            "missing: u at t = 0",
-            None,
-        ));
-    };
-    let initial = scalar_fn(initial);
+    let initial = initial_field(case, spec)?;
     let started = Instant::now();
     phase("assembling and stepping (transport, nodal elements)");
     let keep_every = if time.save_every == 0 {
