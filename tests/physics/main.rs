@@ -18,6 +18,7 @@ mod coupled;
 mod darcy;
 mod diffusion;
 mod elasticity;
+mod form_poisson;
 mod forms;
 mod forms_dec;
 mod hodge_decomposition;

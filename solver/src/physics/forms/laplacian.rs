@@ -113,7 +113,9 @@ pub struct FormModes {
 }
 
 impl HodgeLaplacian {
-    fn splits(
+    /// The k-cells and (k ≥ 1) the (k−1)-cells, split into free and held
+    /// by the boundary condition.
+    pub(super) fn splits(
         forms: &Forms<'_>,
         k: usize,
         boundary: Boundary,
@@ -307,6 +309,11 @@ impl HodgeLaplacian {
     /// K (for the mixed form, the whole symmetric block matrix).
     pub fn stiffness(&self) -> SparseColMatRef<'_, usize, f64> {
         self.stiffness.as_ref()
+    }
+
+    /// K as the owned matrix.
+    pub(super) fn stiffness_matrix(&self) -> &SparseColMat<usize, f64> {
+        &self.stiffness
     }
 
     /// M (for the mixed form, diag(0, M_k)).

@@ -10,6 +10,7 @@
 //! | [`Forms::hodge_laplacian`] | Δ_k as the pencil (K, M) | [`laplacian::HodgeLaplacian`] |
 //! | [`Forms::harmonic_basis`] | harmonic k-forms, one per cohomology class | integer cocycles ([`cohomology`]) made harmonic by one Poisson solve |
 //! | [`Forms::harmonic_basis_with`] | the same for Hᵏ(K, ∂K) (essential conditions) | relative integer cocycles ([`relative`]), α = 0 on the boundary |
+//! | [`Forms::poisson`] | Δ_k u = f, both parts of the Laplacian, natural or essential conditions | K u = M f on the pencil above, one Lagrange multiplier per harmonic form ([`poisson`]) |
 //! | [`Forms::decompose`] | ω = dα + δβ + h for k-cochains, any degree and dimension | a Poisson solve for dα; ⋆⁻¹ eliminated or a mixed saddle-point block system for δβ ([`decomposition`]) |
 //! | [`whitney_map::de_rham`], [`whitney_map::interpolate`] | fields ↔ cochains | quadrature over k-cells; Whitney forms |
 //!
@@ -33,6 +34,7 @@
 pub mod cohomology;
 pub mod decomposition;
 pub mod laplacian;
+pub mod poisson;
 mod reduction;
 pub mod relative;
 pub mod whitney_map;
@@ -40,6 +42,7 @@ pub mod whitney_map;
 pub use cohomology::{cocycle_generators, ExactPart, HarmonicBasis};
 pub use decomposition::Decomposition;
 pub use laplacian::{Boundary, FormModes, HodgeLaplacian};
+pub use poisson::FormPoisson;
 pub use relative::relative_cocycle_generators;
 
 use crate::la::direct::SolveError;
