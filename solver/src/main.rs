@@ -270,6 +270,12 @@ fn describe_problem(case: &Case) -> String {
                 d.method.name()
             )
         }
+        Problem::FormDiffusion(d) => format!(
+            "diffusion of {}-forms (Δ_k u = f), {}, {} boundary",
+            d.degree,
+            d.method.name(),
+            d.boundary.name()
+        ),
         Problem::Elasticity(e) => format!("elasticity, P1/Q1, {:?}", e.plane),
         Problem::Transport(t) => match &t.time {
             Some(time) if t.method == hasse_solver::metric::Method::Fe => format!(

@@ -29,6 +29,7 @@ mod dec;
 #[cfg(feature = "mpi")]
 mod distributed;
 mod doc_commands;
+mod form_poisson;
 mod fuzz_regressions;
 mod heat_solvers;
 mod hodge;

@@ -60,7 +60,7 @@ impl StudyResult {
         };
         writeln!(
             f,
-            "study    {} level{}, {} refinement; resolution = {}; {size}; p = observed order (from the previous level; least squares over all levels); errors as the run reports them (diffusion: L² and H¹ by quadrature of each method's field, max at the unknowns' points; heat, darcy, coupled: at the unknowns' points)",
+            "study    {} level{}, {} refinement; resolution = {}; {size}; p = observed order (from the previous level; least squares over all levels); errors as the run reports them (diffusion: L² and H¹ by quadrature of each method's field, max at the unknowns' points; heat, darcy, coupled: at the unknowns' points; k-forms: the star norm of the cochain, max per cell measure)",
             self.levels,
             if self.levels == 1 { "" } else { "s" },
             self.refinement.name(),

@@ -1,6 +1,7 @@
 //! The specifications of the DEC kinds built on the k-form layer besides
-//! the Hodge Laplacian: `kind = "cohomology"` and
-//! `kind = "hodge-decomposition"`.
+//! the Hodge Laplacian: `kind = "cohomology"`,
+//! `kind = "hodge-decomposition"` and the Poisson problem for k-forms
+//! (`kind = "diffusion"` with `degree` ≥ 1).
 
 use super::expr::Expression;
 use super::HodgeMethod;
@@ -78,4 +79,49 @@ pub struct DecompositionSpec {
     /// vector proxy, one expression for a scalar one; ω = R_k F, its de
     /// Rham cochain.
     pub field: Vec<Expression>,
+}
+
+/// The Poisson problem for k-forms, Δ_k u = f with Δ_k = dδ + δd
+/// (`kind = "diffusion"` with `degree` ≥ 1): the source and the exact
+/// solution are fields given like [`DecompositionSpec::field`] (a vector
+/// field for 1-forms and for 2-forms in 3D, a scalar for the top degree),
+/// their de Rham cochains the data.
+///
+/// ```
+/// use hasse_solver::frontend::case::{Case, HodgeMethod, Problem};
+/// use hasse_solver::physics::forms::Boundary;
+/// let text = r#"
+/// [mesh]
+/// generator = "rectangle"
+/// n = [8, 8]
+/// [problem]
+/// kind = "diffusion"
+/// degree = 1
+/// method = "dec-barycentric"
+/// boundary = "essential"
+/// source = ["2*pi^2*sin(pi*y)", "0"]
+/// [exact]
+/// solution = ["sin(pi*y)", "0"]
+/// "#;
+/// let case = Case::from_text("forms.toml", text, &[]).unwrap();
+/// let Problem::FormDiffusion(spec) = &case.problem else { panic!() };
+/// assert_eq!((spec.degree, spec.method, spec.boundary), (1, HodgeMethod::DecBarycentric, Boundary::Essential));
+/// assert_eq!(case.exact.unwrap().form.unwrap().len(), 2);
+/// ```
+#[derive(Clone, Debug)]
+pub struct FormDiffusionSpec {
+    /// The star (`problem.method`).
+    pub method: HodgeMethod,
+    /// Where `problem.method` is written.
+    pub method_span: Option<Range<usize>>,
+    /// The degree k ≥ 1 (`problem.degree`).
+    pub degree: usize,
+    /// Where `problem.degree` is written, for the check against the mesh.
+    pub degree_span: Option<Range<usize>>,
+    /// `problem.boundary`: natural (absolute, default) or essential
+    /// (relative: u and δu have zero tangential trace).
+    pub boundary: crate::physics::forms::Boundary,
+    /// The source f (`problem.source`), one expression per coordinate for
+    /// a vector proxy, one for a scalar one.
+    pub source: Vec<Expression>,
 }

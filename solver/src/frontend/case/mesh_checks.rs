@@ -32,6 +32,11 @@ impl Case {
                 &spec.method_span,
                 Some((spec.degree, &spec.degree_span)),
             ),
+            Problem::FormDiffusion(spec) => (
+                spec.method,
+                &spec.method_span,
+                Some((spec.degree, &spec.degree_span)),
+            ),
             _ => {
                 // Only the stars and Whitney forms read a cell's geometry from
                 // its unwrapped points; every other kind's metrics, loads and
@@ -42,7 +47,7 @@ impl Case {
                         self.mesh_spans.get("generator").cloned(),
                         "mesh.generator",
                         format!(
-                            "a periodic mesh (the flat torus) is measured unwrapped only by the DEC kinds (hodge-laplacian, cohomology, hodge-decomposition); kind = \"{}\" would read the wrapped cells' coordinates directly",
+                            "a periodic mesh (the flat torus) is measured unwrapped only by the DEC kinds (hodge-laplacian, cohomology, hodge-decomposition, diffusion of k-forms); kind = \"{}\" would read the wrapped cells' coordinates directly",
                             self.problem.kind()
                         ),
                         Some("use kind = \"hodge-laplacian\" on generator = \"torus-flat\"".into()),

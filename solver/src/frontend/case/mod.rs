@@ -42,7 +42,7 @@ mod quantity;
 mod reader;
 mod transport_spec;
 
-pub use dec_spec::{CohomologySpec, DecompositionSpec};
+pub use dec_spec::{CohomologySpec, DecompositionSpec, FormDiffusionSpec};
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
@@ -95,6 +95,9 @@ pub struct ExactSpec {
     pub eigenvalues: Vec<f64>,
     /// The exact displacement of an elasticity problem, per coordinate.
     pub displacement: Option<Vec<Expression>>,
+    /// The exact k-form of a Poisson problem for k-forms: its proxy field,
+    /// one expression per coordinate (vector) or one (scalar).
+    pub form: Option<Vec<Expression>>,
 }
 
 /// Which linear solver a diffusion case uses (`solver.type`).
@@ -506,6 +509,7 @@ impl Case {
             | Problem::Hodge(_)
             | Problem::Cohomology(_)
             | Problem::Decomposition(_)
+            | Problem::FormDiffusion(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => None,
         }

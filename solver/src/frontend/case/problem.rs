@@ -596,6 +596,8 @@ pub struct CoupledSpec {
 pub enum Problem {
     /// `kind = "diffusion"`.
     Diffusion(DiffusionSpec),
+    /// `kind = "diffusion"` with `degree` ≥ 1: Δ_k u = f for k-forms.
+    FormDiffusion(super::FormDiffusionSpec),
     /// `kind = "gradient"`.
     Gradient(GradientSpec),
     /// `kind = "heat"`.
@@ -622,7 +624,7 @@ impl Problem {
     /// The `problem.kind` that names this problem.
     pub fn kind(&self) -> &'static str {
         match self {
-            Problem::Diffusion(_) => "diffusion",
+            Problem::Diffusion(_) | Problem::FormDiffusion(_) => "diffusion",
             Problem::Gradient(_) => "gradient",
             Problem::Heat(_) => "heat",
             Problem::Darcy(_) => "darcy",
@@ -648,6 +650,7 @@ impl Problem {
             | Problem::Hodge(_)
             | Problem::Cohomology(_)
             | Problem::Decomposition(_)
+            | Problem::FormDiffusion(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => &[],
         }
@@ -688,6 +691,7 @@ impl Problem {
             | Problem::Hodge(_)
             | Problem::Cohomology(_)
             | Problem::Decomposition(_)
+            | Problem::FormDiffusion(_)
             | Problem::Elasticity(_)
             | Problem::Coupled(_) => None,
         }
@@ -721,6 +725,7 @@ impl Problem {
             | Problem::Hodge(_)
             | Problem::Cohomology(_)
             | Problem::Decomposition(_)
+            | Problem::FormDiffusion(_)
             | Problem::Elasticity(_) => Vec::new(),
         }
     }
@@ -783,7 +788,8 @@ impl Problem {
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
             | Problem::Cohomology(_)
-            | Problem::Decomposition(_) => {}
+            | Problem::Decomposition(_)
+            | Problem::FormDiffusion(_) => {}
         }
         all.retain(|(_, e)| e.regions().is_some());
         all

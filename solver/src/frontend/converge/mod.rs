@@ -95,7 +95,7 @@ pub enum StudyError {
     #[error("a study needs at least 1 level")]
     NoLevels,
     /// The case's kind is not one a study measures.
-    #[error("{case}: a convergence study measures diffusion, heat, darcy and coupled cases; this case is kind = \"{kind}\"")]
+    #[error("{case}: a convergence study measures diffusion (of functions or k-forms), heat, darcy and coupled cases; this case is kind = \"{kind}\"")]
     Unsupported {
         /// The case file.
         case: String,

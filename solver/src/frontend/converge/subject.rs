@@ -21,6 +21,9 @@ enum Kind {
     /// Two coupled fields: each field's errors at the unknowns' points, a
     /// row of its own.
     Coupled,
+    /// The Poisson problem for k-forms: the star-norm error of the cochain
+    /// and its largest value per cell measure.
+    Forms,
 }
 
 /// One row's errors.
@@ -58,6 +61,7 @@ impl Subject {
             Problem::Diffusion(d) => (Kind::Diffusion, d.method.name().to_string(), vec![]),
             Problem::Heat(h) => (Kind::Heat, h.method.name().to_string(), vec![]),
             Problem::Darcy(d) => (Kind::Darcy, d.mass.name().to_string(), vec![]),
+            Problem::FormDiffusion(d) => (Kind::Forms, d.method.name().to_string(), vec![]),
             Problem::Coupled(c) => {
                 let own = format!(
                     "{}/{}",
@@ -79,9 +83,10 @@ impl Subject {
                 })
             }
         };
-        // Darcy's methods (flux masses) and a coupled case's per-field
-        // methods are not the diffusion methods `--methods` names.
-        if !methods.is_empty() && matches!(kind, Kind::Darcy | Kind::Coupled) {
+        // Darcy's methods (flux masses), a coupled case's per-field
+        // methods and the stars of k-forms are not the diffusion methods
+        // `--methods` names.
+        if !methods.is_empty() && matches!(kind, Kind::Darcy | Kind::Coupled | Kind::Forms) {
             return Err(StudyError::MethodsNotApplicable {
                 case: case(),
                 kind: base.problem.kind(),
@@ -92,6 +97,10 @@ impl Subject {
                 return Err(StudyError::NoFieldExact { case: case() })
             }
             Kind::Coupled => {}
+            Kind::Forms if base.exact.as_ref().and_then(|e| e.form.as_ref()).is_none() => {
+                return Err(StudyError::NoExact { case: case() })
+            }
+            Kind::Forms => {}
             _ if base
                 .exact
                 .as_ref()

@@ -6,6 +6,7 @@
 //! (`NAME_x`, `NAME_y`, `NAME_z`).
 
 use super::{vector_fn, RunError, RunResult};
+use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{Case, CohomologySpec, DecompositionSpec};
 use crate::frontend::output::Cochain;
 use crate::la::direct::Factorization;
@@ -19,6 +20,12 @@ use std::time::Instant;
 const RESIDUAL_WARNING: f64 = 1e-10;
 
 fn run_error(case: &Case, e: FormsError) -> RunError {
+    run_error_at(case, e, "problem.field")
+}
+
+/// A forms error as a run error; a field that does not fit is reported at
+/// `field_key`.
+pub(super) fn run_error_at(case: &Case, e: FormsError, field_key: &str) -> RunError {
     let message = e.to_string();
     let located = match &e {
         FormsError::Solve(_) | FormsError::Eigen(_) => RunError::solve(case, message, None),
@@ -32,7 +39,7 @@ fn run_error(case: &Case, e: FormsError) -> RunError {
             RunError::input_at(case, "problem.degree", message, None)
         }
         FormsError::Field(_) | FormsError::NotSimplex { .. } => {
-            RunError::input_at(case, "problem.field", message, None)
+            RunError::input_at(case, field_key, message, None)
         }
         _ => RunError::input(case, message),
     };
@@ -41,7 +48,7 @@ fn run_error(case: &Case, e: FormsError) -> RunError {
 
 /// The Whitney vector per top cell of a k-cochain as one cell field per
 /// embedding axis, when k-forms are vector fields here.
-fn vector_fields(
+pub(super) fn vector_fields(
     case: &Case,
     complex: &Complex,
     k: usize,
@@ -209,9 +216,19 @@ pub(super) fn check(
     spec: &DecompositionSpec,
     complex: &Complex,
 ) -> Result<(), RunError> {
-    let k = spec.degree;
+    check_field(case, complex, spec.degree, &spec.field, "problem.field")
+}
+
+/// [`check`] for the proxy field `field` of a k-form written at `key`.
+pub(super) fn check_field(
+    case: &Case,
+    complex: &Complex,
+    k: usize,
+    field: &[Expression],
+    key: &str,
+) -> Result<(), RunError> {
     let d = complex.embedding_dim();
-    let proxy = ProxyKind::of(complex, k).map_err(|e| run_error(case, e))?;
+    let proxy = ProxyKind::of(complex, k).map_err(|e| run_error_at(case, e, key))?;
     let (wanted, help) = if proxy.is_vector() {
         (d, format!("give {d} expressions, one per coordinate"))
     } else {
@@ -220,13 +237,13 @@ pub(super) fn check(
             "give one expression (a string), not an array".to_string(),
         )
     };
-    if spec.field.len() != wanted {
+    if field.len() != wanted {
         return Err(RunError::input_at(
             case,
-            "problem.field",
+            key,
             format!(
                 "{} expression(s), but {k}-cochains on this {}-dimensional mesh in R^{d} are the de Rham map of {}",
-                spec.field.len(),
+                field.len(),
                 complex.dim(),
                 match proxy {
                     ProxyKind::Function => "a function (its vertex values)",
@@ -242,20 +259,39 @@ pub(super) fn check(
     for c in 0..complex.cell_count(k) {
         let x = &centroids[c * d..(c + 1) * d];
         let finite = if proxy.is_vector() {
-            vector_fn(&spec.field)(x)[..d].iter().all(|v| v.is_finite())
+            vector_fn(field)(x)[..d].iter().all(|v| v.is_finite())
         } else {
-            spec.field[0].eval(x, 0.0).is_finite()
+            field[0].eval(x, 0.0).is_finite()
         };
         if !finite {
             return Err(RunError::input_at(
                 case,
-                "problem.field",
+                key,
                 format!("the field is not finite at {x:?} (the centroid of {k}-cell {c})"),
                 Some("the field must be defined on the whole mesh".into()),
             ));
         }
     }
     Ok(())
+}
+
+/// The de Rham cochain R_k F of the proxy field `field` (checked by
+/// [`check_field`]).
+pub(super) fn de_rham_of(
+    case: &Case,
+    complex: &Complex,
+    k: usize,
+    field: &[Expression],
+    key: &str,
+) -> Result<Vec<f64>, RunError> {
+    if ProxyKind::of(complex, k).is_ok_and(|p| p.is_vector()) {
+        let f = vector_fn(field);
+        de_rham(complex, k, Field::Vector(&*f))
+    } else {
+        let f = &field[0];
+        de_rham(complex, k, Field::Scalar(&|x| f.eval(x, 0.0)))
+    }
+    .map_err(|e| run_error_at(case, e, key))
 }
 
 pub(super) fn decomposition(
@@ -275,14 +311,7 @@ pub(super) fn decomposition(
         "de Rham map and two Poisson solves"
     });
     let started = Instant::now();
-    let omega = if ProxyKind::of(complex, k).is_ok_and(|p| p.is_vector()) {
-        let f = vector_fn(&spec.field);
-        de_rham(complex, k, Field::Vector(&*f))
-    } else {
-        let f = &spec.field[0];
-        de_rham(complex, k, Field::Scalar(&|x| f.eval(x, 0.0)))
-    }
-    .map_err(|e| run_error(case, e))?;
+    let omega = de_rham_of(case, complex, k, &spec.field, "problem.field")?;
     let forms = Forms::new(complex, star);
     let split = forms.decompose(k, &omega).map_err(|e| run_error(case, e))?;
     let seconds = started.elapsed().as_secs_f64();

@@ -52,6 +52,7 @@ mod diffusion;
 mod disk;
 mod elasticity;
 mod error;
+mod form_diffusion;
 mod gradient;
 mod heat;
 mod hodge;
@@ -163,6 +164,7 @@ pub fn solve(
             nonlinear::solve(case, spec, complex, phase)
         }
         Problem::Diffusion(spec) => solve_diffusion(case, spec, complex, phase),
+        Problem::FormDiffusion(spec) => form_diffusion::solve(case, spec, complex, phase),
         Problem::Gradient(spec) => gradient::solve(case, spec, complex, phase),
         Problem::Heat(spec) => heat::solve(case, spec, complex, phase),
         Problem::Darcy(spec) => darcy::solve(case, spec, complex, phase),
@@ -199,6 +201,7 @@ pub fn check_data(case: &Case, complex: &Complex) -> Result<(), RunError> {
     match &case.problem {
         Problem::Diffusion(spec) if spec.is_nonlinear() => nonlinear::check(case, spec, complex),
         Problem::Diffusion(spec) => diffusion::check(case, spec, complex),
+        Problem::FormDiffusion(spec) => form_diffusion::check(case, spec, complex),
         Problem::Gradient(spec) => gradient::check(case, spec, complex),
         Problem::Heat(spec) => heat::check(case, spec, complex),
         Problem::Darcy(spec) => darcy::check(case, spec, complex),

@@ -58,6 +58,7 @@ pub(crate) fn form_degree(problem: &Problem) -> Option<usize> {
     match problem {
         Problem::Maxwell(_) => Some(1),
         Problem::Decomposition(spec) => Some(spec.degree),
+        Problem::FormDiffusion(spec) => Some(spec.degree),
         Problem::Hodge(spec) => Some(spec.degree),
         Problem::Cohomology(spec) => Some(spec.degree),
         _ => None,

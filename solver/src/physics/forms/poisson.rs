@@ -67,7 +67,8 @@ pub struct FormPoisson {
     pub source_harmonic: Vec<f64>,
     /// The harmonic forms used as constraints, M-orthonormal.
     pub harmonic: Vec<Vec<f64>>,
-    /// ‖b − A x‖₂ / ‖b‖₂ of the solved system (0 for f = 0).
+    /// ‖b − A x‖₂ / ‖M f‖₂ of the solved system, b = M(f − P_ℌ f) on the
+    /// free rows (0 for f = 0).
     pub residual: f64,
     /// The factorisation used.
     pub factorization: Factorization,
@@ -175,7 +176,10 @@ impl Forms<'_> {
             x[sigma + r] = solution[cell];
         }
         let norm = |v: &[f64]| v.iter().map(|a| a * a).sum::<f64>().sqrt();
-        let scale = norm(&rhs);
+        // Relative to the whole source's load M f: the compatible part can
+        // be 0 (a harmonic source), and the residual is then rounding of f.
+        let load = mass.apply(source);
+        let scale = norm(&free.iter().map(|&c| load[c]).collect::<Vec<_>>());
         let residual = if scale > 0.0 {
             norm(&residual_of(&x)) / scale
         } else {

@@ -1,9 +1,12 @@
-//! The `[problem]` tables of kind = "cohomology" and kind =
-//! "hodge-decomposition".
+//! The `[problem]` tables of kind = "cohomology", kind =
+//! "hodge-decomposition" and kind = "diffusion" with `degree` ≥ 1 (the
+//! Poisson problem for k-forms).
 
 use super::*;
 use crate::frontend::case::expr::Scope;
-use crate::frontend::case::{CohomologySpec, DecompositionSpec, HodgeMethod, Problem};
+use crate::frontend::case::{
+    CohomologySpec, DecompositionSpec, FormDiffusionSpec, HodgeMethod, Problem,
+};
 use crate::physics::forms::Boundary;
 use std::ops::Range;
 use toml_edit::TableLike;
@@ -94,6 +97,33 @@ impl Reader {
         }))
     }
 
+    /// A k-form given by its proxy field (`key` of `[problem]`): an array
+    /// of expressions, one per coordinate, or one expression.
+    fn proxy_field(
+        &mut self,
+        table: &dyn TableLike,
+        key: &str,
+        header: Option<Range<usize>>,
+        what: &str,
+        scope: &Scope,
+    ) -> Option<Vec<Expression>> {
+        match self.entry(table, "problem", key) {
+            Some(e) if e.item.as_array().is_some() => self.expression_list(&e, scope),
+            Some(e) => self
+                .expression_of(e.item, &format!("problem.{key}"), e.span(), scope)
+                .map(|f| vec![f]),
+            None => {
+                self.error(
+                    header,
+                    &format!("problem.{key}"),
+                    format!("missing: {what}"),
+                    Some(format!("e.g. {key} = [\"-y\", \"x\"] (one expression per coordinate; one expression for degree 0 or the top degree)")),
+                );
+                None
+            }
+        }
+    }
+
     pub(super) fn decomposition(
         &mut self,
         root: &dyn TableLike,
@@ -115,21 +145,13 @@ impl Reader {
         } else {
             Some((1, None))
         };
-        let field = match self.entry(table, "problem", "field") {
-            Some(e) if e.item.as_array().is_some() => self.expression_list(&e, scope),
-            Some(e) => self
-                .expression_of(e.item, "problem.field", e.span(), scope)
-                .map(|f| vec![f]),
-            None => {
-                self.error(
-                    header,
-                    "problem.field",
-                    "missing: the field whose de Rham cochain is ω (line integrals along the edges for degree 1)",
-                    Some("e.g. field = [\"-y\", \"x\"] (one expression per coordinate; one expression for degree 0 or the top degree)".into()),
-                );
-                None
-            }
-        };
+        let field = self.proxy_field(
+            table,
+            "field",
+            header,
+            "the field whose de Rham cochain is ω (line integrals along the edges for degree 1)",
+            scope,
+        );
         self.refuse_boundary_tables(root, "hodge-decomposition");
         let (degree, degree_span) = degree?;
         Some(Problem::Decomposition(DecompositionSpec {
@@ -138,6 +160,56 @@ impl Reader {
             degree,
             degree_span,
             field: field?,
+        }))
+    }
+
+    pub(super) fn form_diffusion(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        header: Option<Range<usize>>,
+        scope: &Scope,
+    ) -> Option<Problem> {
+        let (method, method_span) = self.star_method(table, header.clone());
+        let degree = self.count(
+            table,
+            "degree",
+            1,
+            header.clone(),
+            "the degree k of the unknown form, 1 to the mesh's dimension",
+        );
+        let boundary = self.choice(
+            table,
+            "boundary",
+            &[Boundary::Natural, Boundary::Essential],
+            Boundary::name,
+            "boundary condition",
+            None,
+            Some(Boundary::Natural),
+        );
+        let source = self.proxy_field(
+            table,
+            "source",
+            header,
+            "the source f of Δ_k u = f as a field (a vector field for 1-forms, and for 2-forms in 3D; a scalar for the top degree)",
+            scope,
+        );
+        if let Some((k, _)) = root.get_key_value("boundary") {
+            self.error(
+                k.span(),
+                "boundary",
+                "the Poisson problem for k-forms takes its one condition from problem.boundary (natural: absolute, u·n = 0 and rot u = 0 for 1-forms in 2D; essential: relative, u × n = 0 and div u = 0), not from [[boundary]] tables",
+                Some("remove the [[boundary]] tables; set boundary = \"essential\" under [problem] for relative conditions".into()),
+            );
+        }
+        let (degree, degree_span) = degree?;
+        Some(Problem::FormDiffusion(FormDiffusionSpec {
+            method: method?,
+            method_span,
+            degree,
+            degree_span,
+            boundary: boundary?,
+            source: source?,
         }))
     }
 }

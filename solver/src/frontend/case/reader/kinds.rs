@@ -22,6 +22,23 @@ pub(in crate::frontend::case) fn problem_kind(root: &dyn TableLike) -> &str {
         .unwrap_or("diffusion")
 }
 
+/// The degree of a Poisson problem for k-forms: `problem.degree` ≥ 1 of
+/// a diffusion case, read directly from the document (degree 0 is
+/// ordinary diffusion).
+pub(in crate::frontend::case) fn form_degree(root: &dyn TableLike) -> Option<i64> {
+    if problem_kind(root) != "diffusion" {
+        return None;
+    }
+    root.get("problem")
+        .and_then(Item::as_table_like)
+        .and_then(|p| p.get("degree"))
+        .and_then(Item::as_integer)
+        .filter(|&k| k >= 1)
+}
+
+/// The `problem` keys of a Poisson problem for k-forms.
+const FORM_DIFFUSION_KEYS: &[&str] = &["method", "degree", "boundary", "source"];
+
 /// The help line of an unknown `problem.kind`.
 pub(in crate::frontend::case) fn kind_help(other: &str) -> String {
     let kinds: Vec<String> = KIND_KEYS.iter().map(|(k, _)| k.to_string()).collect();
@@ -68,9 +85,19 @@ impl Reader {
         table: &dyn TableLike,
         kind: &str,
     ) {
-        let Some((_, keys)) = KIND_KEYS.iter().find(|(k, _)| *k == kind) else {
+        let Some((_, kind_keys)) = KIND_KEYS.iter().find(|(k, _)| *k == kind) else {
             // An unknown kind is reported by the caller.
             return;
+        };
+        let forms = form_degree(root);
+        let keys: &[&str] = if forms.is_some() {
+            FORM_DIFFUSION_KEYS
+        } else {
+            kind_keys
+        };
+        let shown = match forms {
+            Some(k) => format!("kind = \"{kind}\" with degree = {k} (Δ_{k} u = f for {k}-forms)"),
+            None => format!("kind = \"{kind}\""),
         };
         for (key, _) in table.iter() {
             if key == "kind" || keys.contains(&key) || !super::PROBLEM_KEYS.contains(&key) {
@@ -82,14 +109,15 @@ impl Reader {
                 .filter(|(_, ks)| ks.contains(&key))
                 .map(|(k, _)| *k)
                 .collect();
+            let mut users = users.join(", ");
+            if forms.is_none() && FORM_DIFFUSION_KEYS.contains(&key) {
+                users.push_str(", diffusion of k-forms (degree ≥ 1)");
+            }
             self.error(
                 span,
                 &join("problem", key),
-                format!(
-                    "not used by kind = \"{kind}\" (only by {})",
-                    users.join(", ")
-                ),
-                Some(format!("a {kind} problem takes: {}", keys.join(", "))),
+                format!("not used by {shown} (only by {users})"),
+                Some(format!("this problem takes: {}", keys.join(", "))),
             );
         }
         if kind != "coupled" {

@@ -33,7 +33,7 @@ mod tests;
 mod time;
 mod transport;
 
-use kinds::{kind_help, problem_kind, Conditions};
+use kinds::{form_degree, kind_help, problem_kind, Conditions};
 pub(in crate::frontend::case) use overrides::apply_overrides;
 
 pub(super) const TOP_KEYS: &[&str] = &[
@@ -94,6 +94,7 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
             "neumann",
             "neumann_tolerance",
             "reaction",
+            "degree",
         ],
     ),
     ("gradient", &["field", "metric"]),

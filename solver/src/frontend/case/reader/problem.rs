@@ -124,7 +124,21 @@ impl Reader {
             .unwrap_or_else(|| "diffusion".into());
         self.check_kind_keys(root, table, &kind);
         match kind.as_str() {
+            "diffusion" if form_degree(root).is_some() => {
+                self.form_diffusion(root, table, problem_entry.span(), scope)
+            }
             "diffusion" => {
+                if table.get("degree").is_some() {
+                    // Degree 0 is this problem (functions); anything else
+                    // that is not an integer ≥ 1 is refused here.
+                    self.count(
+                        table,
+                        "degree",
+                        0,
+                        None,
+                        "the degree k of the unknown: 0 (functions, ordinary diffusion) or 1 to the mesh's dimension (Δ_k u = f for k-forms)",
+                    );
+                }
                 let method = self.method(table, problem_entry.span());
                 // The conductivity and the reaction may use the solution u.
                 let with_u = scope.with_solution();

@@ -15,7 +15,10 @@ impl Reader {
         self.check_keys(table, "exact", EXACT_KEYS);
         let eigenproblem = matches!(problem_kind(root), "maxwell" | "hodge-laplacian");
         let elastic = problem_kind(root) == "elasticity";
+        let forms = form_degree(root).is_some();
         let solution = match self.entry(table, "exact", "solution") {
+            // A k-form's proxy: read below as `form`.
+            Some(_) if forms => None,
             Some(e) if elastic => {
                 self.error(
                     e.key_span.clone(),
@@ -115,8 +118,31 @@ impl Reader {
             }
             Some(e) => Some(self.expression_list(&e, scope)?),
         };
+        let form = match self.entry(table, "exact", "solution") {
+            Some(e) if forms && e.item.as_array().is_some() => {
+                Some(self.expression_list(&e, scope)?)
+            }
+            Some(e) if forms => Some(vec![self.expression_of(
+                e.item,
+                "exact.solution",
+                e.span(),
+                scope,
+            )?]),
+            _ => None,
+        };
+        if gradient.is_some() && forms {
+            if let Some(e) = self.entry(table, "exact", "gradient") {
+                self.error(
+                    e.key_span.clone(),
+                    "exact.gradient",
+                    "a k-form's error is measured on its cochain; the gradient of a form is not used",
+                    Some("remove exact.gradient".into()),
+                );
+            }
+        }
         Some(ExactSpec {
-            solution: if eigenproblem || elastic {
+            form,
+            solution: if eigenproblem || elastic || forms {
                 None
             } else {
                 Some(solution?)
