@@ -110,3 +110,99 @@ fn other_kinds_are_refused_on_the_flat_torus() -> Result {
     std::fs::remove_dir_all(&dir)?;
     Ok(())
 }
+
+/// `method = "supplied"`: the stars of the rectangle [0, 2] × [0, 1]
+/// written by hand for the unit square's 8 × 8 grid (a metric the mesh's
+/// coordinates do not have): ⋆₀ the vertex's share of the cell area
+/// hx·hy (halved per boundary axis), ⋆₁ = dual length / length (hy/hx on
+/// x-edges, hx/hy on y-edges, halved on the boundary), ⋆₂ = 1/(hx·hy),
+/// hx = 2/8, hy = 1/8. Δ₀ with natural conditions is then the
+/// vertex-centred Neumann Laplacian of the stretched grid, whose spectrum
+/// is exactly (4/hx²) sin²(mπ/16) + (4/hy²) sin²(lπ/16) (cosine
+/// eigenvectors, the 1D identity 2 − 2cos θ = 4 sin²(θ/2) at interior and
+/// boundary rows alike): the first six to 1e-12 (measured ≤ 1.2e-14;
+/// the eigensolver's error in λ is of the order of its residual squared).
+#[test]
+fn supplied_stars_give_the_stretched_grids_spectrum() -> Result {
+    use hasse_complex::generate::rectangle;
+    const N: usize = 8;
+    let (hx, hy) = (2.0 / N as f64, 1.0 / N as f64);
+    let dir = crate::scratch::Scratch::new("supplied-stars");
+    std::fs::create_dir_all(&*dir)?;
+    let mesh = rectangle(N, N, [0.0, 1.0], [0.0, 1.0])?;
+    let point = |v: usize| mesh.vertices().point(v).to_vec();
+    let on_side = |t: f64| t.abs() < 1e-12 || (t - 1.0).abs() < 1e-12;
+    let half = |on: bool| if on { 0.5 } else { 1.0 };
+    let star0: Vec<f64> = (0..mesh.cell_count(0))
+        .map(|v| {
+            let p = point(v);
+            hx * hy * half(on_side(p[0])) * half(on_side(p[1]))
+        })
+        .collect();
+    let star1: Vec<f64> = (0..mesh.cell_count(1))
+        .map(|e| {
+            let ends = mesh.cell_vertices(1, e);
+            let (a, b) = (point(ends[0]), point(ends[1]));
+            if (a[1] - b[1]).abs() < 1e-12 {
+                hy * half(on_side(a[1])) / hx
+            } else {
+                hx * half(on_side(a[0])) / hy
+            }
+        })
+        .collect();
+    let star2 = vec![1.0 / (hx * hy); mesh.cell_count(2)];
+    let mut files = Vec::new();
+    for (k, star) in [star0, star1, star2].iter().enumerate() {
+        let name = format!("star{k}.txt");
+        let text: Vec<String> = star.iter().map(|v| format!("{v:.17e}")).collect();
+        std::fs::write(dir.join(&name), format!("# ⋆_{k}\n{}\n", text.join("\n")))?;
+        files.push(format!("\"{name}\""));
+    }
+    let one_d =
+        |h: f64, m: usize| 4.0 / (h * h) * (m as f64 * std::f64::consts::PI / 16.0).sin().powi(2);
+    let mut exact: Vec<f64> = (0..=N)
+        .flat_map(|m| (0..=N).map(move |l| (m, l)))
+        .map(|(m, l)| one_d(hx, m) + one_d(hy, l))
+        .filter(|&l| l > 1e-9)
+        .collect();
+    exact.sort_by(f64::total_cmp);
+    let exact: Vec<String> = exact[..6].iter().map(|l| format!("{l:.17e}")).collect();
+    let case = dir.join("stretched.toml");
+    std::fs::write(
+        &case,
+        format!(
+            "[mesh]\ngenerator = \"rectangle\"\nn = [{N}, {N}]\n[problem]\nkind = \"hodge-laplacian\"\nmethod = \"supplied\"\nstars = [{}]\ndegree = 0\nmodes = 6\n[exact]\neigenvalues = [{}]\n",
+            files.join(", "),
+            exact.join(", ")
+        ),
+    )?;
+    let out = summary(case.to_str().ok_or("path")?, &[]);
+    assert!(out.contains("dim ker Δ_0 = 1"), "{out}");
+    let errors = relative_errors(&out);
+    assert_eq!(errors.len(), 6, "{out}");
+    assert!(errors.iter().all(|e| *e < 1e-12), "{errors:?}\n{out}");
+
+    // A file with a wrong count is refused by `hasse check`, with its
+    // name and both counts; stars with a computed method are refused.
+    std::fs::write(dir.join("star1.txt"), "1 2 3\n")?;
+    let out = hasse(&["check", case.to_str().ok_or("path")?]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("star1.txt holds 3 values, but ⋆_1 needs one per 1-cell: the mesh has 144"),
+        "{stderr}"
+    );
+    let out = hasse(&[
+        "check",
+        case.to_str().ok_or("path")?,
+        "--set",
+        "problem.method=\"dec\"",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("star files are read only with method = \"supplied\""),
+        "{stderr}"
+    );
+    Ok(())
+}

@@ -33,6 +33,9 @@ pub struct CohomologySpec {
     pub method: HodgeMethod,
     /// Where `problem.method` is written.
     pub method_span: Option<Range<usize>>,
+    /// The star files of `method = "supplied"` (`problem.stars`), one per
+    /// degree 0 … n; empty otherwise.
+    pub stars: Vec<std::path::PathBuf>,
     /// The degree k (`problem.degree`).
     pub degree: usize,
     /// Where `problem.degree` is written, for the check against the mesh.
@@ -71,6 +74,9 @@ pub struct DecompositionSpec {
     pub method: HodgeMethod,
     /// Where `problem.method` is written.
     pub method_span: Option<Range<usize>>,
+    /// The star files of `method = "supplied"` (`problem.stars`), one per
+    /// degree 0 … n; empty otherwise.
+    pub stars: Vec<std::path::PathBuf>,
     /// The degree k (`problem.degree`, default 1).
     pub degree: usize,
     /// Where `problem.degree` is written, for the check against the mesh.
@@ -114,6 +120,9 @@ pub struct FormDiffusionSpec {
     pub method: HodgeMethod,
     /// Where `problem.method` is written.
     pub method_span: Option<Range<usize>>,
+    /// The star files of `method = "supplied"` (`problem.stars`), one per
+    /// degree 0 … n; empty otherwise.
+    pub stars: Vec<std::path::PathBuf>,
     /// The degree k ≥ 1 (`problem.degree`).
     pub degree: usize,
     /// Where `problem.degree` is written, for the check against the mesh.

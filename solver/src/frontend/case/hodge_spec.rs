@@ -12,14 +12,18 @@ pub enum HodgeMethod {
     /// `whitney`: the Whitney (Galerkin) mass, the mixed block form
     /// (simplices).
     Whitney,
+    /// `supplied`: diagonal stars read from files, one per degree
+    /// (`problem.stars`), any cells.
+    Supplied,
 }
 
 impl HodgeMethod {
     /// Every method, in the order help texts list them.
-    pub const ALL: [HodgeMethod; 3] = [
+    pub const ALL: [HodgeMethod; 4] = [
         HodgeMethod::Dec,
         HodgeMethod::DecBarycentric,
         HodgeMethod::Whitney,
+        HodgeMethod::Supplied,
     ];
 
     /// The name case files use.
@@ -28,6 +32,7 @@ impl HodgeMethod {
             HodgeMethod::Dec => "dec",
             HodgeMethod::DecBarycentric => "dec-barycentric",
             HodgeMethod::Whitney => "whitney",
+            HodgeMethod::Supplied => "supplied",
         }
     }
 
@@ -38,6 +43,7 @@ impl HodgeMethod {
             HodgeMethod::Dec => Star::Diagonal(hasse_complex::DualKind::Circumcentric),
             HodgeMethod::DecBarycentric => Star::Diagonal(hasse_complex::DualKind::Barycentric),
             HodgeMethod::Whitney => Star::Whitney,
+            HodgeMethod::Supplied => Star::Supplied,
         }
     }
 }
@@ -68,6 +74,9 @@ pub struct HodgeSpec {
     pub method: HodgeMethod,
     /// Where `problem.method` is written.
     pub method_span: Option<Range<usize>>,
+    /// The star files of `method = "supplied"` (`problem.stars`), one per
+    /// degree 0 … n, relative to the working directory; empty otherwise.
+    pub stars: Vec<std::path::PathBuf>,
     /// `problem.boundary`: natural (absolute, default) or essential
     /// (relative).
     pub boundary: crate::physics::forms::Boundary,

@@ -71,7 +71,10 @@ impl Case {
                 );
             }
         }
-        if method != super::HodgeMethod::DecBarycentric {
+        if !matches!(
+            method,
+            super::HodgeMethod::DecBarycentric | super::HodgeMethod::Supplied
+        ) {
             if let Some(c) =
                 (0..complex.cell_count(n)).find(|&c| complex.cell_vertices(n, c).len() != n + 1)
             {

@@ -5,13 +5,14 @@
 //! proxy is a vector field, its Whitney vector per top cell
 //! (`NAME_x`, `NAME_y`, `NAME_z`).
 
+use super::stars::{forms_of, read_stars};
 use super::{vector_fn, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{Case, CohomologySpec, DecompositionSpec};
 use crate::frontend::output::Cochain;
 use crate::la::direct::Factorization;
 use crate::physics::forms::whitney_map::{cell_vectors, de_rham, Field, ProxyKind};
-use crate::physics::forms::{Boundary, Forms, FormsError};
+use crate::physics::forms::{Boundary, FormsError};
 use hasse_complex::Complex;
 use std::time::Instant;
 
@@ -88,7 +89,8 @@ pub(super) fn cohomology(
     phase("cohomology generators and harmonic projection");
     let started = Instant::now();
     let k = spec.degree;
-    let forms = Forms::new(complex, spec.method.star());
+    let stars = read_stars(case, &spec.stars, complex)?;
+    let forms = forms_of(case, spec.method, complex, &stars)?;
     let basis = forms
         .harmonic_basis_with(k, spec.boundary)
         .map_err(|e| run_error(case, e))?;
@@ -216,7 +218,8 @@ pub(super) fn check(
     spec: &DecompositionSpec,
     complex: &Complex,
 ) -> Result<(), RunError> {
-    check_field(case, complex, spec.degree, &spec.field, "problem.field")
+    check_field(case, complex, spec.degree, &spec.field, "problem.field")?;
+    read_stars(case, &spec.stars, complex).map(|_| ())
 }
 
 /// [`check`] for the proxy field `field` of a k-form written at `key`.
@@ -312,7 +315,8 @@ pub(super) fn decomposition(
     });
     let started = Instant::now();
     let omega = de_rham_of(case, complex, k, &spec.field, "problem.field")?;
-    let forms = Forms::new(complex, star);
+    let stars = read_stars(case, &spec.stars, complex)?;
+    let forms = forms_of(case, spec.method, complex, &stars)?;
     let split = forms.decompose(k, &omega).map_err(|e| run_error(case, e))?;
     let seconds = started.elapsed().as_secs_f64();
     let inner = |a: &[f64], b: &[f64]| forms.inner(k, a, b).map_err(|e| run_error(case, e));

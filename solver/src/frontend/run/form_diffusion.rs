@@ -12,11 +12,12 @@
 //! fluxes, its mean density on a top cell).
 
 use super::dec::{check_field, de_rham_of, run_error_at, vector_fields};
+use super::stars::{forms_of, read_stars};
 use super::{check_residual, RunError, RunResult};
 use crate::frontend::case::{Case, FormDiffusionSpec};
 use crate::frontend::output::Cochain;
 use crate::physics::diffusion::Errors;
-use crate::physics::forms::{Boundary, Forms};
+use crate::physics::forms::Boundary;
 use hasse_complex::Complex;
 use std::time::Instant;
 
@@ -50,7 +51,8 @@ pub(super) fn solve(
     phase("de Rham map, harmonic forms and the Δ_k solve");
     let started = Instant::now();
     let source = de_rham_of(case, complex, k, &spec.source, "problem.source")?;
-    let forms = Forms::new(complex, spec.method.star());
+    let stars = read_stars(case, &spec.stars, complex)?;
+    let forms = forms_of(case, spec.method, complex, &stars)?;
     let solved = forms.poisson(k, spec.boundary, &source).map_err(error)?;
     let seconds = started.elapsed().as_secs_f64();
     let mut warnings = Vec::new();

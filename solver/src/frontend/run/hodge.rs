@@ -7,7 +7,7 @@ use crate::frontend::case::{Case, HodgeSpec};
 use crate::frontend::output::Cochain;
 use crate::la::direct::Factorization;
 use crate::la::eigen::EigenError;
-use crate::physics::forms::{Boundary, Forms, FormsError};
+use crate::physics::forms::{Boundary, FormsError};
 use hasse_complex::Complex;
 use std::time::Instant;
 
@@ -39,7 +39,8 @@ pub(super) fn solve(
     phase("assembling Δ_k");
     let started = Instant::now();
     let k = spec.degree;
-    let forms = Forms::new(complex, spec.method.star());
+    let stars = super::stars::read_stars(case, &spec.stars, complex)?;
+    let forms = super::stars::forms_of(case, spec.method, complex, &stars)?;
     let laplacian = forms
         .hodge_laplacian(k, spec.boundary)
         .map_err(|e| run_error(case, e))?;

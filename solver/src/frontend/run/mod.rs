@@ -63,6 +63,7 @@ pub(crate) mod probes;
 mod quantities;
 pub mod refine;
 mod restart;
+mod stars;
 mod stream;
 mod transport;
 
@@ -205,7 +206,9 @@ pub fn check_data(case: &Case, complex: &Complex) -> Result<(), RunError> {
         Problem::Gradient(spec) => gradient::check(case, spec, complex),
         Problem::Heat(spec) => heat::check(case, spec, complex),
         Problem::Darcy(spec) => darcy::check(case, spec, complex),
-        Problem::Maxwell(_) | Problem::Hodge(_) | Problem::Cohomology(_) => Ok(()),
+        Problem::Maxwell(_) => Ok(()),
+        Problem::Hodge(spec) => stars::read_stars(case, &spec.stars, complex).map(|_| ()),
+        Problem::Cohomology(spec) => stars::read_stars(case, &spec.stars, complex).map(|_| ()),
         Problem::Decomposition(spec) => dec::check(case, spec, complex),
         Problem::Elasticity(spec) => elasticity::check(case, spec, complex),
         Problem::Coupled(spec) => coupled::check(case, spec, complex),

@@ -62,12 +62,16 @@ pub enum Star {
     Diagonal(DualKind),
     /// The Whitney (Galerkin) mass ∫ W_σ · W_τ, simplices only.
     Whitney,
+    /// Diagonal stars given by the user, one value per k-cell for every
+    /// degree ([`Forms::with_stars`]): a metric hasse cannot compute (an
+    /// anisotropic or curved one, another code's dual).
+    Supplied,
 }
 
 impl Star {
     /// Whether ⋆_k is diagonal (so ⋆⁻¹ is too).
     pub fn is_diagonal(&self) -> bool {
-        matches!(self, Star::Diagonal(_))
+        matches!(self, Star::Diagonal(_) | Star::Supplied)
     }
 }
 
@@ -147,12 +151,99 @@ pub enum FormsError {
 pub struct Forms<'a> {
     complex: &'a Complex,
     star: Star,
+    /// ⋆_k per degree for [`Star::Supplied`] (empty otherwise).
+    supplied: &'a [Vec<f64>],
 }
 
 impl<'a> Forms<'a> {
-    /// Forms on `complex` with the star `star`.
+    /// Forms on `complex` with the star `star` ([`Star::Supplied`] needs
+    /// [`Forms::with_stars`], which gives the values).
     pub fn new(complex: &'a Complex, star: Star) -> Self {
-        Self { complex, star }
+        Self {
+            complex,
+            star,
+            supplied: &[],
+        }
+    }
+
+    /// Forms on `complex` with the diagonal stars `stars[k]` (one value per
+    /// k-cell, k = 0 … n), checked for their lengths and finite values;
+    /// where an operator divides by a star or needs it as a mass it is
+    /// checked > 0 there, as the computed stars are.
+    ///
+    /// ```
+    /// use hasse_complex::generate::rectangle;
+    /// use hasse_solver::physics::forms::{Boundary, Forms};
+    /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+    /// // One square cell as the square [0, 2] × [0, 1] would measure it:
+    /// // ⋆₀ = quarter areas ½, ⋆₁ = 1/4 on the x-edges (dual ½ over
+    /// // length 2) and 1 on the y-edges (dual 1 over length 1), ⋆₂ = ½.
+    /// let k = rectangle(1, 1, [0.0, 1.0], [0.0, 1.0])?;
+    /// let x_edges: Vec<bool> = (0..4).map(|e| {
+    ///     let v = k.cell_vertices(1, e);
+    ///     let (a, b) = (k.vertices().point(v[0]), k.vertices().point(v[1]));
+    ///     a[1] == b[1]
+    /// }).collect();
+    /// let stars = vec![
+    ///     vec![0.5; 4],
+    ///     x_edges.iter().map(|&x| if x { 0.25 } else { 1.0 }).collect(),
+    ///     vec![0.5],
+    /// ];
+    /// let forms = Forms::with_stars(&k, &stars)?;
+    /// let area: f64 = forms.star(0)?.diagonal_weights().unwrap().iter().sum();
+    /// assert_eq!(area, 2.0);
+    /// // Δ₀ with natural conditions: the constants are the kernel.
+    /// assert_eq!(forms.hodge_laplacian(0, Boundary::Natural)?.betti(), 1);
+    /// # Ok(())
+    /// # }
+    /// ```
+    pub fn with_stars(complex: &'a Complex, stars: &'a [Vec<f64>]) -> Result<Self, FormsError> {
+        let n = complex.dim();
+        if stars.len() != n + 1 {
+            return Err(FormsError::Field(format!(
+                "a {n}-dimensional complex needs {} supplied stars (degrees 0 to {n}), got {}",
+                n + 1,
+                stars.len()
+            )));
+        }
+        for (k, star) in stars.iter().enumerate() {
+            let cells = complex.cell_count(k);
+            if star.len() != cells {
+                return Err(FormsError::Field(format!(
+                    "the supplied star ⋆_{k} has {} values, but the complex has {cells} {k}-cells",
+                    star.len()
+                )));
+            }
+            if let Some(cell) = star.iter().position(|v| !v.is_finite()) {
+                return Err(FormsError::Field(format!(
+                    "the supplied star ⋆_{k} is {} on {k}-cell {cell}",
+                    star[cell]
+                )));
+            }
+        }
+        Ok(Self {
+            complex,
+            star: Star::Supplied,
+            supplied: stars,
+        })
+    }
+
+    /// The diagonal ⋆_k of a diagonal star.
+    fn diagonal_star(&self, k: usize) -> Result<Option<Vec<f64>>, FormsError> {
+        Ok(match self.star {
+            Star::Diagonal(dual) => Some(self.complex.hodge_star(dual, k)?),
+            Star::Supplied => Some(
+                self.supplied
+                    .get(k)
+                    .ok_or_else(|| {
+                        FormsError::Field(format!(
+                            "no supplied star of degree {k}: build the forms with Forms::with_stars"
+                        ))
+                    })?
+                    .clone(),
+            ),
+            Star::Whitney => None,
+        })
     }
 
     /// The complex.
@@ -194,9 +285,9 @@ impl<'a> Forms<'a> {
     /// one dense block per top simplex for [`Star::Whitney`].
     pub fn star(&self, k: usize) -> Result<BlockMetric, FormsError> {
         self.check(k)?;
-        Ok(match self.star {
-            Star::Diagonal(kind) => BlockMetric::from_weights(self.complex.hodge_star(kind, k)?),
-            Star::Whitney => whitney::whitney_mass(self.complex, k)?,
+        Ok(match self.diagonal_star(k)? {
+            Some(weights) => BlockMetric::from_weights(weights),
+            None => whitney::whitney_mass(self.complex, k)?,
         })
     }
 
@@ -207,10 +298,9 @@ impl<'a> Forms<'a> {
         cells: Option<&[usize]>,
         what: &'static str,
     ) -> Result<Vec<f64>, FormsError> {
-        let Star::Diagonal(kind) = self.star else {
+        let Some(star) = self.diagonal_star(k)? else {
             return Err(FormsError::NeedsDiagonal(what));
         };
-        let star = self.complex.hodge_star(kind, k)?;
         let bad = |&c: &usize| !(star[c].is_finite() && star[c] > 0.0);
         let found = match cells {
             Some(cells) => cells.iter().copied().find(bad),

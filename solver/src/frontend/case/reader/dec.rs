@@ -9,15 +9,21 @@ use crate::frontend::case::{
 };
 use crate::physics::forms::Boundary;
 use std::ops::Range;
+use std::path::PathBuf;
 use toml_edit::TableLike;
 
 impl Reader {
-    /// `problem.method` of a DEC kind, with its span.
-    fn star_method(
+    /// `problem.method` of a DEC kind, with its span and the star files of
+    /// `method = "supplied"` (`problem.stars`).
+    pub(super) fn star_method(
         &mut self,
         table: &dyn TableLike,
         header: Option<Range<usize>>,
-    ) -> (Option<HodgeMethod>, Option<Range<usize>>) {
+    ) -> (
+        Option<HodgeMethod>,
+        Option<Range<usize>>,
+        Option<Vec<PathBuf>>,
+    ) {
         let span = self
             .entry(table, "problem", "method")
             .and_then(|e| e.span());
@@ -27,10 +33,74 @@ impl Reader {
             &HodgeMethod::ALL,
             HodgeMethod::name,
             "Hodge star",
-            header,
+            header.clone(),
             None,
         );
-        (method, span)
+        let stars = self.star_files(table, method, header);
+        (method, span, stars)
+    }
+
+    /// `problem.stars`: with `method = "supplied"`, one existing file per
+    /// degree (relative to the case file); refused with any other method.
+    fn star_files(
+        &mut self,
+        table: &dyn TableLike,
+        method: Option<HodgeMethod>,
+        header: Option<Range<usize>>,
+    ) -> Option<Vec<PathBuf>> {
+        let entry = self.entry(table, "problem", "stars");
+        let help = "e.g. stars = [\"star0.txt\", \"star1.txt\", \"star2.txt\"]: for degree k one value per k-cell in hasse's cell order (whitespace-separated, `#` starts a comment), paths relative to the case file";
+        match (method, entry) {
+            (Some(HodgeMethod::Supplied), None) => {
+                self.error(
+                    header,
+                    "problem.stars",
+                    "missing: method = \"supplied\" reads the diagonal Hodge stars from files, one per degree 0 to n",
+                    Some(help.into()),
+                );
+                None
+            }
+            (Some(HodgeMethod::Supplied), Some(e)) => {
+                let Some(array) = e.item.as_array() else {
+                    self.type_error(&e, "an array of file names, one per degree");
+                    return None;
+                };
+                let mut files = Vec::new();
+                for value in array.iter() {
+                    let Some(name) = value.as_str() else {
+                        self.error(
+                            value.span(),
+                            "problem.stars",
+                            "a file name (a string)",
+                            Some(help.into()),
+                        );
+                        return None;
+                    };
+                    let path = self.relative(name);
+                    if !path.is_file() {
+                        self.error(
+                            value.span(),
+                            "problem.stars",
+                            format!("no such file: {}", path.display()),
+                            Some("paths are relative to the case file".into()),
+                        );
+                        return None;
+                    }
+                    files.push(path);
+                }
+                Some(files)
+            }
+            (_, Some(e)) => {
+                self.error(
+                    e.key_span.clone(),
+                    "problem.stars",
+                    "star files are read only with method = \"supplied\"",
+                    Some("remove problem.stars, or set method = \"supplied\"".into()),
+                );
+                None
+            }
+            (_, None) => Some(Vec::new()),
+        }
     }
 
     /// Refuse `[[boundary]]` tables (these kinds constrain no tagged
@@ -69,7 +139,7 @@ impl Reader {
         table: &dyn TableLike,
         header: Option<Range<usize>>,
     ) -> Option<Problem> {
-        let (method, method_span) = self.star_method(table, header.clone());
+        let (method, method_span, stars) = self.star_method(table, header.clone());
         let degree = self.count(
             table,
             "degree",
@@ -91,6 +161,7 @@ impl Reader {
         Some(Problem::Cohomology(CohomologySpec {
             method: method?,
             method_span,
+            stars: stars?,
             degree,
             degree_span,
             boundary: boundary?,
@@ -131,7 +202,7 @@ impl Reader {
         header: Option<Range<usize>>,
         scope: &Scope,
     ) -> Option<Problem> {
-        let (method, method_span) = self.star_method(table, header.clone());
+        let (method, method_span, stars) = self.star_method(table, header.clone());
         // Every star is accepted: a diagonal one has its coexact part
         // eliminated, the Whitney mass is solved in mixed form.
         let degree = if table.get("degree").is_some() {
@@ -157,6 +228,7 @@ impl Reader {
         Some(Problem::Decomposition(DecompositionSpec {
             method: method?,
             method_span,
+            stars: stars?,
             degree,
             degree_span,
             field: field?,
@@ -170,7 +242,7 @@ impl Reader {
         header: Option<Range<usize>>,
         scope: &Scope,
     ) -> Option<Problem> {
-        let (method, method_span) = self.star_method(table, header.clone());
+        let (method, method_span, stars) = self.star_method(table, header.clone());
         let degree = self.count(
             table,
             "degree",
@@ -206,6 +278,7 @@ impl Reader {
         Some(Problem::FormDiffusion(FormDiffusionSpec {
             method: method?,
             method_span,
+            stars: stars?,
             degree,
             degree_span,
             boundary: boundary?,

@@ -1,7 +1,7 @@
 //! The `[problem]` table of kind = "hodge-laplacian": eigenpairs of Δ_k.
 
 use super::*;
-use crate::frontend::case::{HodgeMethod, HodgeSpec, Problem};
+use crate::frontend::case::{HodgeSpec, Problem};
 use crate::physics::forms::Boundary;
 use std::ops::Range;
 use toml_edit::TableLike;
@@ -52,18 +52,7 @@ impl Reader {
         table: &dyn TableLike,
         header: Option<Range<usize>>,
     ) -> Option<Problem> {
-        let method_span = self
-            .entry(table, "problem", "method")
-            .and_then(|e| e.span());
-        let method = self.choice(
-            table,
-            "method",
-            &HodgeMethod::ALL,
-            HodgeMethod::name,
-            "Hodge star",
-            header.clone(),
-            None,
-        );
+        let (method, method_span, stars) = self.star_method(table, header.clone());
         let boundary = self.choice(
             table,
             "boundary",
@@ -108,6 +97,7 @@ impl Reader {
         Some(Problem::Hodge(HodgeSpec {
             method: method?,
             method_span,
+            stars: stars?,
             boundary: boundary?,
             degree,
             degree_span,

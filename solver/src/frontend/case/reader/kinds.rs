@@ -37,7 +37,7 @@ pub(in crate::frontend::case) fn form_degree(root: &dyn TableLike) -> Option<i64
 }
 
 /// The `problem` keys of a Poisson problem for k-forms.
-const FORM_DIFFUSION_KEYS: &[&str] = &["method", "degree", "boundary", "source"];
+const FORM_DIFFUSION_KEYS: &[&str] = &["method", "degree", "boundary", "source", "stars"];
 
 /// The help line of an unknown `problem.kind`.
 pub(in crate::frontend::case) fn kind_help(other: &str) -> String {

@@ -81,6 +81,7 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "velocity",
     "scheme",
     "stabilisation",
+    "stars",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -103,10 +104,13 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
     ("maxwell", &["method", "mass", "modes"]),
     (
         "hodge-laplacian",
-        &["method", "degree", "modes", "boundary"],
+        &["method", "degree", "modes", "boundary", "stars"],
     ),
-    ("cohomology", &["method", "degree", "boundary"]),
-    ("hodge-decomposition", &["method", "degree", "field"]),
+    ("cohomology", &["method", "degree", "boundary", "stars"]),
+    (
+        "hodge-decomposition",
+        &["method", "degree", "field", "stars"],
+    ),
     (
         "elasticity",
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],
