@@ -83,8 +83,11 @@ pub struct DecompositionSpec {
     pub degree_span: Option<Range<usize>>,
     /// The field F (`problem.field`): one expression per coordinate for a
     /// vector proxy, one expression for a scalar one; ω = R_k F, its de
-    /// Rham cochain.
+    /// Rham cochain. Empty when ω is read from `cochain`.
     pub field: Vec<Expression>,
+    /// `problem.cochain`: a file holding ω itself, one value per k-cell
+    /// in hasse's cell order (instead of `field`).
+    pub cochain: Option<std::path::PathBuf>,
 }
 
 /// The Poisson problem for k-forms, Δ_k u = f with Δ_k = dδ + δd

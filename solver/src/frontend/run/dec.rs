@@ -5,7 +5,7 @@
 //! proxy is a vector field, its Whitney vector per top cell
 //! (`NAME_x`, `NAME_y`, `NAME_z`).
 
-use super::stars::{forms_of, read_stars};
+use super::stars::{forms_of, read_cochain, read_stars};
 use super::{vector_fn, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{Case, CohomologySpec, DecompositionSpec};
@@ -218,8 +218,34 @@ pub(super) fn check(
     spec: &DecompositionSpec,
     complex: &Complex,
 ) -> Result<(), RunError> {
-    check_field(case, complex, spec.degree, &spec.field, "problem.field")?;
+    omega_from_file(case, spec, complex)?;
+    if spec.cochain.is_none() {
+        check_field(case, complex, spec.degree, &spec.field, "problem.field")?;
+    }
     read_stars(case, &spec.stars, complex).map(|_| ())
+}
+
+/// ω read from `problem.cochain`, when the case gives it so.
+fn omega_from_file(
+    case: &Case,
+    spec: &DecompositionSpec,
+    complex: &Complex,
+) -> Result<Option<Vec<f64>>, RunError> {
+    let k = spec.degree;
+    spec.cochain
+        .as_ref()
+        .map(|path| {
+            read_cochain(
+                case,
+                path,
+                "problem.cochain",
+                &format!("the {k}-cochain ω"),
+                "one value per k-cell of problem.degree, in hasse's cell order (that of the cochains in hasse's output)",
+                k,
+                complex.cell_count(k),
+            )
+        })
+        .transpose()
 }
 
 /// [`check`] for the proxy field `field` of a k-form written at `key`.
@@ -314,7 +340,10 @@ pub(super) fn decomposition(
         "de Rham map and two Poisson solves"
     });
     let started = Instant::now();
-    let omega = de_rham_of(case, complex, k, &spec.field, "problem.field")?;
+    let omega = match omega_from_file(case, spec, complex)? {
+        Some(omega) => omega,
+        None => de_rham_of(case, complex, k, &spec.field, "problem.field")?,
+    };
     let stars = read_stars(case, &spec.stars, complex)?;
     let forms = forms_of(case, spec.method, complex, &stars)?;
     let split = forms.decompose(k, &omega).map_err(|e| run_error(case, e))?;
@@ -362,11 +391,13 @@ pub(super) fn decomposition(
             "the parts are ⋆-orthogonal only to {worst:.1e} of ‖ω‖², above {RESIDUAL_WARNING:.0e}"
         ));
     }
-    let mut fields = vec![
-        Cochain::new("omega", k, omega.clone()).with_description(format!(
-            "ω = R_{k}F, the de Rham cochain of the field on the {k}-cells"
-        )),
-    ];
+    let mut fields =
+        vec![
+            Cochain::new("omega", k, omega.clone()).with_description(match &spec.cochain {
+                Some(path) => format!("ω on the {k}-cells, read from {}", path.display()),
+                None => format!("ω = R_{k}F, the de Rham cochain of the field on the {k}-cells"),
+            }),
+        ];
     fields.extend(vector_fields(case, complex, k, "omega", &omega, "ω")?);
     let descriptions = [
         "the exact part dα",
@@ -431,7 +462,11 @@ pub(super) fn decomposition(
         (
             "split".to_string(),
             format!(
-                "ω = R_{k}F on {} {k}-cells = exact + coexact + harmonic ({lower}; {upper})",
+                "{} on {} {k}-cells = exact + coexact + harmonic ({lower}; {upper})",
+                match &spec.cochain {
+                    Some(path) => format!("ω from {}", path.display()),
+                    None => format!("ω = R_{k}F"),
+                },
                 complex.cell_count(k),
             ),
         ),

@@ -1,7 +1,8 @@
 //! The forms of a DEC case: the star its `method` names, and for
 //! `method = "supplied"` the diagonal stars read from `problem.stars`
 //! (one file per degree: one value per k-cell in hasse's cell order,
-//! whitespace-separated, `#` starting a comment).
+//! whitespace-separated, `#` starting a comment); and cochains read from
+//! files of the same format (`problem.cochain`).
 
 use super::RunError;
 use crate::frontend::case::{Case, HodgeMethod};
@@ -38,20 +39,32 @@ pub(super) fn read_stars(
     files
         .iter()
         .enumerate()
-        .map(|(k, path)| read_star(case, path, k, complex.cell_count(k)))
+        .map(|(k, path)| {
+            let what = format!("⋆_{k}");
+            let help = format!(
+                "file {} of problem.stars is degree {k}; `hasse info` prints the cell counts",
+                k + 1
+            );
+            read_cochain(case, path, KEY, &what, &help, k, complex.cell_count(k))
+        })
         .collect()
 }
 
-fn read_star(case: &Case, path: &PathBuf, k: usize, cells: usize) -> Result<Vec<f64>, RunError> {
+/// One value per k-cell from the file `path` (written at `key`), `what`
+/// naming them in messages: numbers separated by whitespace, `#` starting
+/// a comment; the count must be `cells`.
+pub(super) fn read_cochain(
+    case: &Case,
+    path: &PathBuf,
+    key: &str,
+    what: &str,
+    help: &str,
+    k: usize,
+    cells: usize,
+) -> Result<Vec<f64>, RunError> {
     let shown = path.display();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        RunError::input_at(
-            case,
-            KEY,
-            format!("cannot read the star file {shown}: {e}"),
-            None,
-        )
-    })?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| RunError::input_at(case, key, format!("cannot read {shown}: {e}"), None))?;
     let mut values = Vec::with_capacity(cells);
     for (number, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("");
@@ -59,16 +72,16 @@ fn read_star(case: &Case, path: &PathBuf, k: usize, cells: usize) -> Result<Vec<
             let value: f64 = word.parse().map_err(|_| {
                 RunError::input_at(
                     case,
-                    KEY,
+                    key,
                     format!("{shown}:{}: `{word}` is not a number", number + 1),
-                    Some("a star file holds numbers only, `#` starts a comment".into()),
+                    Some("the file holds numbers only, `#` starts a comment".into()),
                 )
             })?;
             if !value.is_finite() {
                 return Err(RunError::input_at(
                     case,
-                    KEY,
-                    format!("{shown}:{}: ⋆_{k} value {value} is not finite", number + 1),
+                    key,
+                    format!("{shown}:{}: {what} value {value} is not finite", number + 1),
                     None,
                 ));
             }
@@ -78,15 +91,12 @@ fn read_star(case: &Case, path: &PathBuf, k: usize, cells: usize) -> Result<Vec<
     if values.len() != cells {
         return Err(RunError::input_at(
             case,
-            KEY,
+            key,
             format!(
-                "{shown} holds {} values, but ⋆_{k} needs one per {k}-cell: the mesh has {cells}",
+                "{shown} holds {} values, but {what} needs one per {k}-cell: the mesh has {cells}",
                 values.len()
             ),
-            Some(format!(
-                "file {} of problem.stars is degree {k}; `hasse info` prints the cell counts",
-                k + 1
-            )),
+            Some(help.to_string()),
         ));
     }
     Ok(values)

@@ -216,13 +216,48 @@ impl Reader {
         } else {
             Some((1, None))
         };
-        let field = self.proxy_field(
-            table,
-            "field",
-            header,
-            "the field whose de Rham cochain is ω (line integrals along the edges for degree 1)",
-            scope,
-        );
+        let cochain = match self.entry(table, "problem", "cochain") {
+            None => Some(None),
+            Some(e) => match e.item.as_str() {
+                Some(name) => {
+                    let path = self.relative(name);
+                    if path.is_file() {
+                        Some(Some(path))
+                    } else {
+                        self.error(
+                            e.span(),
+                            "problem.cochain",
+                            format!("no such file: {}", path.display()),
+                            Some("paths are relative to the case file".into()),
+                        );
+                        None
+                    }
+                }
+                None => {
+                    self.type_error(&e, "a file name");
+                    None
+                }
+            },
+        };
+        let field = match (&cochain, self.entry(table, "problem", "field")) {
+            (Some(Some(_)), Some(e)) => {
+                self.error(
+                    e.key_span.clone(),
+                    "problem.field",
+                    "give ω either as a field (its de Rham cochain) or as a cochain file, not both",
+                    Some("remove problem.field or problem.cochain".into()),
+                );
+                None
+            }
+            (Some(Some(_)), None) => Some(Vec::new()),
+            _ => self.proxy_field(
+                table,
+                "field",
+                header,
+                "the field whose de Rham cochain is ω (line integrals along the edges for degree 1), or `cochain = \"omega.txt\"`, a file of its values",
+                scope,
+            ),
+        };
         self.refuse_boundary_tables(root, "hodge-decomposition");
         let (degree, degree_span) = degree?;
         Some(Problem::Decomposition(DecompositionSpec {
@@ -232,6 +267,7 @@ impl Reader {
             degree,
             degree_span,
             field: field?,
+            cochain: cochain?,
         }))
     }
 

@@ -82,6 +82,7 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "scheme",
     "stabilisation",
     "stars",
+    "cochain",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -109,7 +110,7 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
     ("cohomology", &["method", "degree", "boundary", "stars"]),
     (
         "hodge-decomposition",
-        &["method", "degree", "field", "stars"],
+        &["method", "degree", "field", "cochain", "stars"],
     ),
     (
         "elasticity",
