@@ -200,7 +200,19 @@ fn a_linear_steady_state_restarts_exactly_on_refinements() {
                 for (&u, &p) in u0.iter().zip(&vertices) {
                     approx::assert_abs_diff_eq!(u, linear(p), epsilon = 1e-14);
                 }
-                // 9 × 9 of the 17 × 17 vertices are coarse vertices.
+                // 9 × 9 of the 17 × 17 vertices are coarse vertices; the
+                // stored report says so too.
+                let report: serde_json::Value = serde_json::from_str(
+                    hdf5::File::open(dir.join("fine.h5"))
+                        .and_then(|f| f.dataset("provenance/report"))
+                        .and_then(|d| d.read_scalar::<hdf5::types::VarLenUnicode>())
+                        .expect("the report")
+                        .as_str(),
+                )
+                .expect("JSON");
+                assert_eq!(report["restart"]["mesh"], "refinement");
+                assert_eq!(report["restart"]["interpolated"], 208);
+                assert_eq!(report["restart"]["unknowns"], 289);
                 assert!(
                     summary.contains(
                         "on a refinement: 208 of 289 values interpolated (P1/Q1 in the saved cell), 81 at saved vertices"
