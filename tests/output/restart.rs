@@ -150,6 +150,17 @@ fn level(path: &Path, k: usize) -> (f64, Vec<f64>) {
     )
 }
 
+/// Run the linear case on the coarse 8 × 8 grid with `method`, from the
+/// linear field: coarse.h5, levels at t = 0, 0.01, 0.02.
+fn save_coarse(dir: &Path, method: &str) {
+    std::fs::write(
+        dir.join("coarse.toml"),
+        linear_case(COARSE, method, "\"1 + 2*x - y\""),
+    )
+    .expect("case");
+    run_ok(dir, &["run", "coarse.toml", "-q", "-o", "coarse"]);
+}
+
 fn run_ok(dir: &Path, args: &[&str]) -> String {
     let out = hasse(dir, args);
     assert!(
@@ -175,12 +186,7 @@ fn a_linear_steady_state_restarts_exactly_on_refinements() {
     ];
     let linear = |p: [f64; 2]| 1.0 + 2.0 * p[0] - p[1];
     for method in ["fe", "fv"] {
-        std::fs::write(
-            dir.join("coarse.toml"),
-            linear_case(COARSE, method, "\"1 + 2*x - y\""),
-        )
-        .expect("case");
-        run_ok(&dir, &["run", "coarse.toml", "-q", "-o", "coarse"]);
+        save_coarse(&dir, method);
         let (t_saved, u_saved) = level(&dir.join("coarse.h5"), 2);
         let (coarse_vertices, coarse_cells) = mesh_of(&dir.join("coarse.h5"));
         for (name, mesh) in fine_meshes {
@@ -262,12 +268,7 @@ fn a_restart_on_another_domain_or_mesh_is_refused_before_solving() {
     let wide = "[mesh]\ngenerator = \"rectangle\"\nn = [16, 8]\nx = [0.0, 2.0]";
     let mesh = hasse_complex::generate::rectangle(16, 8, [0.0, 2.0], [0.0, 1.0]).expect("grid");
     for method in ["fe", "fv"] {
-        std::fs::write(
-            dir.join("coarse.toml"),
-            linear_case(COARSE, method, "\"1 + 2*x - y\""),
-        )
-        .expect("case");
-        run_ok(&dir, &["run", "coarse.toml", "-q", "-o", "coarse"]);
+        save_coarse(&dir, method);
         // The first unknown's point beyond x = 1, in the wide mesh's own
         // numbering: a vertex (fe) or a cell centroid (fv).
         let (what, points): (&str, Vec<Vec<f64>>) = if method == "fe" {
@@ -307,40 +308,33 @@ fn a_restart_on_another_domain_or_mesh_is_refused_before_solving() {
         }
         assert!(!dir.join("wide.h5").exists(), "refused before any output");
         // Same domain, not nested: 12 × 12 squares straddle the 8 × 8 ones.
-        std::fs::write(
-            dir.join("straddle.toml"),
-            linear_case(
-                "[mesh]\ngenerator = \"rectangle\"\nn = [12, 12]",
-                method,
-                RESTART,
-            ),
-        )
-        .expect("case");
-        let out = hasse(&dir, &["check", "straddle.toml"]);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(
-            !out.status.success()
-                && stderr.contains("is not a refinement")
-                && stderr.contains("saved cell 0"),
-            "{method}: {stderr}"
+        assert_check_refuses(
+            &dir,
+            "[mesh]\ngenerator = \"rectangle\"\nn = [12, 12]",
+            method,
+            &["is not a refinement", "saved cell 0"],
         );
     }
     // The method of the saved run (fv, the last above) is the restart's.
-    std::fs::write(
-        dir.join("other.toml"),
-        linear_case(
-            "[mesh]\ngenerator = \"rectangle\"\nn = [16, 16]",
-            "fe",
-            RESTART,
-        ),
-    )
-    .expect("case");
-    let out = hasse(&dir, &["check", "other.toml"]);
+    assert_check_refuses(
+        &dir,
+        "[mesh]\ngenerator = \"rectangle\"\nn = [16, 16]",
+        "fe",
+        &[
+            "coarse.h5 was computed with method \"fv\"",
+            "this case uses \"fe\"",
+        ],
+    );
+}
+
+/// `hasse check` of a linear case on `mesh` restarted from coarse.h5
+/// fails, and its message holds each of `words`.
+fn assert_check_refuses(dir: &Path, mesh: &str, method: &str, words: &[&str]) {
+    std::fs::write(dir.join("refused.toml"), linear_case(mesh, method, RESTART)).expect("case");
+    let out = hasse(dir, &["check", "refused.toml"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        !out.status.success()
-            && stderr.contains("coarse.h5 was computed with method \"fv\"")
-            && stderr.contains("this case uses \"fe\""),
-        "{stderr}"
+        !out.status.success() && words.iter().all(|w| stderr.contains(w)),
+        "{method} on {mesh}: {stderr}"
     );
 }
