@@ -56,16 +56,20 @@ pub enum ReadMeshError {
 /// ```
 /// use hasse_solver::frontend::output::read_mesh::read_mesh;
 /// use hasse_solver::frontend::output::{write_run, Provenance, RunOutput};
-/// let k = hasse_complex::generate::rectangle(2, 1, [0.0, 2.0], [0.0, 1.0]).unwrap();
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// let k = hasse_complex::generate::rectangle(2, 1, [0.0, 2.0], [0.0, 1.0])?;
 /// let run = RunOutput { complex: &k, steps: vec![], provenance: Provenance::new(serde_json::Value::Null) };
 /// let dir = std::env::temp_dir().join(format!("hasse-doc-read-mesh-{}", std::process::id()));
-/// let files = write_run(&dir.join("run"), &run).unwrap();
-/// let back = read_mesh(&files.hdf5, "mesh").unwrap();
+/// let files = write_run(&dir.join("run"), &run)?;
+/// let back = read_mesh(&files.hdf5, "mesh")?;
 /// assert_eq!(back.cell_counts(), vec![6, 7, 2]);
 /// assert_eq!(back.cell_vertices(2, 1), k.cell_vertices(2, 1));
-/// let missing = read_mesh(&files.hdf5, "steps/0/mesh").unwrap_err().to_string();
-/// assert!(missing.contains("/steps/0/mesh"));
-/// std::fs::remove_dir_all(&dir).unwrap();
+/// // A run on one mesh has no mesh per level: the error names the group.
+/// let Err(missing) = read_mesh(&files.hdf5, "steps/0/mesh") else { panic!("read a missing mesh") };
+/// assert!(missing.to_string().contains("/steps/0/mesh"));
+/// std::fs::remove_dir_all(&dir)?;
+/// # Ok(())
+/// # }
 /// ```
 pub fn read_mesh(h5: &Path, mesh: &str) -> Result<Complex, ReadMeshError> {
     let hdf5_error = |dataset: &str| {
