@@ -91,6 +91,7 @@ mod hdf5_file;
 mod layout;
 mod levels;
 mod partial;
+pub mod read_mesh;
 pub mod study;
 #[cfg(test)]
 mod tests;

@@ -122,12 +122,14 @@ pub(super) fn solve_streaming<'a>(
 ) -> Result<RunResult, RunError> {
     let mut heat = heat_problem(case, spec);
     let mut time = spec.time.clone();
+    let mut restarted = None;
     if let Some(restart) = &spec.restart {
         let state = super::restart::read(case, spec, restart, complex)?;
         heat.start = state.time;
         heat.initial_field = Some(state.field);
         time.start = state.time;
         time.steps = state.steps;
+        restarted = Some((state.note, state.report));
     }
     let time = &time;
     if let Some(choice) = super::diffusion::solver_choice(case)? {
@@ -374,6 +376,10 @@ pub(super) fn solve_streaming<'a>(
             1e3 * history.solve_seconds_per_step,
         ),
     )];
+    if let Some((note, entry)) = restarted {
+        notes.insert(0, ("restart".to_string(), note));
+        report.insert("restart".into(), entry);
+    }
     if let Some(b) = &balance {
         notes.push((
             "balance".to_string(),
