@@ -201,9 +201,9 @@ fn heat_ode_limit_orders() -> Result {
     Ok(())
 }
 
-/// The shipped case's manufactured solution u = 1 + e^(−t)(sin πx sin πy
-/// + xy) (source and Dirichlet values both move with t) with Crank–
-/// Nicolson and Δt = 0.2/n refined with h = 1/n: the error at t = 0.2 is
+/// The shipped case's manufactured solution u = 1 + e^(−t) w with
+/// w = sin πx sin πy + xy (source and Dirichlet values both move with t),
+/// Crank–Nicolson and Δt = 0.2/n refined with h = 1/n: the error at t = 0.2 is
 /// O(h²) in space (P1 on triangles, the two-point flux on squares, both
 /// second order at the unknowns' points) plus O(Δt²) = O(h²) in time, so
 /// it falls by 2² per halving: the observed order over n = 16 → 32 must
@@ -324,6 +324,10 @@ fn check_refuses_bad_nonlinear_heat_input() {
             &["`problem.source`", "per region"],
         ),
         (
+            "problem.conductivity={ left = \"2\", default = \"1\" }",
+            &["`problem.conductivity`", "per region"],
+        ),
+        (
             "boundary.0.type=\"robin\"",
             &["`boundary[0].type`", "Robin"],
         ),
@@ -347,4 +351,25 @@ fn check_refuses_bad_nonlinear_heat_input() {
             assert!(stderr.contains(s), "{set}: `{s}` not in {stderr}");
         }
     }
+}
+
+/// θ = 0 (explicit) has no Newton step to take: `hasse check` refuses it
+/// at `time.theta` with the mesh, before stepping.
+#[test]
+fn check_refuses_explicit_nonlinear_heat() -> Result {
+    let dir = Scratch::new("nonlinear-heat-theta0");
+    std::fs::create_dir_all(&*dir)?;
+    let shipped = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(HEAT);
+    let text =
+        std::fs::read_to_string(shipped)?.replace("scheme = \"crank-nicolson\"", "theta = 0.0");
+    let case = dir.join("theta0.toml");
+    std::fs::write(&case, text)?;
+    let out = hasse(&["check", case.to_str().ok_or("path")?]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("`time.theta`"), "{stderr}");
+    assert!(stderr.contains("θ in (0, 1]"), "{stderr}");
+    Ok(())
 }
