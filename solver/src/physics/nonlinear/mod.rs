@@ -39,7 +39,10 @@
 //! [`NonlinearDiffusion::solve_transient_with`] for data in t), each step
 //! of the θ-scheme V (uⁿ⁺¹ − uⁿ)/Δt + θ F(uⁿ⁺¹, tⁿ⁺¹) + (1 − θ) F(uⁿ, tⁿ)
 //! = 0 (F the residual above with the source and boundary data at the
-//! given time) is solved the same way: its Jacobian V/Δt + θ J scales the
+//! given time: the ghosts and Dirichlet values from g_D(·, t), the load
+//! from f(·, t) and g_N(·, t); tⁿ = t₀ + n Δt; F(uⁿ, tⁿ) is the previous
+//! step's converged residual, so each level's data are assembled once)
+//! is solved the same way: its Jacobian V/Δt + θ J scales the
 //! first blocks of Ω_J and adds V/Δt to the third, on the same pattern and
 //! the same analysis for every step.
 

@@ -196,8 +196,10 @@ impl NonlinearDiffusion {
 
     /// As [`NonlinearDiffusion::solve_transient`] with source and boundary
     /// data in x and t from `data` (the problem's own are not used) and
-    /// levels at tⁿ = t₀ + n Δt: the scheme of the [module
-    /// documentation](self), F(·, t) assembled with the data at t.
+    /// levels at tⁿ = t₀ + n Δt: V (uⁿ⁺¹ − uⁿ)/Δt + θ F(uⁿ⁺¹, tⁿ⁺¹) +
+    /// (1 − θ) F(uⁿ, tⁿ) = 0 with F(·, t) assembled from the data at t (see
+    /// [`crate::physics::nonlinear`]); the fixed unknowns of uⁿ⁺¹ hold
+    /// g_D(·, tⁿ⁺¹).
     pub fn solve_transient_with(
         &self,
         complex: &Complex,
