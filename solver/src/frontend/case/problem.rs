@@ -285,8 +285,11 @@ pub struct TimeSpec {
 pub struct HeatSpec {
     /// `problem.method`, nodal or cell-centred.
     pub method: Method,
-    /// K (`problem.conductivity`, default 1), constant in time.
+    /// K (`problem.conductivity`, default 1), constant in time; a scalar
+    /// k(u, x) makes the problem nonlinear.
     pub conductivity: Coefficient,
+    /// r(u, x) (`problem.reaction`), which makes the problem nonlinear.
+    pub reaction: Option<Expression>,
     /// f(x, t).
     pub source: Expression,
     /// u(x, t₀).

@@ -120,6 +120,10 @@ pub(super) fn solve_streaming<'a>(
     phase: &mut dyn FnMut(&str),
     mut stream: Option<&mut LevelStream<'a>>,
 ) -> Result<RunResult, RunError> {
+    // k(u) or r(u): Newton in every step, nothing streamed.
+    if super::nonlinear_heat::is_nonlinear(spec) {
+        return super::nonlinear_heat::solve(case, spec, complex, phase);
+    }
     let mut heat = heat_problem(case, spec);
     let mut time = spec.time.clone();
     let mut restarted = None;
@@ -479,6 +483,9 @@ fn time_json(time: &crate::frontend::case::TimeSpec, history: &History) -> serde
 /// The conductivity and the source at t₀ evaluated where the solve
 /// evaluates them, without solving.
 pub(super) fn check(case: &Case, spec: &HeatSpec, complex: &Complex) -> Result<(), RunError> {
+    if super::nonlinear_heat::is_nonlinear(spec) {
+        return super::nonlinear_heat::check(case, spec, complex);
+    }
     let keys = Keys {
         prefix: "problem".into(),
         coefficient: "conductivity",

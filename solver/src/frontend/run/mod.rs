@@ -58,6 +58,7 @@ mod heat;
 mod hodge;
 mod maxwell;
 mod nonlinear;
+mod nonlinear_heat;
 mod petsc;
 pub(crate) mod probes;
 mod quantities;

@@ -35,16 +35,21 @@
 //! reaction still linearised), which leaves a symmetric matrix and linear
 //! convergence.
 //!
-//! In time ([`NonlinearDiffusion::solve_transient`]), each step of the
-//! θ-scheme V (u − u⁰)/Δt + θ F(u) + (1 − θ) F(u⁰) = 0 (F the residual
-//! above) is solved the same way: its Jacobian V/Δt + θ J scales the first
-//! blocks of Ω_J and adds V/Δt to the third, on the same pattern and the
-//! same analysis for every step.
+//! In time ([`NonlinearDiffusion::solve_transient`], and
+//! [`NonlinearDiffusion::solve_transient_with`] for data in t), each step
+//! of the θ-scheme V (uⁿ⁺¹ − uⁿ)/Δt + θ F(uⁿ⁺¹, tⁿ⁺¹) + (1 − θ) F(uⁿ, tⁿ)
+//! = 0 (F the residual above with the source and boundary data at the
+//! given time: the ghosts and Dirichlet values from g_D(·, t), the load
+//! from f(·, t) and g_N(·, t); tⁿ = t₀ + n Δt; F(uⁿ, tⁿ) is the previous
+//! step's converged residual, so each level's data are assembled once)
+//! is solved the same way: its Jacobian V/Δt + θ J scales the
+//! first blocks of Ω_J and adds V/Δt to the third, on the same pattern and
+//! the same analysis for every step.
 
 mod newton;
 mod transient;
 
-pub use transient::{NonlinearTransient, TimeStepping};
+pub use transient::{NonlinearTransient, TimeStepping, TransientData};
 
 use crate::la::direct::SolveError;
 use crate::la::fixed::FixedSplit;
@@ -407,18 +412,75 @@ pub(crate) struct System {
     pub(crate) dimension: usize,
 }
 
+/// The parts of [`System`] that come from the source and boundary data
+/// (the ones a transient run with data in t re-makes at every level).
+pub(crate) struct Data {
+    /// Dirichlet ghost values w on the rows of A.
+    pub(crate) ghosts: Vec<f64>,
+    /// b: sources and Neumann data.
+    pub(crate) load: Vec<f64>,
+    /// Unknowns held at Dirichlet values (nodal methods).
+    pub(crate) fixed: Vec<Option<f64>>,
+}
+
+/// The linear diffusion with conductivity 1 and the problem's data: its
+/// assembly gives Ω₀, A, and the data's ghosts, load and fixed values.
+fn assemble_linear(
+    problem: &NonlinearDiffusion,
+    complex: &Complex,
+) -> Result<(crate::physics::diffusion::Assembled, Data), NonlinearError> {
+    let mut linear = Diffusion::new(
+        problem.method,
+        Conductivity::Scalar(Arc::new(|_| 1.0)),
+        Arc::clone(&problem.source),
+    );
+    linear.boundary = problem.boundary.clone();
+    let assembled = linear.assemble(complex)?;
+    let ghosts = assembled.ghost_values.clone();
+    // The linear assembly lifted the ghosts with Ω₀ (b += Aᵀ Ω₀ w);
+    // here they enter the residual through Ω(u), so take them out.
+    let lifted = assembled
+        .canonical
+        .sum_transpose(&assembled.canonical.metric().apply(&ghosts));
+    let load: Vec<f64> = assembled
+        .rhs
+        .iter()
+        .zip(&lifted)
+        .map(|(b, l)| b - l)
+        .collect();
+    let fixed = assembled.fixed.clone();
+    Ok((
+        assembled,
+        Data {
+            ghosts,
+            load,
+            fixed,
+        },
+    ))
+}
+
 impl System {
+    /// The data of `problem` (the same method and mesh as this system's,
+    /// other source and boundary values), without the rest of the set-up.
+    pub(crate) fn data(
+        problem: &NonlinearDiffusion,
+        complex: &Complex,
+    ) -> Result<Data, NonlinearError> {
+        assemble_linear(problem, complex).map(|(_, data)| data)
+    }
+
+    /// Replace the source and boundary data (same fixed unknowns).
+    pub(crate) fn set_data(&mut self, data: Data) {
+        self.ghosts = data.ghosts;
+        self.load = data.load;
+        self.fixed = data.fixed;
+    }
+
     fn new(problem: &NonlinearDiffusion, complex: &Complex) -> Result<Self, NonlinearError> {
         problem.check()?;
         let started = std::time::Instant::now();
         let method = problem.method.name();
-        let mut linear = Diffusion::new(
-            problem.method,
-            Conductivity::Scalar(Arc::new(|_| 1.0)),
-            Arc::clone(&problem.source),
-        );
-        linear.boundary = problem.boundary.clone();
-        let assembled = linear.assemble(complex)?;
+        let (assembled, data) = assemble_linear(problem, complex)?;
         let weights = match assembled.canonical.metric().diagonal_weights() {
             Some(w) => w.to_vec(),
             None => {
@@ -429,18 +491,11 @@ impl System {
             }
         };
         let incidence = assembled.canonical.shared_incidence();
-        let ghosts = assembled.ghost_values.clone();
-        // The linear assembly lifted the ghosts with Ω₀ (b += Aᵀ Ω₀ w);
-        // here they enter the residual through Ω(u), so take them out.
-        let lifted = assembled
-            .canonical
-            .sum_transpose(&assembled.canonical.metric().apply(&ghosts));
-        let load: Vec<f64> = assembled
-            .rhs
-            .iter()
-            .zip(&lifted)
-            .map(|(b, l)| b - l)
-            .collect();
+        let Data {
+            ghosts,
+            load,
+            fixed,
+        } = data;
         let n = complex.dim();
         let location = assembled.location;
         let (row_points, unknown_points, volumes) = match location {
@@ -455,7 +510,7 @@ impl System {
                 complex.measure(n).to_vec(),
             ),
         };
-        let split = FixedSplit::new(&assembled.fixed);
+        let split = FixedSplit::new(&fixed);
         let jacobian = jacobian_operator(&incidence, &split)?;
         Ok(Self {
             location,
@@ -463,7 +518,7 @@ impl System {
             weights,
             ghosts,
             load,
-            fixed: assembled.fixed,
+            fixed,
             split,
             row_points,
             unknown_points,

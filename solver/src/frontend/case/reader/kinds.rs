@@ -163,19 +163,52 @@ impl Reader {
                 Some("use fe, fv, fd, dec or dec-barycentric".into()),
             );
         }
-        let conductivity = self.coefficient(table, "conductivity", scope);
+        // k and r may use u (which makes the problem nonlinear: Newton in
+        // every step); k(u, x) must then be one differentiable scalar.
+        let with_u = scope.with_solution();
+        let conductivity = self
+            .coefficient(table, "conductivity", &with_u)
+            .and_then(|k| self.nonlinear_conductivity(table, k));
+        let reaction = match self.entry(table, "problem", "reaction") {
+            Some(_) => self
+                .expression_at(table, "problem", "reaction", &with_u)
+                .and_then(|r| self.differentiable(table, "reaction", r))
+                .map(Some),
+            None => Some(None),
+        };
+        let nonlinear = reaction.as_ref().is_some_and(Option::is_some)
+            || match &conductivity {
+                Some(Coefficient::Scalar(e)) => e.uses_solution(),
+                _ => false,
+            };
+        let span_of = |key: &str| table.get_key_value(key).and_then(|(_, i)| i.span());
         if conductivity.as_ref().is_some_and(Coefficient::uses_time) {
             // As for a Robin α: K enters the matrix, which is assembled
             // and factorised once; evaluating it at t = 0 would freeze it
-            // silently (even when time.start ≠ 0).
-            let span = self
-                .entry(table, "problem", "conductivity")
-                .and_then(|e| e.span());
+            // silently (even when time.start ≠ 0). The nonlinear run
+            // evaluates k(u, x) and r(u, x) without t.
+            let message = if nonlinear {
+                "a nonlinear heat problem evaluates k(u, x) and r(u, x) without t: the conductivity may not depend on t"
+            } else {
+                "the conductivity enters the matrix, which is assembled and factorised once: it may not depend on t"
+            };
             self.error(
-                span,
+                span_of("conductivity"),
                 "problem.conductivity",
-                "the conductivity enters the matrix, which is assembled and factorised once: it may not depend on t",
+                message,
                 Some("the source and the boundary values may depend on t; the conductivity may vary with x, y and z".into()),
+            );
+        }
+        if reaction
+            .as_ref()
+            .and_then(Option::as_ref)
+            .is_some_and(|r| r.uses_time())
+        {
+            self.error(
+                span_of("reaction"),
+                "problem.reaction",
+                "a nonlinear heat problem evaluates r(u, x) without t: the reaction may not depend on t",
+                Some("put the part that depends on t in the source".into()),
             );
         }
         let source = match self.entry(table, "problem", "source") {
@@ -205,15 +238,123 @@ impl Reader {
         if method == Some(Method::FvMimetic) {
             return None;
         }
+        if nonlinear {
+            self.check_nonlinear_heat(
+                root,
+                table,
+                conductivity.as_ref(),
+                &boundary,
+                source.as_ref(),
+                restart.is_some(),
+            );
+        }
         Some(Problem::Heat(HeatSpec {
             method: method?,
             conductivity: conductivity?,
+            reaction: reaction?,
             source: source?,
             initial: initial?,
             boundary,
             time: time?,
             restart,
         }))
+    }
+
+    /// What a nonlinear heat case (k with u, or a reaction) cannot combine
+    /// with, found from the input alone: Robin conditions, a source per
+    /// region, a restart, adaptive steps, solvers other than the direct
+    /// LU of Newton's steps, quantities and probes.
+    fn check_nonlinear_heat(
+        &mut self,
+        root: &dyn TableLike,
+        table: &dyn TableLike,
+        conductivity: Option<&Coefficient>,
+        boundary: &[crate::frontend::case::BoundarySpec],
+        source: Option<&crate::frontend::case::expr::Expression>,
+        restart: bool,
+    ) {
+        let span_of =
+            |t: &dyn TableLike, key: &str| t.get_key_value(key).and_then(|(_, i)| i.span());
+        let message = match conductivity {
+            Some(Coefficient::Tensor(_)) => Some("a nonlinear problem takes a scalar conductivity"),
+            Some(Coefficient::Scalar(k)) if k.regions().is_some() => {
+                Some("values per region are not supported in a nonlinear problem")
+            }
+            _ => None,
+        };
+        if let Some(message) = message {
+            self.error(
+                span_of(table, "conductivity"),
+                "problem.conductivity",
+                message,
+                Some("write k(u, x) as one expression (if(…) selects by position)".into()),
+            );
+        }
+        for b in boundary {
+            if matches!(
+                b.kind,
+                crate::frontend::case::BoundaryKindSpec::Robin { .. }
+            ) {
+                self.error(
+                    b.tag_span.clone(),
+                    &format!("{}.type", b.key),
+                    "Robin conditions are not supported with a u-dependent conductivity or a reaction",
+                    Some("use dirichlet or neumann".into()),
+                );
+            }
+        }
+        if source.is_some_and(|f| f.regions().is_some()) {
+            self.error(
+                span_of(table, "source"),
+                "problem.source",
+                "values per region are not supported in a nonlinear problem",
+                Some("write one expression (if(…) selects by position)".into()),
+            );
+        }
+        if restart {
+            self.error(
+                span_of(table, "initial"),
+                "problem.initial",
+                "a nonlinear heat run cannot restart from a saved level",
+                Some("give the initial temperature as an expression".into()),
+            );
+        }
+        let time = root.get("time").and_then(Item::as_table_like);
+        if let Some(adaptive) = time.and_then(|t| t.get_key_value("adaptive")) {
+            self.error(
+                adaptive.0.span(),
+                "time.adaptive",
+                "a nonlinear heat run takes constant steps: adaptive step sizes are not available for it",
+                Some("remove time.adaptive and choose time.dt".into()),
+            );
+        }
+        if let Some(kind) = root
+            .get("solver")
+            .and_then(Item::as_table_like)
+            .and_then(|t| t.get_key_value("type"))
+        {
+            if kind.1.as_str().is_some_and(|k| k != "direct") {
+                self.error(
+                    kind.1.span(),
+                    "solver.type",
+                    "a nonlinear problem solves its Newton steps with a direct LU factorisation; other solver types are not available for it",
+                    Some("remove solver.type (or set it to \"direct\")".into()),
+                );
+            }
+        }
+        let output = root.get("output").and_then(Item::as_table_like);
+        for name in ["quantity", "probe"] {
+            if let Some((key, _)) = output.and_then(|o| o.get_key_value(name)) {
+                self.error(
+                    key.span(),
+                    &format!("output.{name}"),
+                    format!("output.{name} is not evaluated for a nonlinear problem"),
+                    Some(format!(
+                        "remove [[output.{name}]]; the field u is in the output"
+                    )),
+                );
+            }
+        }
     }
 
     /// `problem.initial = { from = "run.h5", level = "last" | k }`.

@@ -100,7 +100,10 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
         ],
     ),
     ("gradient", &["field", "metric"]),
-    ("heat", &["method", "conductivity", "source", "initial"]),
+    (
+        "heat",
+        &["method", "conductivity", "source", "initial", "reaction"],
+    ),
     ("darcy", &["method", "permeability", "source"]),
     ("maxwell", &["method", "mass", "modes"]),
     (

@@ -241,7 +241,7 @@ impl Reader {
 
     /// A conductivity that uses u must be one scalar expression whose
     /// derivative exmex can form.
-    fn nonlinear_conductivity(
+    pub(super) fn nonlinear_conductivity(
         &mut self,
         table: &dyn TableLike,
         k: Coefficient,
@@ -278,7 +278,7 @@ impl Reader {
     }
 
     /// `e` (at `problem.<key>`) if its derivative with respect to u exists.
-    fn differentiable(
+    pub(super) fn differentiable(
         &mut self,
         table: &dyn TableLike,
         key: &str,
