@@ -34,6 +34,7 @@
 
 mod dec_spec;
 pub mod diagnostic;
+mod elasticity_spec;
 pub mod expr;
 mod hodge_spec;
 mod mesh_checks;
@@ -44,6 +45,7 @@ mod transport_spec;
 
 pub use dec_spec::{CohomologySpec, DecompositionSpec, FormDiffusionSpec};
 pub use diagnostic::{Diagnostic, Diagnostics};
+pub use elasticity_spec::{ElasticBoundaryKind, ElasticBoundarySpec, ElasticitySpec, MaterialSpec};
 pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
 pub use quantity::{ProbeSpec, QuantityKind, QuantitySpec};
