@@ -366,7 +366,7 @@ fn bad_studies_exit_2_and_write_nothing() {
         ),
         (
             vec!["converge", "cases/torus.toml", "--levels", "2", "-o", o],
-            "measures diffusion, heat, darcy and coupled cases; this case is kind = \"gradient\"",
+            "measures diffusion (of functions or k-forms), heat, darcy and coupled cases; this case is kind = \"gradient\"",
         ),
         (
             vec![
