@@ -664,7 +664,7 @@ pub(super) const REGIONAL_KEYS: &str = "values per region are accepted by the co
 pub(super) fn expression_help(e: &ExprError, scope: &Scope) -> String {
     match e {
         ExprError::UnknownVariable { name, .. } if name == "u" => format!(
-            "the solution u may appear only in the conductivity and reaction of a diffusion problem (which makes it nonlinear); here expressions may use {}",
+            "the solution u may appear only in the conductivity and reaction of a diffusion or heat problem (which makes it nonlinear); here expressions may use {}",
             scope.names().join(", ")
         ),
         ExprError::UnknownVariable { .. } => format!(
