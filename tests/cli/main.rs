@@ -11,6 +11,8 @@
 
 #[path = "../common/hasse.rs"]
 mod hasse;
+#[path = "../common/orders.rs"]
+mod orders;
 #[path = "../common/pyenv.rs"]
 mod pyenv;
 #[path = "../common/scratch.rs"]

@@ -147,18 +147,6 @@ fn check_refuses_bad_nonlinear_input() {
 
 const HEAT: &str = "cases/nonlinear-heat.toml";
 
-/// Least-squares slope of log e against log h (as tests/common/orders.rs,
-/// which this binary does not include).
-fn slope(h: &[f64], e: &[f64]) -> f64 {
-    let x: Vec<f64> = h.iter().map(|v| v.ln()).collect();
-    let y: Vec<f64> = e.iter().map(|v| v.ln()).collect();
-    let m = x.len() as f64;
-    let (mx, my) = (x.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
-    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - mx) * (b - my)).sum();
-    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
-    sxy / sxx
-}
-
 /// The ODE limit: with zero flux on the whole boundary (insulated), no
 /// source and a uniform start u₀ = 1, every unknown follows u' = −u³ (the
 /// differences Au vanish, so does the flux whatever k(u) is), whose
@@ -191,7 +179,7 @@ fn heat_ode_limit_orders() -> Result {
             h.push(dt);
             e.push(reported(&out, "error", "max")?);
         }
-        let p = slope(&h, &e);
+        let p = crate::orders::order(&h, &e);
         eprintln!("{scheme}: errors at t = 1 {e:?}, order {p}");
         assert!(
             (p - expected).abs() < 0.15,

@@ -17,7 +17,7 @@ use std::time::Instant;
 
 /// Steady data are assembled once; data that use t are re-assembled at
 /// every step, so the distinction matters for speed.
-fn time_fn(e: &Expression) -> TimeFn {
+pub(super) fn time_fn(e: &Expression) -> TimeFn {
     if e.uses_time() {
         let e = e.clone();
         TimeFn::Varying(Arc::new(move |x: &[f64], t: f64| e.eval(x, t)))
@@ -156,17 +156,7 @@ pub(super) fn solve_streaming<'a>(
     });
     let started = Instant::now();
     let initial = |x: &[f64]| spec.initial.eval(x, time.start);
-    let dim = if heat.at(time.start).location() == crate::metric::Location::Nodal {
-        0
-    } else {
-        complex.dim()
-    };
-    let points = super::field_points(complex, dim);
-    let weights = if dim == 0 {
-        lumped_vertex_volumes(complex)
-    } else {
-        complex.measure(dim).to_vec()
-    };
+    let (dim, points, weights) = level_points(complex, heat.at(time.start).location());
     let exact = case.exact.as_ref().and_then(|e| e.solution.as_ref());
     let method = spec.method.name();
     // The fields of each level are made as it completes, so that they can
@@ -506,4 +496,24 @@ fn short(t: f64) -> String {
     let text = format!("{t:.10e}");
     let value: f64 = text.parse().unwrap_or(t);
     format!("{value}")
+}
+
+/// Where a heat run's unknowns sit, for its per-level errors: the
+/// dimension of their cells (0 for nodal methods), their points and
+/// their weights (lumped vertex volumes or cell measures).
+pub(super) fn level_points(
+    complex: &Complex,
+    location: crate::metric::Location,
+) -> (usize, Vec<Vec<f64>>, Vec<f64>) {
+    let dim = if location == crate::metric::Location::Nodal {
+        0
+    } else {
+        complex.dim()
+    };
+    let weights = if dim == 0 {
+        lumped_vertex_volumes(complex)
+    } else {
+        complex.measure(dim).to_vec()
+    };
+    (dim, super::field_points(complex, dim), weights)
 }

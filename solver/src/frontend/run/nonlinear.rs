@@ -18,7 +18,11 @@ fn field_fn(e: &Expression) -> FieldFn {
 
 /// c(u, x) and ∂c/∂u from one expression; the reader has checked that the
 /// derivative exists, so an error here is a case changed since.
-fn coefficient(case: &Case, key: &str, e: &Expression) -> Result<nonlinear::Coefficient, RunError> {
+pub(super) fn coefficient(
+    case: &Case,
+    key: &str,
+    e: &Expression,
+) -> Result<nonlinear::Coefficient, RunError> {
     let derivative = e
         .derivative_u()
         .map_err(|error| RunError::input_at(case, key, error.to_string(), None))?;
@@ -68,29 +72,43 @@ pub(super) fn nonlinear_problem(
     let monitor: Option<nonlinear::Monitor> = settings.monitor.then(|| {
         let name = settings.iteration.name();
         let monitor: nonlinear::Monitor = Arc::new(move |step: &Step| {
-            eprintln!(
-                "{name} {:>3}: residual {:.3e} (relative {:.2e}), step {}, rate {}",
-                step.iteration,
-                step.residual,
-                step.relative,
-                step.step_length,
-                if step.rate.is_nan() {
-                    "-".to_string()
-                } else {
-                    format!("{:.3e}", step.rate)
-                }
-            );
+            eprintln!("{name} {}", monitor_figures(step));
         });
         monitor
     });
-    problem.options = NonlinearOptions {
+    problem.options = options(settings, monitor);
+    Ok(problem)
+}
+
+/// A monitor line's figures for one iteration: its number, the residual
+/// (absolute and relative), the line search's step and the rate.
+pub(super) fn monitor_figures(step: &Step) -> String {
+    format!(
+        "{:>3}: residual {:.3e} (relative {:.2e}), step {}, rate {}",
+        step.iteration,
+        step.residual,
+        step.relative,
+        step.step_length,
+        if step.rate.is_nan() {
+            "-".to_string()
+        } else {
+            format!("{:.3e}", step.rate)
+        }
+    )
+}
+
+/// The library's iteration settings from `[solver.nonlinear]`.
+pub(super) fn options(
+    settings: &crate::frontend::case::NonlinearSolverSpec,
+    monitor: Option<nonlinear::Monitor>,
+) -> NonlinearOptions {
+    NonlinearOptions {
         iteration: settings.iteration,
         tolerance: settings.tolerance,
         max_iterations: settings.max_iterations,
         initial: None,
         monitor,
-    };
-    Ok(problem)
+    }
 }
 
 fn keys(spec: &DiffusionSpec) -> Keys<'_> {

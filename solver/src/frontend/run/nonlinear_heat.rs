@@ -8,20 +8,17 @@
 //! Nothing is streamed: a step that does not converge fails the run before
 //! any level is written, so a failed run leaves no output file.
 
+use super::heat::time_fn;
+use super::nonlinear::{coefficient, monitor_figures, options};
 use super::{diffusion_error, Keys, RunError, RunResult};
-use crate::frontend::case::expr::Expression;
 use crate::frontend::case::{BoundaryKindSpec, Case, Coefficient, HeatSpec};
 use crate::frontend::output::Cochain;
 use crate::la::direct::Factorization;
-use crate::metric::mass::lumped_vertex_volumes;
-use crate::metric::Location;
-use crate::physics::diffusion::{Diffusion, Errors};
-use crate::physics::heat::{HeatBoundary, SpaceTimeFn, TimeFn};
+use crate::physics::diffusion::Errors;
+use crate::physics::heat::HeatBoundary;
 use crate::physics::nonlinear::{
-    self, FieldFn, NonlinearDiffusion, NonlinearError, NonlinearOptions, Step, TimeStepping,
-    TransientData,
+    self, NonlinearDiffusion, NonlinearError, Step, TimeStepping, TransientData,
 };
-use crate::physics::Conductivity;
 use hasse_complex::Complex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -32,35 +29,6 @@ use std::time::Instant;
 pub(super) fn is_nonlinear(spec: &HeatSpec) -> bool {
     spec.reaction.is_some()
         || matches!(&spec.conductivity, Coefficient::Scalar(k) if k.uses_solution())
-}
-
-/// c(u, x) from an expression in x and u (the reader refused t in it).
-fn field_fn(e: &Expression) -> FieldFn {
-    let e = e.clone();
-    Arc::new(move |u: f64, x: &[f64]| e.eval_with(x, 0.0, u))
-}
-
-/// c(u, x) and ∂c/∂u from one expression; the reader has checked that the
-/// derivative exists, so an error here is a case changed since.
-fn coefficient(case: &Case, key: &str, e: &Expression) -> Result<nonlinear::Coefficient, RunError> {
-    let derivative = e
-        .derivative_u()
-        .map_err(|error| RunError::input_at(case, key, error.to_string(), None))?;
-    Ok(nonlinear::Coefficient::new(
-        field_fn(e),
-        field_fn(&derivative),
-    ))
-}
-
-/// A datum in x and t: steady data are assembled once for the run.
-fn time_fn(e: &Expression) -> TimeFn {
-    let e = e.clone();
-    if e.uses_time() {
-        let g: SpaceTimeFn = Arc::new(move |x: &[f64], t: f64| e.eval(x, t));
-        TimeFn::Varying(g)
-    } else {
-        TimeFn::Steady(Arc::new(move |x: &[f64]| e.eval(x, 0.0)))
-    }
 }
 
 fn keys(spec: &HeatSpec) -> Keys<'_> {
@@ -99,28 +67,14 @@ fn problem(case: &Case, spec: &HeatSpec) -> Result<(NonlinearDiffusion, Transien
                 step_number.fetch_add(1, Ordering::Relaxed);
             }
             eprintln!(
-                "step {} {name} {:>3}: residual {:.3e} (relative {:.2e}), step {}, rate {}",
+                "step {} {name} {}",
                 step_number.load(Ordering::Relaxed),
-                step.iteration,
-                step.residual,
-                step.relative,
-                step.step_length,
-                if step.rate.is_nan() {
-                    "-".to_string()
-                } else {
-                    format!("{:.3e}", step.rate)
-                }
+                monitor_figures(step)
             );
         });
         monitor
     });
-    problem.options = NonlinearOptions {
-        iteration: settings.iteration,
-        tolerance: settings.tolerance,
-        max_iterations: settings.max_iterations,
-        initial: None,
-        monitor,
-    };
+    problem.options = options(settings, monitor);
     let data = TransientData {
         start: spec.time.start,
         source: time_fn(&spec.source),
@@ -206,23 +160,7 @@ pub(super) fn solve(
         .map_err(|e| nonlinear_error(case, spec, e))?;
     let total = started.elapsed().as_secs_f64();
     let post = Instant::now();
-    let location = Diffusion::new(
-        spec.method,
-        Conductivity::Scalar(Arc::new(|_| 1.0)),
-        Arc::new(|_| 0.0),
-    )
-    .location();
-    let dim = if location == Location::Nodal {
-        0
-    } else {
-        complex.dim()
-    };
-    let points = super::field_points(complex, dim);
-    let weights = if dim == 0 {
-        lumped_vertex_volumes(complex)
-    } else {
-        complex.measure(dim).to_vec()
-    };
+    let (dim, points, weights) = super::heat::level_points(complex, spec.method.location());
     let exact = case.exact.as_ref().and_then(|e| e.solution.as_ref());
     let mut series = Vec::new();
     let mut level_errors = Vec::new();

@@ -40,6 +40,19 @@ impl Reader {
         (method, span, stars)
     }
 
+    /// `problem.boundary` of a DEC kind: natural (default) or essential.
+    pub(super) fn form_boundary(&mut self, table: &dyn TableLike) -> Option<Boundary> {
+        self.choice(
+            table,
+            "boundary",
+            &[Boundary::Natural, Boundary::Essential],
+            Boundary::name,
+            "boundary condition",
+            None,
+            Some(Boundary::Natural),
+        )
+    }
+
     /// `problem.stars`: with `method = "supplied"`, one existing file per
     /// degree (relative to the case file); refused with any other method.
     fn star_files(
@@ -147,15 +160,7 @@ impl Reader {
             header,
             "the degree k of the harmonic forms, 0 to the mesh's dimension (absolute or, with boundary = \"essential\", relative)",
         );
-        let boundary = self.choice(
-            table,
-            "boundary",
-            &[Boundary::Natural, Boundary::Essential],
-            Boundary::name,
-            "boundary condition",
-            None,
-            Some(Boundary::Natural),
-        );
+        let boundary = self.form_boundary(table);
         self.refuse_boundary_tables(root, "cohomology");
         let (degree, degree_span) = degree?;
         Some(Problem::Cohomology(CohomologySpec {
@@ -286,15 +291,7 @@ impl Reader {
             header.clone(),
             "the degree k of the unknown form, 1 to the mesh's dimension",
         );
-        let boundary = self.choice(
-            table,
-            "boundary",
-            &[Boundary::Natural, Boundary::Essential],
-            Boundary::name,
-            "boundary condition",
-            None,
-            Some(Boundary::Natural),
-        );
+        let boundary = self.form_boundary(table);
         let source = self.proxy_field(
             table,
             "source",

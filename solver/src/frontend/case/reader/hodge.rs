@@ -2,7 +2,6 @@
 
 use super::*;
 use crate::frontend::case::{HodgeSpec, Problem};
-use crate::physics::forms::Boundary;
 use std::ops::Range;
 use toml_edit::TableLike;
 
@@ -53,15 +52,7 @@ impl Reader {
         header: Option<Range<usize>>,
     ) -> Option<Problem> {
         let (method, method_span, stars) = self.star_method(table, header.clone());
-        let boundary = self.choice(
-            table,
-            "boundary",
-            &[Boundary::Natural, Boundary::Essential],
-            Boundary::name,
-            "boundary condition",
-            None,
-            Some(Boundary::Natural),
-        );
+        let boundary = self.form_boundary(table);
         let degree = self.count(
             table,
             "degree",

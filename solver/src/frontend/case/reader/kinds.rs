@@ -328,33 +328,7 @@ impl Reader {
                 Some("remove time.adaptive and choose time.dt".into()),
             );
         }
-        if let Some(kind) = root
-            .get("solver")
-            .and_then(Item::as_table_like)
-            .and_then(|t| t.get_key_value("type"))
-        {
-            if kind.1.as_str().is_some_and(|k| k != "direct") {
-                self.error(
-                    kind.1.span(),
-                    "solver.type",
-                    "a nonlinear problem solves its Newton steps with a direct LU factorisation; other solver types are not available for it",
-                    Some("remove solver.type (or set it to \"direct\")".into()),
-                );
-            }
-        }
-        let output = root.get("output").and_then(Item::as_table_like);
-        for name in ["quantity", "probe"] {
-            if let Some((key, _)) = output.and_then(|o| o.get_key_value(name)) {
-                self.error(
-                    key.span(),
-                    &format!("output.{name}"),
-                    format!("output.{name} is not evaluated for a nonlinear problem"),
-                    Some(format!(
-                        "remove [[output.{name}]]; the field u is in the output"
-                    )),
-                );
-            }
-        }
+        self.refuse_nonlinear_solver_and_output(root);
     }
 
     /// `problem.initial = { from = "run.h5", level = "last" | k }`.

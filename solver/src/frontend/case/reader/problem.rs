@@ -239,6 +239,41 @@ impl Reader {
         }
     }
 
+    /// What a nonlinear problem (steady or heat) does not have: a solver
+    /// type other than the direct LU its Newton steps reuse, and
+    /// quantities or probes.
+    pub(super) fn refuse_nonlinear_solver_and_output(&mut self, root: &dyn TableLike) {
+        // Newton's steps are solved by one LU analysis reused over the
+        // steps; the iterative and distributed solvers are not wired in.
+        if let Some((solver, kind)) = root
+            .get("solver")
+            .and_then(Item::as_table_like)
+            .and_then(|t| t.get_key_value("type"))
+        {
+            if kind.as_str().is_some_and(|k| k != "direct") {
+                self.error(
+                    kind.span().or_else(|| solver.span()),
+                    "solver.type",
+                    "a nonlinear problem solves its Newton steps with a direct LU factorisation; other solver types are not available for it",
+                    Some("remove solver.type (or set it to \"direct\")".into()),
+                );
+            }
+        }
+        let output = root.get("output").and_then(Item::as_table_like);
+        for name in ["quantity", "probe"] {
+            if let Some((key, _)) = output.and_then(|o| o.get_key_value(name)) {
+                self.error(
+                    key.span(),
+                    &format!("output.{name}"),
+                    format!("output.{name} is not evaluated for a nonlinear problem"),
+                    Some(format!(
+                        "remove [[output.{name}]]; the field u is in the output"
+                    )),
+                );
+            }
+        }
+    }
+
     /// A conductivity that uses u must be one scalar expression whose
     /// derivative exmex can form.
     pub(super) fn nonlinear_conductivity(
@@ -332,35 +367,7 @@ impl Reader {
                 );
             }
         }
-        // Newton's steps are solved by one LU analysis reused over the
-        // steps; the iterative and distributed solvers are not wired in.
-        if let Some((solver, kind)) = root
-            .get("solver")
-            .and_then(Item::as_table_like)
-            .and_then(|t| t.get_key_value("type"))
-        {
-            if kind.as_str().is_some_and(|k| k != "direct") {
-                self.error(
-                    kind.span().or_else(|| solver.span()),
-                    "solver.type",
-                    "a nonlinear problem solves its Newton steps with a direct LU factorisation; other solver types are not available for it",
-                    Some("remove solver.type (or set it to \"direct\")".into()),
-                );
-            }
-        }
-        let output = root.get("output").and_then(Item::as_table_like);
-        for name in ["quantity", "probe"] {
-            if let Some((key, _)) = output.and_then(|o| o.get_key_value(name)) {
-                self.error(
-                    key.span(),
-                    &format!("output.{name}"),
-                    format!("output.{name} is not evaluated for a nonlinear problem"),
-                    Some(format!(
-                        "remove [[output.{name}]]; the field u is in the output"
-                    )),
-                );
-            }
-        }
+        self.refuse_nonlinear_solver_and_output(root);
         if let Some((key, _)) = root.get_key_value("refine") {
             self.error(
                 key.span(),
