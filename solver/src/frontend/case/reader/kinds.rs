@@ -165,17 +165,7 @@ impl Reader {
         }
         // k and r may use u (which makes the problem nonlinear: Newton in
         // every step); k(u, x) must then be one differentiable scalar.
-        let with_u = scope.with_solution();
-        let conductivity = self
-            .coefficient(table, "conductivity", &with_u)
-            .and_then(|k| self.nonlinear_conductivity(table, k));
-        let reaction = match self.entry(table, "problem", "reaction") {
-            Some(_) => self
-                .expression_at(table, "problem", "reaction", &with_u)
-                .and_then(|r| self.differentiable(table, "reaction", r))
-                .map(Some),
-            None => Some(None),
-        };
+        let (conductivity, reaction) = self.conductivity_and_reaction(table, scope);
         let nonlinear = reaction.as_ref().is_some_and(Option::is_some)
             || match &conductivity {
                 Some(Coefficient::Scalar(e)) => e.uses_solution(),

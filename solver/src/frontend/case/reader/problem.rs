@@ -140,18 +140,7 @@ impl Reader {
                     );
                 }
                 let method = self.method(table, problem_entry.span());
-                // The conductivity and the reaction may use the solution u.
-                let with_u = scope.with_solution();
-                let conductivity = self
-                    .coefficient(table, "conductivity", &with_u)
-                    .and_then(|k| self.nonlinear_conductivity(table, k));
-                let reaction = match self.entry(table, "problem", "reaction") {
-                    Some(_) => self
-                        .expression_at(table, "problem", "reaction", &with_u)
-                        .and_then(|r| self.differentiable(table, "reaction", r))
-                        .map(Some),
-                    None => Some(None),
-                };
+                let (conductivity, reaction) = self.conductivity_and_reaction(table, scope);
                 let source = match self.entry(table, "problem", "source") {
                     Some(_) => self.expression_or_regions_at(table, "problem", "source", scope),
                     None => scope.parse("0").ok(),
@@ -272,6 +261,29 @@ impl Reader {
                 );
             }
         }
+    }
+
+    /// `problem.conductivity` and `problem.reaction` of diffusion and heat:
+    /// both may use the solution u (which makes the problem nonlinear),
+    /// k(u, x) then one differentiable scalar, r(u, x) differentiable.
+    #[allow(clippy::type_complexity)]
+    pub(super) fn conductivity_and_reaction(
+        &mut self,
+        table: &dyn TableLike,
+        scope: &Scope,
+    ) -> (Option<Coefficient>, Option<Option<Expression>>) {
+        let with_u = scope.with_solution();
+        let conductivity = self
+            .coefficient(table, "conductivity", &with_u)
+            .and_then(|k| self.nonlinear_conductivity(table, k));
+        let reaction = match self.entry(table, "problem", "reaction") {
+            Some(_) => self
+                .expression_at(table, "problem", "reaction", &with_u)
+                .and_then(|r| self.differentiable(table, "reaction", r))
+                .map(Some),
+            None => Some(None),
+        };
+        (conductivity, reaction)
     }
 
     /// A conductivity that uses u must be one scalar expression whose
