@@ -545,15 +545,19 @@ impl Reader {
         scope: &Scope,
     ) -> Option<Coefficient> {
         // Each region's value: a scalar or the rows of a tensor.
-        let mut pieces: Vec<(String, Result<Expression, Vec<Vec<Expression>>>)> = Vec::new();
+        let mut pieces: Vec<(String, Coefficient)> = Vec::new();
         let mut ok = true;
         for (region, item) in regions.iter() {
             let name = format!("{}.{region}", entry.name);
             let span = item.span().or_else(|| entry.span());
             self.collector.record(&name, span.clone());
             let value = match item.as_value() {
-                Some(Value::Array(rows)) => self.tensor_rows(rows, &name, span, scope).map(Err),
-                _ => self.expression_of(item, &name, span, scope).map(Ok),
+                Some(Value::Array(rows)) => self
+                    .tensor_rows(rows, &name, span, scope)
+                    .map(Coefficient::Tensor),
+                _ => self
+                    .expression_of(item, &name, span, scope)
+                    .map(Coefficient::Scalar),
             };
             match value {
                 Some(v) => pieces.push((region.to_string(), v)),
@@ -564,8 +568,8 @@ impl Reader {
             return None;
         }
         let mut sizes = pieces.iter().filter_map(|(name, v)| match v {
-            Err(rows) => Some((name, rows.len())),
-            Ok(_) => None,
+            Coefficient::Tensor(rows) => Some((name, rows.len())),
+            Coefficient::Scalar(_) => None,
         });
         let (first, size) = sizes.next()?;
         if let Some((other, other_size)) = sizes.find(|&(_, s)| s != size) {
@@ -588,10 +592,10 @@ impl Reader {
         }
         let zero = scope.parse("0").ok()?;
         // Entry (i, j) of each region.
-        let entry_of = |v: &Result<Expression, Vec<Vec<Expression>>>, i: usize, j: usize| match v {
-            Err(rows) => rows[i][j].clone(),
-            Ok(s) if i == j => s.clone(),
-            Ok(_) => zero.clone(),
+        let entry_of = |v: &Coefficient, i: usize, j: usize| match v {
+            Coefficient::Tensor(rows) => rows[i][j].clone(),
+            Coefficient::Scalar(s) if i == j => s.clone(),
+            Coefficient::Scalar(_) => zero.clone(),
         };
         let mut tensor = Vec::with_capacity(size);
         for i in 0..size {
