@@ -30,6 +30,14 @@ use std::path::PathBuf;
 /// let Some(Coefficient::Scalar(k)) = case.problem.coefficient() else { panic!() };
 /// assert_eq!(k.eval(&[0.3, 0.7], 0.0), 1.0);
 /// ```
+///
+/// Given per region, a scalar coefficient is one expression per region
+/// ([`Expression::regions`]); when some region is a tensor
+/// (`{ layer = [[1, 0], [0, "10 + y"]], default = 1 }`, a scalar region s
+/// standing for s·I) it is a `Tensor` whose entries are each given per
+/// region, all with the same regions in the same order (an off-diagonal
+/// entry that is 0 in every region stays the constant 0).
+/// [`Coefficient::by_region`] gives the coefficient of each region.
 #[derive(Clone, Debug)]
 pub enum Coefficient {
     /// K = λ(x) I.
@@ -51,6 +59,92 @@ impl Coefficient {
         match self {
             Coefficient::Scalar(e) => e.uses_time(),
             Coefficient::Tensor(rows) => rows.iter().flatten().any(Expression::uses_time),
+        }
+    }
+
+    /// An expression given per region whose regions are the coefficient's
+    /// (what the mesh's tags must cover); `None` for one coefficient
+    /// everywhere.
+    pub fn regional_expression(&self) -> Option<&Expression> {
+        match self {
+            Coefficient::Scalar(e) => e.regions().map(|_| e),
+            Coefficient::Tensor(rows) => rows.iter().flatten().find(|e| e.regions().is_some()),
+        }
+    }
+
+    /// The coefficient of each region, each one expression (or tensor of
+    /// expressions) for the whole region; `None` for a coefficient that is
+    /// not given per region.
+    ///
+    /// ```
+    /// use hasse_solver::frontend::case::{Case, Coefficient};
+    /// let text = r#"
+    /// [mesh]
+    /// generator = "rectangle"
+    /// n = [2, 2]
+    /// [regions]
+    /// layer = "y > 0.5"
+    /// [problem]
+    /// method = "fe"
+    /// conductivity = { layer = [[1, 0], [0, "10 + y"]], default = 3 }
+    /// "#;
+    /// let case = Case::from_text("k.toml", text, &[]).unwrap();
+    /// let regions = case.problem.coefficient().unwrap().by_region().unwrap();
+    /// let Coefficient::Tensor(layer) = &regions.pieces()[0].1 else { panic!() };
+    /// assert_eq!(layer[1][1].eval(&[0.0, 1.0], 0.0), 11.0);
+    /// assert_eq!(layer[0][1].eval(&[0.0, 1.0], 0.0), 0.0);
+    /// // The scalar default 3 is 3·I.
+    /// let Some(Coefficient::Tensor(default)) = regions.default() else { panic!() };
+    /// assert_eq!((default[0][0].eval(&[], 0.0), default[1][0].eval(&[], 0.0)), (3.0, 0.0));
+    /// ```
+    pub fn by_region(&self) -> Option<crate::physics::regions::Regional<Coefficient>> {
+        use crate::physics::regions::Regional;
+        match self {
+            Coefficient::Scalar(e) => {
+                let regions = e.regions()?;
+                Some(Regional::new(
+                    regions
+                        .pieces
+                        .iter()
+                        .map(|(name, piece)| (name.clone(), Coefficient::Scalar(piece.clone())))
+                        .collect(),
+                    regions.default.clone().map(Coefficient::Scalar),
+                ))
+            }
+            Coefficient::Tensor(rows) => {
+                let regions = self.regional_expression()?.regions()?;
+                // Entry (i, j) in piece k (the default for k = #regions):
+                // the entry's own piece, or the entry itself where it is
+                // one expression for all regions.
+                let piece = |k: usize| -> Option<Coefficient> {
+                    let mut tensor = Vec::with_capacity(rows.len());
+                    for row in rows {
+                        let mut out = Vec::with_capacity(row.len());
+                        for e in row {
+                            out.push(match e.regions() {
+                                None => e.clone(),
+                                Some(r) => match r.pieces.get(k) {
+                                    Some((_, piece)) => piece.clone(),
+                                    None => r.default.clone()?,
+                                },
+                            });
+                        }
+                        tensor.push(out);
+                    }
+                    Some(Coefficient::Tensor(tensor))
+                };
+                let pieces = regions
+                    .pieces
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (name, _))| Some((name.clone(), piece(k)?)))
+                    .collect::<Option<Vec<_>>>()?;
+                let default = match &regions.default {
+                    Some(_) => Some(piece(regions.pieces.len())?),
+                    None => None,
+                };
+                Some(Regional::new(pieces, default))
+            }
         }
     }
 }
@@ -609,7 +703,7 @@ impl Problem {
             k: &'a Coefficient,
             f: &'a Expression,
         ) {
-            if let Coefficient::Scalar(e) = k {
+            if let Some(e) = k.regional_expression() {
                 all.push((format!("{prefix}.conductivity"), e));
             }
             all.push((format!("{prefix}.source"), f));
@@ -619,7 +713,11 @@ impl Problem {
             Problem::Diffusion(d) => diffusion(&mut all, "problem", &d.conductivity, &d.source),
             Problem::Heat(h) => diffusion(&mut all, "problem", &h.conductivity, &h.source),
             Problem::Transport(t) => {
-                if let Some(Coefficient::Scalar(e)) = &t.conductivity {
+                if let Some(e) = t
+                    .conductivity
+                    .as_ref()
+                    .and_then(Coefficient::regional_expression)
+                {
                     all.push(("problem.conductivity".into(), e));
                 }
                 all.push(("problem.source".into(), &t.source));
@@ -649,7 +747,7 @@ impl Problem {
                 }
             },
             Problem::Darcy(d) => {
-                if let Coefficient::Scalar(e) = &d.permeability {
+                if let Some(e) = d.permeability.regional_expression() {
                     all.push(("problem.permeability".into(), e));
                 }
                 all.push(("problem.source".into(), &d.source));

@@ -58,39 +58,41 @@ fn per_cell<'a>(
     }
 }
 
-/// The permeability's expression in each top cell when it is given per
-/// region (`None` for one expression or a tensor, the same everywhere).
-fn regional_permeability<'a>(
-    case: &Case,
-    coefficient: &'a Coefficient,
-    complex: &Complex,
-) -> Result<Option<Vec<&'a Expression>>, RunError> {
-    match coefficient {
-        Coefficient::Scalar(e) if e.regions().is_some() => {
-            per_cell(case, "problem.permeability", e, complex).map(Some)
-        }
-        _ => Ok(None),
-    }
+/// The permeability of each region and each top cell's region, when it is
+/// given per region (`None` for one expression or tensor, the same
+/// everywhere); a region may be a scalar (times I) or a tensor.
+struct RegionalPermeability {
+    pieces: Vec<Coefficient>,
+    owner: Vec<usize>,
 }
 
-/// K at `x` in top cell `c`: the cell's region's scalar times I, or
-/// [`tensor_at`].
+fn regional_permeability(
+    case: &Case,
+    coefficient: &Coefficient,
+    complex: &Complex,
+) -> Result<Option<RegionalPermeability>, RunError> {
+    let Some(regional) = coefficient.by_region() else {
+        return Ok(None);
+    };
+    let owner = regional
+        .piece_per_cell(complex)
+        .map_err(|e| RunError::input_at(case, "problem.permeability", e.to_string(), None))?;
+    let mut pieces: Vec<Coefficient> = regional.pieces().iter().map(|(_, k)| k.clone()).collect();
+    pieces.extend(regional.default().cloned());
+    Ok(Some(RegionalPermeability { pieces, owner }))
+}
+
+/// K at `x` in top cell `c`: the cell's region's permeability, or
+/// [`tensor_at`] of the one coefficient.
 fn tensor_in(
     coefficient: &Coefficient,
-    regional: Option<&[&Expression]>,
+    regional: Option<&RegionalPermeability>,
     c: usize,
     x: &[f64],
     d: usize,
 ) -> Tensor {
     match regional {
-        Some(pieces) => {
-            let k = pieces[c].eval(x, 0.0);
-            let mut t: Tensor = [[0.0; 3]; 3];
-            for (i, row) in t.iter_mut().enumerate().take(d) {
-                row[i] = k;
-            }
-            t
-        }
+        Some(r) => tensor_at(&r.pieces[r.owner[c]], x, d),
         None => tensor_at(coefficient, x, d),
     }
 }
@@ -120,7 +122,7 @@ fn source_integrals(
 fn tensors(
     case: &Case,
     coefficient: &Coefficient,
-    regional: Option<&[&Expression]>,
+    regional: Option<&RegionalPermeability>,
     complex: &Complex,
 ) -> Result<Vec<Tensor>, RunError> {
     let n = complex.dim();
@@ -284,7 +286,7 @@ pub(super) fn solve(
     phase("assembling");
     let started = Instant::now();
     let regional = regional_permeability(case, &spec.permeability, complex)?;
-    let permeability = tensors(case, &spec.permeability, regional.as_deref(), complex)?;
+    let permeability = tensors(case, &spec.permeability, regional.as_ref(), complex)?;
     let source = source_integrals(case, spec, complex)?;
     let bc = conditions(case, spec, complex)?;
     // Without a pressure face p is defined up to a constant: the solve
@@ -335,7 +337,7 @@ pub(super) fn solve(
                         complex,
                         &solution,
                         &spec.permeability,
-                        regional.as_deref(),
+                        regional.as_ref(),
                         |x| {
                             let mut v = [0.0; 3];
                             for (slot, e) in v.iter_mut().zip(g) {
@@ -457,7 +459,7 @@ fn flux_error(
     complex: &Complex,
     solution: &DarcySolution,
     permeability: &Coefficient,
-    regional: Option<&[&Expression]>,
+    regional: Option<&RegionalPermeability>,
     gradient: impl Fn(&[f64]) -> [f64; 3],
 ) -> f64 {
     let n = complex.dim();
@@ -508,7 +510,7 @@ pub(super) fn check(case: &Case, spec: &DarcySpec, complex: &Complex) -> Result<
     // Positive definite as the assembly will demand: a negative constant
     // permeability is refused here, not after `hasse check` said ok.
     let regional = regional_permeability(case, &spec.permeability, complex)?;
-    let permeability = tensors(case, &spec.permeability, regional.as_deref(), complex)?;
+    let permeability = tensors(case, &spec.permeability, regional.as_ref(), complex)?;
     crate::metric::check_tensors(&permeability, complex.cell_count(n), n)
         .map_err(|e| run_error(case, DarcyError::Metric(e)))?;
     source_integrals(case, spec, complex)?;

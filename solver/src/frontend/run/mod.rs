@@ -230,14 +230,14 @@ pub(crate) fn vector_fn(components: &[crate::frontend::case::expr::Expression]) 
 }
 
 /// A case coefficient as a conductivity of the library (evaluated at t = 0).
+/// A coefficient per region (scalars, tensors or both) is one conductivity
+/// per region, each cell's checked where the assembly evaluates it.
 pub(crate) fn conductivity(coefficient: &Coefficient) -> Conductivity {
+    if let Some(regional) = coefficient.by_region() {
+        return Conductivity::Regional(Arc::new(regional.map(conductivity)));
+    }
     match coefficient {
-        Coefficient::Scalar(e) => match regional_fn(e) {
-            Some(regional) => {
-                Conductivity::Regional(Arc::new(regional.map(|f| Conductivity::Scalar(f.clone()))))
-            }
-            None => Conductivity::Scalar(scalar_fn(e)),
-        },
+        Coefficient::Scalar(e) => Conductivity::Scalar(scalar_fn(e)),
         Coefficient::Tensor(rows) => {
             let rows = rows.clone();
             let f: TensorFn = Arc::new(move |x: &[f64]| {

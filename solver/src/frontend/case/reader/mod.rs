@@ -19,6 +19,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml_edit::{ImDocument, Item, TableLike, Value};
 
+mod coefficient;
 mod coupled;
 mod dec;
 mod elasticity;
