@@ -22,9 +22,10 @@ pub(in crate::frontend::case) fn problem_kind(root: &dyn TableLike) -> &str {
         .unwrap_or("diffusion")
 }
 
-/// The degree of a Poisson problem for k-forms: `problem.degree` ≥ 1 of
-/// a diffusion case, read directly from the document (degree 0 is
-/// ordinary diffusion).
+/// The degree of a Poisson problem for k-forms: an integer
+/// `problem.degree` other than 0 in a diffusion case, read directly from
+/// the document (degree 0 is ordinary diffusion; a negative one is then
+/// refused by the forms' reader, which asks for k ≥ 1).
 pub(in crate::frontend::case) fn form_degree(root: &dyn TableLike) -> Option<i64> {
     if problem_kind(root) != "diffusion" {
         return None;
@@ -33,7 +34,7 @@ pub(in crate::frontend::case) fn form_degree(root: &dyn TableLike) -> Option<i64
         .and_then(Item::as_table_like)
         .and_then(|p| p.get("degree"))
         .and_then(Item::as_integer)
-        .filter(|&k| k >= 1)
+        .filter(|&k| k != 0)
 }
 
 /// The `problem` keys of a Poisson problem for k-forms.
