@@ -46,6 +46,7 @@
 //! first blocks of Ω_J and adds V/Δt to the third, on the same pattern and
 //! the same analysis for every step.
 
+mod krylov_step;
 mod newton;
 mod transient;
 
@@ -157,6 +158,12 @@ pub struct NonlinearOptions {
     pub initial: Option<Vec<f64>>,
     /// Called after every iteration.
     pub monitor: Option<Monitor>,
+    /// Newton–Krylov: each Newton correction by GMRES on the exact
+    /// Jacobian, preconditioned by an LLᵀ of its symmetric part (Picard's
+    /// matrix) kept over the steps, instead of a sparse LU per step (see
+    /// the module `krylov_step`); a step falls back to LU when that part
+    /// is not positive definite or GMRES does not converge. Newton only.
+    pub krylov: bool,
 }
 
 impl Default for NonlinearOptions {
@@ -167,6 +174,7 @@ impl Default for NonlinearOptions {
             max_iterations: 50,
             initial: None,
             monitor: None,
+            krylov: false,
         }
     }
 }

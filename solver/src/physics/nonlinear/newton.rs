@@ -1,6 +1,7 @@
 //! The Newton (or Picard) loop with a backtracking line search, on one
 //! Jacobian pattern and one symbolic LU analysis.
 
+use super::krylov_step::KrylovState;
 use super::{
     Iteration, NonlinearDiffusion, NonlinearError, NonlinearSolution, Stall, Step, System,
 };
@@ -195,6 +196,8 @@ fn jacobian_weights(
 pub(super) struct Workspace {
     jacobian: Canonical,
     analysis: Option<DirectSolver>,
+    /// Newton–Krylov's kept preconditioner ([`super::NonlinearOptions::krylov`]).
+    krylov: Option<KrylovState>,
     /// Symbolic analyses made so far (one per run).
     pub(super) analyses: usize,
 }
@@ -204,6 +207,7 @@ impl Workspace {
         Self {
             jacobian: system.jacobian.clone(),
             analysis: None,
+            krylov: None,
             analyses: 0,
         }
     }
@@ -282,30 +286,46 @@ pub(super) fn iterate(
             return Err(stop(Stall::MaxIterations(k), &history));
         }
         k += 1;
+        let weights = jacobian_weights(problem, system, &u, &at, time_step);
+        let krylov_weights =
+            (options.krylov && iteration == Iteration::Newton).then(|| weights.clone());
         work.jacobian
-            .set_metric(BlockMetric::from_weights(jacobian_weights(
-                problem, system, &u, &at, time_step,
-            )))?;
+            .set_metric(BlockMetric::from_weights(weights))?;
         let matrix = work.jacobian.assemble();
-        // The pattern never changes: analyze once (LU, since the
-        // derivative of the face weights makes J unsymmetric).
-        let solver = match work.analysis.take() {
-            Some(solver) => solver,
+        let minus: Vec<f64> = at.residual.iter().map(|r| -r).collect();
+        let krylov_delta = krylov_weights.and_then(|weights| {
+            let state = work
+                .krylov
+                .get_or_insert_with(|| KrylovState::new(&work.jacobian));
+            let eta = at.relative().clamp(1e-12, 0.1);
+            state
+                .step(&matrix, &weights, system.weights.len(), &minus, eta)
+                .map(|(delta, _)| delta)
+        });
+        let delta = match krylov_delta {
+            Some(delta) => delta,
             None => {
-                work.analyses += 1;
-                DirectSolver::analyze_pattern(
-                    matrix.symbolic(),
-                    Factorization::Lu,
-                    Ordering::Automatic,
-                )
-                .map_err(|e| stop(Stall::Solve(e), &history))?
+                // The pattern never changes: analyze once (LU, since the
+                // derivative of the face weights makes J unsymmetric).
+                let solver = match work.analysis.take() {
+                    Some(solver) => solver,
+                    None => {
+                        work.analyses += 1;
+                        DirectSolver::analyze_pattern(
+                            matrix.symbolic(),
+                            Factorization::Lu,
+                            Ordering::Automatic,
+                        )
+                        .map_err(|e| stop(Stall::Solve(e), &history))?
+                    }
+                };
+                let solved = direct::solve_analyzed(&solver, &matrix, &minus);
+                work.analysis = Some(solver);
+                let (delta, solved) = solved.map_err(|e| stop(Stall::Solve(e), &history))?;
+                report = Some(solved);
+                delta
             }
         };
-        let minus: Vec<f64> = at.residual.iter().map(|r| -r).collect();
-        let solved = direct::solve_analyzed(&solver, &matrix, &minus);
-        work.analysis = Some(solver);
-        let (delta, solved) = solved.map_err(|e| stop(Stall::Solve(e), &history))?;
-        report = Some(solved);
         // Backtracking: halve α until ‖R‖ decreases enough.
         let mut alpha = 1.0;
         let mut accepted = None;
