@@ -193,6 +193,10 @@ pub struct NonlinearSolverSpec {
     pub max_iterations: usize,
     /// `monitor`: one line per iteration on stderr (default false).
     pub monitor: bool,
+    /// `linear = "krylov"`: Newton–Krylov steps (GMRES preconditioned by
+    /// an LLᵀ of the Jacobian's symmetric part) instead of an LU per step
+    /// (`"direct"`, the default).
+    pub krylov: bool,
 }
 
 impl Default for NonlinearSolverSpec {
@@ -202,6 +206,7 @@ impl Default for NonlinearSolverSpec {
             tolerance: 1e-10,
             max_iterations: 50,
             monitor: false,
+            krylov: false,
         }
     }
 }

@@ -108,7 +108,7 @@ pub(super) fn options(
         max_iterations: settings.max_iterations,
         initial: None,
         monitor,
-        krylov: false,
+        krylov: settings.krylov,
     }
 }
 

@@ -32,6 +32,8 @@ pub(super) struct KrylovState {
     factor: Option<Factor>,
     /// GMRES iterations of the last step (refactor when above the limit).
     last_iterations: usize,
+    /// Symbolic analyses of P made (one per run).
+    pub(super) analyses: usize,
 }
 
 struct FactorPreconditioner<'a>(&'a Factor);
@@ -58,6 +60,7 @@ impl KrylovState {
             analysis: None,
             factor: None,
             last_iterations: 0,
+            analyses: 0,
         }
     }
 
@@ -82,6 +85,7 @@ impl KrylovState {
             let p = self.symmetric.assemble();
             if self.analysis.is_none() {
                 self.analysis = Some(DirectSolver::analyze(p.as_ref(), Factorization::Llt).ok()?);
+                self.analyses += 1;
             }
             self.factor = Some(self.analysis.as_ref()?.factorize(p.as_ref()).ok()?);
         }

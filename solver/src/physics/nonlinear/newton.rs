@@ -198,7 +198,8 @@ pub(super) struct Workspace {
     analysis: Option<DirectSolver>,
     /// Newton–Krylov's kept preconditioner ([`super::NonlinearOptions::krylov`]).
     krylov: Option<KrylovState>,
-    /// Symbolic analyses made so far (one per run).
+    /// Symbolic analyses made so far (one per run, and one more for
+    /// Newton–Krylov's preconditioner).
     pub(super) analyses: usize,
 }
 
@@ -298,9 +299,12 @@ pub(super) fn iterate(
                 .krylov
                 .get_or_insert_with(|| KrylovState::new(&work.jacobian));
             let eta = at.relative().clamp(1e-12, 0.1);
-            state
+            let before = state.analyses;
+            let step = state
                 .step(&matrix, &weights, system.weights.len(), &minus, eta)
-                .map(|(delta, _)| delta)
+                .map(|(delta, _)| delta);
+            work.analyses += state.analyses - before;
+            step
         });
         let delta = match krylov_delta {
             Some(delta) => delta,

@@ -150,7 +150,8 @@ pub(super) const SOLVER_KEYS: &[&str] = &[
 ];
 pub(super) const PETSC_KEYS: &[&str] = &["options"];
 /// Keys of `[solver.nonlinear]`.
-pub(super) const NONLINEAR_KEYS: &[&str] = &["method", "tolerance", "max_iterations", "monitor"];
+pub(super) const NONLINEAR_KEYS: &[&str] =
+    &["method", "tolerance", "max_iterations", "monitor", "linear"];
 pub(super) const OUTPUT_KEYS: &[&str] = &[
     "directory",
     "name",

@@ -455,6 +455,19 @@ impl Reader {
                 None => self.type_error(&entry, "true or false"),
             }
         }
+        if let Some(entry) = self.entry(table, PREFIX, "linear") {
+            match entry.item.as_str() {
+                Some("direct") => spec.krylov = false,
+                Some("krylov") => spec.krylov = true,
+                Some(other) => self.error(
+                    entry.span(),
+                    &entry.name,
+                    format!("unknown linear solver \"{other}\" for the Newton steps"),
+                    Some("use \"direct\" (an LU per step, default) or \"krylov\" (GMRES preconditioned by an LLᵀ of the Jacobian's symmetric part)".into()),
+                ),
+                None => self.type_error(&entry, "\"direct\" or \"krylov\""),
+            }
+        }
         spec
     }
 
