@@ -612,6 +612,15 @@ fn transient_picard_linear_in_every_step() -> Result {
     Ok(())
 }
 
+/// max |u_a − u_b| over the unknowns of two solves of one problem.
+fn max_difference(a: &NonlinearSolution, b: &NonlinearSolution) -> f64 {
+    a.solution
+        .values
+        .iter()
+        .zip(&b.solution.values)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
 /// Newton–Krylov (`options.krylov`: GMRES on the exact Jacobian,
 /// preconditioned by an LLᵀ of its symmetric part, with linear tolerance
 /// η_k = min(0.1, relative residual)) is an inexact Newton method whose
@@ -645,12 +654,7 @@ fn newton_krylov_converges_quadratically_to_newtons_solution() -> Result {
         "{} iterations",
         solved.iterations()
     );
-    let difference = solved
-        .solution
-        .values
-        .iter()
-        .zip(&direct.solution.values)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let difference = max_difference(&solved, &direct);
     eprintln!("max |u_krylov − u_newton| = {difference:e}");
     assert!(
         difference < 2e-9,
@@ -675,12 +679,7 @@ fn newton_krylov_is_newton_when_the_jacobian_is_symmetric() -> Result {
     problem.options.krylov = true;
     let krylov = problem.solve(&mesh)?;
     assert_eq!(krylov.iterations(), direct.iterations());
-    let difference = krylov
-        .solution
-        .values
-        .iter()
-        .zip(&direct.solution.values)
-        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    let difference = max_difference(&krylov, &direct);
     eprintln!("Bratu: max |u_krylov − u_newton| = {difference:e}");
     assert!(
         difference < 1e-12,

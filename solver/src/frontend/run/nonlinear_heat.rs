@@ -8,7 +8,7 @@
 //! Nothing is streamed: a step that does not converge fails the run before
 //! any level is written, so a failed run leaves no output file.
 
-use super::heat::time_fn;
+use super::heat::{errors_per_level, time_fn};
 use super::nonlinear::{coefficient, monitor_figures, options};
 use super::{diffusion_error, Keys, RunError, RunResult};
 use crate::frontend::case::{BoundaryKindSpec, Case, Coefficient, HeatSpec};
@@ -235,14 +235,8 @@ pub(super) fn solve(
             "symbolic_analyses": run.symbolic_analyses,
         }),
     );
-    if !level_errors.is_empty() {
-        report.insert(
-            "errors_per_level".into(),
-            level_errors
-                .iter()
-                .map(|&(t, l2, max)| serde_json::json!({ "time": t, "l2": l2, "max": max }))
-                .collect(),
-        );
+    if let Some(errors) = errors_per_level(&level_errors) {
+        report.insert("errors_per_level".into(), errors);
     }
     let errors = level_errors
         .last()
