@@ -22,6 +22,7 @@ mod form_poisson;
 mod forms;
 mod forms_dec;
 mod hodge_decomposition;
+mod interface_flux;
 mod maxwell;
 mod nonlinear;
 mod refinement;

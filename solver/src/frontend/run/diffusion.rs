@@ -274,6 +274,7 @@ pub(super) fn solve_diffusion(
         super::quantities::diffusion_quantities(case, &problem, complex, &solution, &outflow)
             .map_err(|e| diffusion_error(case, &keys, e))?;
     notes.extend(quantities.notes);
+    warnings.extend(quantities.warnings);
     let mut run_report = quantities.report;
     let probed = super::probes::probe_values(
         case,

@@ -14,6 +14,8 @@ pub(super) struct Quantities {
     pub notes: Vec<(String, String)>,
     /// `balance` and `quantities` of the run report.
     pub report: serde_json::Map<String, Value>,
+    /// What the summary's warnings add (fluxes that left vertices out).
+    pub warnings: Vec<String>,
 }
 
 /// The balance Σ outflow = ∫f and every quantity of the case, from the
@@ -49,26 +51,55 @@ pub(super) fn diffusion_quantities(
         "balance".into(),
         json!({ "outflow": total, "sources": sources, "imbalance": imbalance, "relative": relative }),
     );
-    let face_flux = problem.face_flux(complex, solution);
-    let mut entries = Vec::new();
+    let (mut entries, mut warnings) = (Vec::new(), Vec::new());
     for q in &case.output.quantities {
+        let mut left_out = Vec::new();
         let value = match q.kind {
-            QuantityKind::Flux => flux_through(q, complex, outflow, face_flux.as_deref()),
+            QuantityKind::Flux => {
+                let tag = q.tag.as_deref().and_then(|t| complex.tag(t));
+                let faces = tag.map_or(&[][..], |t| &t.cells[..]);
+                let across = problem.flux_across(complex, solution, outflow, faces)?;
+                left_out = across.left_out;
+                across.flux.iter().sum()
+            }
             kind => region_statistic(kind, q, complex, solution.field(complex), solution.location),
         };
         notes.push(("quantity".into(), format!("{} = {value:e}", q.name)));
-        entries.push(quantity_json(q, value));
+        if let Some(&v) = left_out.first() {
+            warnings.push(
+                format!(
+                    "{}: the faces of `{}` end inside the domain; the flux near {} (at {:?}{}) is not counted, an O(h) part of it",
+                    q.name,
+                    q.tag.as_deref().unwrap_or_default(),
+                    if left_out.len() == 1 { "its end vertex".to_string() } else { format!("its {} end vertices", left_out.len()) },
+                    complex.vertices().point(v),
+                    if left_out.len() > 1 { ", …" } else { "" }
+                ),
+            );
+        }
+        let mut entry = quantity_json(q, value);
+        if !left_out.is_empty() {
+            if let Value::Object(map) = &mut entry {
+                map.insert("left_out_vertices".into(), json!(left_out));
+            }
+        }
+        entries.push(entry);
     }
     if !entries.is_empty() {
         report.insert("quantities".into(), Value::Array(entries));
     }
-    Ok(Quantities { notes, report })
+    Ok(Quantities {
+        notes,
+        report,
+        warnings,
+    })
 }
 
-/// The flux of a `type = "flux"` quantity: the outflow through the faces
-/// of its tag that bound the domain, the flux along their orientation
-/// through interior ones (`face_flux`, which cell-centred and hybrid
-/// methods have; nodal ones are refused when the mesh is built).
+/// The flux of a `type = "flux"` quantity of a heat level: the outflow
+/// through the faces of its tag that bound the domain, the flux along their
+/// orientation through interior ones (`face_flux`, which cell-centred and
+/// hybrid methods have; nodal heat runs are refused interior tags when the
+/// mesh is built).
 fn flux_through(
     q: &QuantitySpec,
     complex: &Complex,
@@ -151,7 +182,11 @@ pub(super) fn heat_quantities(case: &Case, times: &[f64], values: &[Vec<f64>]) -
     if !entries.is_empty() {
         report.insert("quantities".into(), Value::Array(entries));
     }
-    Quantities { notes, report }
+    Quantities {
+        notes,
+        report,
+        warnings: Vec::new(),
+    }
 }
 
 /// The CSV time history of a report's quantities (`t` and one column per

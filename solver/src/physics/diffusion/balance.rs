@@ -195,9 +195,26 @@ impl Diffusion {
         solution: &Solution,
         out: &mut [f64],
     ) -> Result<(), DiffusionError> {
+        for (f, _, q) in self.nodal_outflow_shares(complex, solution)? {
+            out[f] += q;
+        }
+        Ok(())
+    }
+
+    /// The residual flux of every boundary vertex of a nodal method, split
+    /// among its boundary faces: (face, vertex, share), each face's shares
+    /// in the order of its vertices (the outflow of a face is their sum).
+    /// The interface fluxes ([`Diffusion::flux_across`]) take the shares of
+    /// a vertex's faces on one side.
+    pub(super) fn nodal_outflow_shares(
+        &self,
+        complex: &Complex,
+        solution: &Solution,
+    ) -> Result<Vec<(usize, usize, f64)>, DiffusionError> {
         let n = complex.dim();
         let d = complex.embedding_dim();
         let vertices = complex.cell_count(0);
+        let mut shares = Vec::new();
         // f_v − (Aᵀ q)_v, with A = δ⁰ (so Aᵀ q = ∂₁ q).
         let mut remainder = self.source_load(complex, vertices)?;
         for (v, row) in complex.boundary(1).outer_iterator().enumerate() {
@@ -242,7 +259,7 @@ impl Diffusion {
             }
             for &v in verts {
                 let q = share(v).unwrap_or(0.0);
-                out[f] += q;
+                shares.push((f, v, q));
                 remainder[v] -= q;
             }
         }
@@ -284,20 +301,16 @@ impl Diffusion {
             }
         }
         for (&(f, _, weight), &w) in dirichlet.iter().zip(&informed) {
-            out[f] = complex
-                .cell_vertices(n - 1, f)
-                .iter()
-                .map(|&v| {
-                    let share = if informed_sum[v] > 0.0 {
-                        w / informed_sum[v]
-                    } else {
-                        weight / plain_sum[v]
-                    };
-                    remainder[v] * share
-                })
-                .sum();
+            for &v in complex.cell_vertices(n - 1, f) {
+                let share = if informed_sum[v] > 0.0 {
+                    w / informed_sum[v]
+                } else {
+                    weight / plain_sum[v]
+                };
+                shares.push((f, v, remainder[v] * share));
+            }
         }
-        Ok(())
+        Ok(shares)
     }
 }
 

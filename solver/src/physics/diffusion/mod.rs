@@ -24,6 +24,7 @@
 
 mod assemble;
 mod balance;
+mod interface;
 mod norms;
 mod post;
 mod solve;
@@ -48,6 +49,7 @@ pub use assemble::Assembled;
 pub use balance::CellCoefficients;
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use hasse_complex::Complex;
+pub use interface::FacesFlux;
 pub use post::{conservation_residual, errors, flux_error, gradient_of, reconstruct_gradient};
 use rayon::prelude::*;
 pub use solve::solve_with_fixed;
