@@ -161,11 +161,10 @@ impl Case {
 }
 
 impl Case {
-    /// Refuse quantities whose tag or region the mesh does not have, a
-    /// flux across interior (n−1)-cells in a nodal heat run, and
+    /// Refuse quantities whose tag or region the mesh does not have and
     /// quantities of problems that do not compute them.
     pub(super) fn check_quantities(&self, complex: &Complex, collector: &mut Collector) {
-        use super::{Problem, QuantityKind};
+        use super::Problem;
         let n = complex.dim();
         for q in &self.output.quantities {
             match (&self.problem, q.kind) {
@@ -219,28 +218,6 @@ impl Case {
                     )),
                 );
                 continue;
-            }
-            let nodal = self
-                .method()
-                .is_some_and(|m| m.location() == crate::metric::Location::Nodal);
-            // Steady nodal runs take the flux across inner faces from each
-            // side's residual; heat runs would need the mass term's share
-            // of it as well, which they do not compute.
-            let heat = matches!(self.problem, Problem::Heat(_));
-            if q.kind == QuantityKind::Flux && nodal && heat {
-                let top = complex.boundary(n);
-                if let Some(&f) = tag
-                    .cells
-                    .iter()
-                    .find(|&&f| top.outer_view(f).map_or(0, |r| r.nnz()) != 1)
-                {
-                    collector.error(
-                        None,
-                        &key,
-                        format!("tag `{name}` has interior (n−1)-cells (cell {f}, at {:?}); heat runs compute a flux across them for the cell-centred methods (fv, fd, fv-mimetic), whose unknowns make face fluxes", complex.centroid_of(n - 1, f)),
-                        Some("use a boundary tag, or a cell-centred method (steady diffusion runs compute it for every method)".into()),
-                    );
-                }
             }
         }
     }

@@ -178,6 +178,8 @@ pub(super) fn solve_streaming<'a>(
         .iter()
         .any(|q| q.kind == crate::frontend::case::QuantityKind::Flux);
     let mut flux_failure: Option<HeatError> = None;
+    // Fluxes that leave vertices out do so at every level: warned once.
+    let mut flux_warnings: Option<Vec<String>> = None;
     // Progress on long runs: at most ~100 updates, each a phase message.
     let report_every = (time.steps / 100).max(1);
     let history = heat
@@ -203,9 +205,10 @@ pub(super) fn solve_streaming<'a>(
                                 let problem = heat.at(t);
                                 problem
                                     .boundary_outflow(complex, &solution)
-                                    .map(|outflow| super::quantities::LevelFluxes {
-                                        outflow,
-                                        face_flux: problem.face_flux(complex, &solution),
+                                    .and_then(|outflow| {
+                                        super::quantities::flux_values(
+                                            case, &problem, complex, &solution, &outflow,
+                                        )
                                     })
                                     .map_err(|e| flux_failure.get_or_insert(e.into()))
                                     .ok()
@@ -218,6 +221,9 @@ pub(super) fn solve_streaming<'a>(
                     } else {
                         None
                     };
+                    if let (None, Some(f)) = (&flux_warnings, &fluxes) {
+                        flux_warnings = Some(f.warnings(case, complex));
+                    }
                     level_quantities.push(super::quantities::level_values(
                         case,
                         complex,
@@ -427,12 +433,16 @@ pub(super) fn solve_streaming<'a>(
         factorization: heat.iterative.is_none().then_some(heat.factorization),
         ordering: history.ordering,
         timings,
-        warnings: super::consistency::diffusion_warnings(
-            complex,
-            spec.method,
-            &spec.conductivity,
-            false,
-        ),
+        warnings: {
+            let mut warnings = super::consistency::diffusion_warnings(
+                complex,
+                spec.method,
+                &spec.conductivity,
+                false,
+            );
+            warnings.extend(flux_warnings.unwrap_or_default());
+            warnings
+        },
         pure_neumann: false,
         series,
         notes,

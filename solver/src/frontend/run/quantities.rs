@@ -51,36 +51,19 @@ pub(super) fn diffusion_quantities(
         "balance".into(),
         json!({ "outflow": total, "sources": sources, "imbalance": imbalance, "relative": relative }),
     );
-    let (mut entries, mut warnings) = (Vec::new(), Vec::new());
-    for q in &case.output.quantities {
-        let mut left_out = Vec::new();
+    let fluxes = flux_values(case, problem, complex, solution, outflow)?;
+    let warnings = fluxes.warnings(case, complex);
+    let mut entries = Vec::new();
+    for (i, q) in case.output.quantities.iter().enumerate() {
         let value = match q.kind {
-            QuantityKind::Flux => {
-                let tag = q.tag.as_deref().and_then(|t| complex.tag(t));
-                let faces = tag.map_or(&[][..], |t| &t.cells[..]);
-                let across = problem.flux_across(complex, solution, outflow, faces)?;
-                left_out = across.left_out;
-                across.flux.iter().sum()
-            }
+            QuantityKind::Flux => fluxes.values[i],
             kind => region_statistic(kind, q, complex, solution.field(complex), solution.location),
         };
         notes.push(("quantity".into(), format!("{} = {value:e}", q.name)));
-        if let Some(&v) = left_out.first() {
-            warnings.push(
-                format!(
-                    "{}: the faces of `{}` end inside the domain; the flux near {} (at {:?}{}) is not counted, an O(h) part of it",
-                    q.name,
-                    q.tag.as_deref().unwrap_or_default(),
-                    if left_out.len() == 1 { "its end vertex".to_string() } else { format!("its {} end vertices", left_out.len()) },
-                    complex.vertices().point(v),
-                    if left_out.len() > 1 { ", …" } else { "" }
-                ),
-            );
-        }
         let mut entry = quantity_json(q, value);
-        if !left_out.is_empty() {
+        if !fluxes.left_out[i].is_empty() {
             if let Value::Object(map) = &mut entry {
-                map.insert("left_out_vertices".into(), json!(left_out));
+                map.insert("left_out_vertices".into(), json!(fluxes.left_out[i]));
             }
         }
         entries.push(entry);
@@ -95,39 +78,63 @@ pub(super) fn diffusion_quantities(
     })
 }
 
-/// The flux of a `type = "flux"` quantity of a heat level: the outflow
-/// through the faces of its tag that bound the domain, the flux along their
-/// orientation through interior ones (`face_flux`, which cell-centred and
-/// hybrid methods have; nodal heat runs are refused interior tags when the
-/// mesh is built).
-fn flux_through(
-    q: &QuantitySpec,
-    complex: &Complex,
-    outflow: &[f64],
-    face_flux: Option<&[f64]>,
-) -> f64 {
-    let top = complex.boundary(complex.dim());
-    let tag = q.tag.as_deref().and_then(|t| complex.tag(t));
-    let faces = tag.map_or(&[][..], |t| &t.cells[..]);
-    faces
-        .iter()
-        .map(|&f| {
-            let boundary = top.outer_view(f).is_some_and(|r| r.nnz() == 1);
-            match (face_flux, boundary) {
-                (_, true) => outflow[f],
-                (Some(along), false) => along[f],
-                // Refused when the mesh was built.
-                (None, false) => f64::NAN,
-            }
-        })
-        .sum()
+/// The value of every `type = "flux"` quantity (NaN for the others): the
+/// outflow through the faces of its tag that bound the domain plus the
+/// flux along their orientation through the inner ones, the method's own
+/// ([`Diffusion::flux_across`]), and the vertices a nodal method left out.
+pub(super) struct LevelFluxes {
+    pub values: Vec<f64>,
+    pub left_out: Vec<Vec<usize>>,
 }
 
-/// The fluxes of a level of a heat run: the outflow through each face and,
-/// for methods with face unknowns, the flux along every face.
-pub(super) struct LevelFluxes {
-    pub outflow: Vec<f64>,
-    pub face_flux: Option<Vec<f64>>,
+impl LevelFluxes {
+    /// A warning for every flux whose tag ends inside the domain, where a
+    /// nodal method leaves the end vertices out.
+    pub fn warnings(&self, case: &Case, complex: &Complex) -> Vec<String> {
+        let mut warnings = Vec::new();
+        for (q, left_out) in case.output.quantities.iter().zip(&self.left_out) {
+            let Some(&v) = left_out.first() else {
+                continue;
+            };
+            let (count, more) = match left_out.len() {
+                1 => ("its end vertex".to_string(), ""),
+                k => (format!("its {k} end vertices"), ", …"),
+            };
+            warnings.push(format!(
+                "{}: the faces of `{}` end inside the domain; the flux near {count} (at {:?}{more}) is not counted, an O(h) part of it",
+                q.name,
+                q.tag.as_deref().unwrap_or_default(),
+                complex.vertices().point(v),
+            ));
+        }
+        warnings
+    }
+}
+
+/// [`LevelFluxes`] of a solution whose boundary outflow is `outflow`.
+pub(super) fn flux_values(
+    case: &Case,
+    problem: &Diffusion,
+    complex: &Complex,
+    solution: &Solution,
+    outflow: &[f64],
+) -> Result<LevelFluxes, DiffusionError> {
+    let count = case.output.quantities.len();
+    let mut fluxes = LevelFluxes {
+        values: vec![f64::NAN; count],
+        left_out: vec![Vec::new(); count],
+    };
+    for (i, q) in case.output.quantities.iter().enumerate() {
+        if q.kind != QuantityKind::Flux {
+            continue;
+        }
+        let tag = q.tag.as_deref().and_then(|t| complex.tag(t));
+        let faces = tag.map_or(&[][..], |t| &t.cells[..]);
+        let across = problem.flux_across(complex, solution, outflow, faces)?;
+        fluxes.values[i] = across.flux.iter().sum();
+        fluxes.left_out[i] = across.left_out;
+    }
+    Ok(fluxes)
 }
 
 /// The quantities of a heat run at one saved level, one value per
@@ -142,10 +149,9 @@ pub(super) fn level_values(
     case.output
         .quantities
         .iter()
-        .map(|q| match (q.kind, fluxes) {
-            (QuantityKind::Flux, Some(f)) => {
-                flux_through(q, complex, &f.outflow, f.face_flux.as_deref())
-            }
+        .enumerate()
+        .map(|(i, q)| match (q.kind, fluxes) {
+            (QuantityKind::Flux, Some(f)) => f.values[i],
             (QuantityKind::Flux, None) => f64::NAN,
             (kind, _) => region_statistic(kind, q, complex, field, location),
         })
