@@ -9,7 +9,8 @@
 //! LLᵀ, solve). Newton runs twice: with a numeric LU of each step's
 //! Jacobian (one symbolic analysis; J is not symmetric: the face weights'
 //! derivative), and as Newton–Krylov (`NonlinearOptions::krylov`: GMRES on
-//! J preconditioned by an LLᵀ of its symmetric part kept over the steps).
+//! J preconditioned by an LLᵀ of its symmetric part kept over the steps, or
+//! by a smoothed-aggregation V-cycle of it: `KrylovPreconditioner`).
 //!
 //! - `cargo bench --bench nonlinear` — 300².
 //! - `cargo bench --bench nonlinear -- full` — 1000² (10⁶ unknowns).
@@ -20,7 +21,7 @@ mod measure;
 use hasse_complex::generate::rectangle;
 use hasse_solver::metric::Method;
 use hasse_solver::physics::diffusion::Diffusion;
-use hasse_solver::physics::nonlinear::{Coefficient, NonlinearDiffusion};
+use hasse_solver::physics::nonlinear::{Coefficient, KrylovPreconditioner, NonlinearDiffusion};
 use hasse_solver::physics::{BoundaryKind, Conductivity};
 use measure::seconds;
 use std::f64::consts::PI;
@@ -52,7 +53,11 @@ fn main() {
     drop(linear);
     println!("linear −Δu = f (assembly + LLᵀ + solve): {linear_time:.2} s");
 
-    for krylov in [false, true] {
+    for (krylov, preconditioner) in [
+        (false, KrylovPreconditioner::Factor),
+        (true, KrylovPreconditioner::Factor),
+        (true, KrylovPreconditioner::Multigrid),
+    ] {
         let started = Instant::now();
         let conductivity = Coefficient::new(
             Arc::new(|u: f64, _: &[f64]| 1.0 + u * u),
@@ -61,13 +66,18 @@ fn main() {
         let mut problem = NonlinearDiffusion::new(Method::Fv, conductivity, Arc::new(source))
             .with_boundary("boundary", zero());
         problem.options.krylov = krylov;
+        problem.options.preconditioner = preconditioner;
         let solved = problem.solve(&mesh).expect("Newton converges");
         let newton_time = seconds(started);
         let history: Vec<String> = solved.history.iter().map(|r| format!("{r:.1e}")).collect();
-        let name = if krylov {
-            "newton–krylov (GMRES, LLᵀ of the symmetric part)"
-        } else {
-            "newton (LU per step)"
+        let name = match (krylov, preconditioner) {
+            (false, _) => "newton (LU per step)",
+            (true, KrylovPreconditioner::Factor) => {
+                "newton–krylov (GMRES, LLᵀ of the symmetric part)"
+            }
+            (true, KrylovPreconditioner::Multigrid) => {
+                "newton–krylov (GMRES, AMG V-cycle of the symmetric part)"
+            }
         };
         println!(
             "{name}: {newton_time:.2} s, {} iterations (residuals {})",

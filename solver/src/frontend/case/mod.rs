@@ -195,8 +195,11 @@ pub struct NonlinearSolverSpec {
     pub monitor: bool,
     /// `linear = "krylov"`: Newton–Krylov steps (GMRES preconditioned by
     /// an LLᵀ of the Jacobian's symmetric part) instead of an LU per step
-    /// (`"direct"`, the default).
+    /// (`"direct"`, the default); `"krylov-multigrid"` preconditions by an
+    /// algebraic multigrid V-cycle of that part instead.
     pub krylov: bool,
+    /// The preconditioner of Newton–Krylov steps.
+    pub preconditioner: crate::physics::nonlinear::KrylovPreconditioner,
 }
 
 impl Default for NonlinearSolverSpec {
@@ -207,6 +210,7 @@ impl Default for NonlinearSolverSpec {
             max_iterations: 50,
             monitor: false,
             krylov: false,
+            preconditioner: crate::physics::nonlinear::KrylovPreconditioner::Factor,
         }
     }
 }

@@ -109,6 +109,7 @@ pub(super) fn options(
         initial: None,
         monitor,
         krylov: settings.krylov,
+        preconditioner: settings.preconditioner,
     }
 }
 

@@ -164,6 +164,22 @@ pub struct NonlinearOptions {
     /// the module `krylov_step`); a step falls back to LU when that part
     /// is not positive definite or GMRES does not converge. Newton only.
     pub krylov: bool,
+    /// What preconditions Newton–Krylov's GMRES: the LLᵀ of the Jacobian's
+    /// symmetric part, or an algebraic multigrid V-cycle of it.
+    pub preconditioner: KrylovPreconditioner,
+}
+
+/// The preconditioner of Newton–Krylov steps ([`NonlinearOptions::krylov`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KrylovPreconditioner {
+    /// A sparse LLᵀ of the Jacobian's symmetric part P (Picard's matrix):
+    /// GMRES needs few iterations, each a pair of triangular solves.
+    #[default]
+    Factor,
+    /// A smoothed-aggregation V-cycle of P: no factorisation and cheap
+    /// iterations, more of them; for large 2D and for 3D problems, where
+    /// the factor's fill dominates.
+    Multigrid,
 }
 
 impl Default for NonlinearOptions {
@@ -175,6 +191,7 @@ impl Default for NonlinearOptions {
             initial: None,
             monitor: None,
             krylov: false,
+            preconditioner: KrylovPreconditioner::Factor,
         }
     }
 }

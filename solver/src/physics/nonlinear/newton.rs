@@ -297,7 +297,7 @@ pub(super) fn iterate(
         let krylov_delta = krylov_weights.and_then(|weights| {
             let state = work
                 .krylov
-                .get_or_insert_with(|| KrylovState::new(&work.jacobian));
+                .get_or_insert_with(|| KrylovState::new(&work.jacobian, options.preconditioner));
             let eta = at.relative().clamp(1e-12, 0.1);
             let before = state.analyses;
             let step = state

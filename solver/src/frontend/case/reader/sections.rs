@@ -3,7 +3,7 @@
 use super::*;
 use crate::frontend::case::NonlinearSolverSpec;
 use crate::frontend::output::ComplexLayout;
-use crate::physics::nonlinear::Iteration;
+use crate::physics::nonlinear::{Iteration, KrylovPreconditioner};
 
 impl Reader {
     pub(super) fn exact(&mut self, root: &dyn TableLike, scope: &Scope) -> Option<ExactSpec> {
@@ -459,13 +459,17 @@ impl Reader {
             match entry.item.as_str() {
                 Some("direct") => spec.krylov = false,
                 Some("krylov") => spec.krylov = true,
+                Some("krylov-multigrid") => {
+                    spec.krylov = true;
+                    spec.preconditioner = KrylovPreconditioner::Multigrid;
+                }
                 Some(other) => self.error(
                     entry.span(),
                     &entry.name,
                     format!("unknown linear solver \"{other}\" for the Newton steps"),
-                    Some("use \"direct\" (an LU per step, default) or \"krylov\" (GMRES preconditioned by an LLᵀ of the Jacobian's symmetric part)".into()),
+                    Some("use \"direct\" (an LU per step, default), \"krylov\" (GMRES preconditioned by an LLᵀ of the Jacobian's symmetric part) or \"krylov-multigrid\" (GMRES preconditioned by an algebraic multigrid V-cycle of it)".into()),
                 ),
-                None => self.type_error(&entry, "\"direct\" or \"krylov\""),
+                None => self.type_error(&entry, "\"direct\", \"krylov\" or \"krylov-multigrid\""),
             }
         }
         spec
