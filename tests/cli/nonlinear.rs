@@ -383,5 +383,16 @@ fn krylov_newton_steps_reach_the_direct_solution() -> Result {
     let steps = |out: &str| reported(out, "newton", "newton");
     assert_eq!(steps(&direct)?, steps(&krylov)?, "{direct}\n{krylov}");
     assert!(krylov.contains("1 symbolic analysis"), "{krylov}");
+    // The multigrid-preconditioned variant: the same steps and error, and
+    // no symbolic analysis of a Newton matrix (the V-cycle replaces the
+    // LLᵀ; only its own coarsest level is factorised).
+    let multigrid = summary(
+        "cases/nonlinear-diffusion.toml",
+        &["solver.nonlinear.linear=\"krylov-multigrid\""],
+    );
+    let c = reported(&multigrid, "error", "L2")?;
+    assert!((a - c).abs() <= 1e-8 * a, "{direct}\n{multigrid}");
+    assert_eq!(steps(&direct)?, steps(&multigrid)?, "{direct}\n{multigrid}");
+    assert!(multigrid.contains("0 symbolic analysis"), "{multigrid}");
     Ok(())
 }
