@@ -20,9 +20,9 @@
 //! assert_eq!(fine.cell_count(2), 16 + 3);
 //! ```
 
+use crate::cells::{TopCells, Vertices};
 use crate::complex::Complex;
 use crate::error::SplitError;
-use crate::cells::{TopCells, Vertices};
 use crate::split::{split_cells, Hyperplane, Refinement, SplitOptions};
 use nalgebra::{Matrix2, Matrix3, SymmetricEigen, Vector3};
 use sprs::CsMat;
@@ -389,7 +389,9 @@ pub fn divide_midpoint(
     );
     let zeta0 = CsMat::new(
         (v0 + cells.len(), v0),
-        (0..=v0).chain(std::iter::repeat(v0).take(cells.len())).collect(),
+        (0..=v0)
+            .chain(std::iter::repeat(v0).take(cells.len()))
+            .collect(),
         (0..v0).collect(),
         vec![1i8; v0],
     );
@@ -655,7 +657,11 @@ mod tests {
         let k = interval(2, 0.0, 1.0).unwrap();
         assert!(matches!(
             divide_midpoint(&k, &[2]),
-            Err(SplitError::CellOutOfRange { p: 1, cell: 2, count: 2 })
+            Err(SplitError::CellOutOfRange {
+                p: 1,
+                cell: 2,
+                count: 2
+            })
         ));
         // Nothing listed: the same filament and the identity map.
         let (same, r) = divide_midpoint(&k, &[]).unwrap();

@@ -401,7 +401,8 @@ fn run_case(
         None if matches!(
             case.problem,
             hasse_solver::frontend::case::Problem::Growth(_)
-        ) => {
+        ) =>
+        {
             match run::growth::grow_case(&case, &complex, &mut |name| progress.phase(name)) {
                 Ok(growth) => {
                     let result = Ok(growth.result.clone());
@@ -480,16 +481,13 @@ fn run_case(
                 })
             }
             (None, _) if grown.is_some() => match &grown {
-                Some(growth) => run::growth::write_series(
-                    &case,
-                    growth,
-                    result.report_json(complex),
-                    &stem,
-                )
-                .and_then(|files| {
-                    hasse_solver::frontend::output::remove_partial(&stem)?;
-                    Ok(files)
-                }),
+                Some(growth) => {
+                    run::growth::write_series(&case, growth, result.report_json(complex), &stem)
+                        .and_then(|files| {
+                            hasse_solver::frontend::output::remove_partial(&stem)?;
+                            Ok(files)
+                        })
+                }
                 None => run::write_output(&case, complex, &result, &stem),
             },
             (None, Some(stream)) => stream.finish(complex, &mut result),

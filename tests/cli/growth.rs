@@ -28,7 +28,9 @@ struct Level {
 /// The rows of the `levels` table of a growth summary.
 fn levels(stdout: &str) -> Result<Vec<Level>> {
     let mut lines = stdout.lines().skip_while(|l| !l.starts_with("levels"));
-    lines.next().ok_or_else(|| format!("no levels table in\n{stdout}"))?;
+    lines
+        .next()
+        .ok_or_else(|| format!("no levels table in\n{stdout}"))?;
     let mut rows = Vec::new();
     for line in lines.take_while(|l| l.starts_with("    ")) {
         let w: Vec<&str> = line.split_whitespace().collect();
@@ -41,7 +43,11 @@ fn levels(stdout: &str) -> Result<Vec<Level>> {
             euler: w[3].parse()?,
             size: w[4].parse()?,
             mass: w[5].parse()?,
-            balance: if w[6] == "—" { None } else { Some(w[6].parse()?) },
+            balance: if w[6] == "—" {
+                None
+            } else {
+                Some(w[6].parse()?)
+            },
         });
     }
     Ok(rows)
@@ -57,7 +63,11 @@ fn the_filament_divides_at_the_hand_counted_steps() -> Result {
     let stem = dir.join("filament");
     let out = hasse(&["run", FILAMENT, "-o", stem.to_str().ok_or("path")?]);
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let rows = levels(&stdout)?;
     let steps: Vec<usize> = rows.iter().map(|r| r.step).collect();
     assert_eq!(steps, vec![0, 10, 20, 30, 40, 50]);
@@ -75,9 +85,18 @@ fn the_filament_divides_at_the_hand_counted_steps() -> Result {
     // The series: one mesh per saved level, with c and amount.
     let xdmf = std::fs::read_to_string(dir.join("filament.xdmf"))?;
     for k in 0..6 {
-        assert!(xdmf.contains(&format!("filament.h5:/steps/{k}/mesh/vertices")), "{xdmf}");
-        assert!(xdmf.contains(&format!("filament.h5:/steps/{k}/c")), "{xdmf}");
-        assert!(xdmf.contains(&format!("filament.h5:/steps/{k}/amount")), "{xdmf}");
+        assert!(
+            xdmf.contains(&format!("filament.h5:/steps/{k}/mesh/vertices")),
+            "{xdmf}"
+        );
+        assert!(
+            xdmf.contains(&format!("filament.h5:/steps/{k}/c")),
+            "{xdmf}"
+        );
+        assert!(
+            xdmf.contains(&format!("filament.h5:/steps/{k}/amount")),
+            "{xdmf}"
+        );
     }
     assert!(dir.join("filament.level-5.xdmf").exists());
     Ok(())
@@ -97,7 +116,10 @@ fn the_tissue_grows_by_its_affine_factor_and_stays_a_disc() -> Result {
     assert!(rows[6].cells > 100, "{stdout}");
     for r in &rows {
         assert_eq!(r.euler, 1, "{r:?}");
-        assert!((r.size - 1.025f64.powi(2 * r.step as i32)).abs() < 1e-6, "{r:?}");
+        assert!(
+            (r.size - 1.025f64.powi(2 * r.step as i32)).abs() < 1e-6,
+            "{r:?}"
+        );
         assert!(r.balance.is_none_or(|b| b < 1e-12), "{r:?}");
     }
     Ok(())
@@ -109,7 +131,11 @@ fn mass_is_kept_without_sources_and_decays_by_one_plus_lambda_dt() -> Result {
     // = 1.5 (each cell starts with c(centroid)|σ|, exact for linear c).
     let kept = summary(
         TISSUE,
-        &["problem.source=\"0\"", "problem.decay=0", "problem.initial=\"1 + x\""],
+        &[
+            "problem.source=\"0\"",
+            "problem.decay=0",
+            "problem.initial=\"1 + x\"",
+        ],
     );
     for r in levels(&kept)? {
         assert!((r.mass - 1.5).abs() < 1e-6 * 1.5, "{r:?}");
@@ -119,7 +145,11 @@ fn mass_is_kept_without_sources_and_decays_by_one_plus_lambda_dt() -> Result {
     // Euler gives M^{n+1} = Mⁿ/(1 + λΔt) = Mⁿ/1.1 with λ = 2, Δt = 0.05.
     let decayed = summary(
         TISSUE,
-        &["problem.source=\"0\"", "problem.decay=2", "problem.initial=\"1\""],
+        &[
+            "problem.source=\"0\"",
+            "problem.decay=2",
+            "problem.initial=\"1\"",
+        ],
     );
     for r in levels(&decayed)? {
         let expected = 1.1f64.powi(-(r.step as i32));
@@ -145,7 +175,11 @@ fn check_fails(case: &str, sets: &[&str], key: &str, expected: &str) -> Result {
 fn check_refuses_what_cannot_grow() -> Result {
     for case in [FILAMENT, TISSUE] {
         let out = hasse(&["check", case]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     check_fails(
         TISSUE,

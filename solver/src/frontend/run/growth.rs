@@ -6,7 +6,9 @@
 use super::heat::time_fn;
 use super::{conductivity, diffusion_error, scalar_fn, Keys, RunError, RunResult};
 use crate::frontend::case::{BoundaryKindSpec, Case, GrowthSpec, Problem};
-use crate::frontend::output::{Cochain, MeshStep, OutputError, OutputFiles, Provenance, SeriesOutput};
+use crate::frontend::output::{
+    Cochain, MeshStep, OutputError, OutputFiles, Provenance, SeriesOutput,
+};
 use crate::physics::heat::{Heat, HeatBoundary, SpaceTimeFn};
 use crate::refine::growth::{Growth, GrowthError, GrowthStep, Tissue};
 use hasse_complex::Complex;
@@ -71,7 +73,9 @@ fn growth_error(case: &Case, spec: &GrowthSpec, e: GrowthError) -> RunError {
             case,
             "mesh",
             message,
-            Some("grow an interval (a filament) or a 2D mesh such as generator = \"voronoi\"".into()),
+            Some(
+                "grow an interval (a filament) or a 2D mesh such as generator = \"voronoi\"".into(),
+            ),
         ),
         GrowthError::Velocity { expected, .. } => RunError::input_at(
             case,
@@ -189,14 +193,17 @@ pub fn grow_case(
                 } else {
                     phase(&format!("step {k} of {}", time.steps));
                 }
-                let save = k == 0
-                    || k == time.steps
-                    || (time.save_every > 0 && k % time.save_every == 0);
+                let save =
+                    k == 0 || k == time.steps || (time.save_every > 0 && k % time.save_every == 0);
                 if save {
                     if k > 0 {
                         saved_steps.push(k);
                     }
-                    levels.push((tissue.time, tissue.complex.clone(), level_fields(case, tissue)));
+                    levels.push((
+                        tissue.time,
+                        tissue.complex.clone(),
+                        level_fields(case, tissue),
+                    ));
                 }
                 if k == time.steps {
                     last = Some((tissue.complex.clone(), tissue.concentration()));
@@ -304,7 +311,13 @@ pub fn grow_case(
     let result = RunResult {
         problem: "growth".into(),
         method: Some(spec.method.name().into()),
-        unknowns: final_complex.cell_count(n),
+        // Cell averages, and fv-mimetic's face values beside them.
+        unknowns: match spec.method.location() {
+            crate::metric::Location::Hybrid => {
+                final_complex.cell_count(n) + final_complex.cell_count(n - 1)
+            }
+            _ => final_complex.cell_count(n),
+        },
         fields,
         errors: None,
         flux_error: None,

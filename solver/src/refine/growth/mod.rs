@@ -148,7 +148,9 @@ pub enum GrowthError {
         dim: usize,
     },
     /// The velocity is not finite at a vertex.
-    #[error("velocity component {component} is not finite at vertex {vertex} ({point:?}, t = {time})")]
+    #[error(
+        "velocity component {component} is not finite at vertex {vertex} ({point:?}, t = {time})"
+    )]
     NonFiniteVelocity {
         /// 0-based component.
         component: usize,
@@ -160,7 +162,9 @@ pub enum GrowthError {
         time: f64,
     },
     /// A step of the motion turned a cell inside out (or flattened it).
-    #[error("at t = {time} the motion turned cell {cell} inside out or flat: take a smaller time step")]
+    #[error(
+        "at t = {time} the motion turned cell {cell} inside out or flat: take a smaller time step"
+    )]
     Inverted {
         /// The time at which the step started.
         time: f64,
@@ -417,8 +421,7 @@ impl Growth {
             .collect();
         let mass: f64 = new_amount.iter().sum();
         let decay = self.decay * mass;
-        let residual =
-            (mass - mass_before) - dt * (diffused.sources - decay - diffused.outflow);
+        let residual = (mass - mass_before) - dt * (diffused.sources - decay - diffused.outflow);
         let scale = mass_before
             .abs()
             .max(mass.abs())

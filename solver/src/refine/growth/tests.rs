@@ -84,13 +84,18 @@ fn a_filament_divides_at_the_hand_counted_steps() {
     let mut counts = Vec::new();
     let mut checks = Vec::new();
     let steps = growth
-        .run(&interval(4, 0.0, 1.0).unwrap(), &|_| 1.0, 20, &mut |t, _| {
-            counts.push(t.complex.cell_count(1));
-            checks.push((
-                t.complex.euler_characteristic(),
-                signed_measures(&t.complex).iter().all(|&l| l > 0.0),
-            ));
-        })
+        .run(
+            &interval(4, 0.0, 1.0).unwrap(),
+            &|_| 1.0,
+            20,
+            &mut |t, _| {
+                counts.push(t.complex.cell_count(1));
+                checks.push((
+                    t.complex.euler_characteristic(),
+                    signed_measures(&t.complex).iter().all(|&l| l > 0.0),
+                ));
+            },
+        )
         .unwrap();
     let mut expected = vec![4; 4];
     expected.extend(vec![8; 14]);
@@ -129,7 +134,12 @@ fn without_sources_decay_or_flux_the_mass_stays_through_motions_and_divisions() 
         }
         for s in &steps {
             assert_relative_eq!(s.mass_carried, s.mass_before, max_relative = 1e-14);
-            assert!(s.relative < 1e-13, "{method:?} step {}: {}", s.number, s.relative);
+            assert!(
+                s.relative < 1e-13,
+                "{method:?} step {}: {}",
+                s.number,
+                s.relative
+            );
         }
     }
 }
@@ -149,11 +159,20 @@ fn uniform_decay_divides_the_mass_by_one_plus_lambda_dt_each_step() {
     )
     .with_decay(2.0);
     let steps = growth
-        .run(&interval(5, 0.0, 1.0).unwrap(), &|_| 1.0, 12, &mut |_, _| {})
+        .run(
+            &interval(5, 0.0, 1.0).unwrap(),
+            &|_| 1.0,
+            12,
+            &mut |_, _| {},
+        )
         .unwrap();
     assert!(steps.iter().any(|s| s.divided > 0));
     for s in &steps {
-        assert_relative_eq!(s.mass, 1.2f64.powi(-(s.number as i32)), max_relative = 1e-13);
+        assert_relative_eq!(
+            s.mass,
+            1.2f64.powi(-(s.number as i32)),
+            max_relative = 1e-13
+        );
         assert!(s.relative < 1e-13);
     }
 }
@@ -163,12 +182,7 @@ fn every_divided_tissue_stays_a_coherently_oriented_disc() {
     // After every motion and division: ∂∂ = 0 exactly, every top cell's
     // boundary chain encloses a positive area, and χ = 1 (a disc).
     for rule in [DivisionRule::LongestAxis, DivisionRule::ShortestWall] {
-        let growth = Growth::new(
-            heat(Method::FvMimetic, 0.05),
-            expanding(2, 1.0),
-            0.04,
-            rule,
-        );
+        let growth = Growth::new(heat(Method::FvMimetic, 0.05), expanding(2, 1.0), 0.04, rule);
         let mesh = voronoi(25, [0.0, 1.0], [0.0, 1.0], 3, 5).unwrap();
         let mut seen = 0;
         growth
@@ -195,12 +209,15 @@ fn a_source_decay_and_a_held_boundary_balance_to_rounding() {
             "boundary",
             HeatBoundary::Dirichlet(TimeFn::Steady(Arc::new(|_| 0.0))),
         );
-    let growth =
-        Growth::new(h, expanding(2, 0.5), 0.05, DivisionRule::LongestAxis).with_decay(0.5);
+    let growth = Growth::new(h, expanding(2, 0.5), 0.05, DivisionRule::LongestAxis).with_decay(0.5);
     let mesh = voronoi(30, [0.0, 1.0], [0.0, 1.0], 7, 5).unwrap();
     let steps = growth.run(&mesh, &|_| 0.0, 6, &mut |_, _| {}).unwrap();
     for s in &steps {
-        assert_relative_eq!(s.sources, 1.05f64.powi(2 * s.number as i32), max_relative = 1e-12);
+        assert_relative_eq!(
+            s.sources,
+            1.05f64.powi(2 * s.number as i32),
+            max_relative = 1e-12
+        );
         assert!(s.outflow > 0.0);
         assert!(s.relative < 1e-12, "step {}: {}", s.number, s.relative);
     }
@@ -237,7 +254,10 @@ fn growth_refuses_what_it_cannot_grow() {
     let one = expanding(1, 1.0);
     assert!(matches!(
         g(Method::Fv, expanding(2, 1.0), 0.3, DivisionRule::Midpoint).check(&line),
-        Err(GrowthError::Velocity { expected: 1, found: 2 })
+        Err(GrowthError::Velocity {
+            expected: 1,
+            found: 2
+        })
     ));
     assert!(matches!(
         g(Method::Fv, one.clone(), 0.0, DivisionRule::Midpoint).check(&line),
@@ -253,8 +273,17 @@ fn growth_refuses_what_it_cannot_grow() {
     ));
     let cube = box3(1, 1, 1, [0.0, 1.0], [0.0, 1.0], [0.0, 1.0]).unwrap();
     assert!(matches!(
-        g(Method::Fv, expanding(3, 1.0), 0.3, DivisionRule::LongestAxis).check(&cube),
-        Err(GrowthError::Dimension { dim: 3, embedding: 3 })
+        g(
+            Method::Fv,
+            expanding(3, 1.0),
+            0.3,
+            DivisionRule::LongestAxis
+        )
+        .check(&cube),
+        Err(GrowthError::Dimension {
+            dim: 3,
+            embedding: 3
+        })
     ));
     // A velocity that squeezes a cell past flat in one step is refused.
     let crush: Vec<SpaceTimeFn> = vec![Arc::new(|x: &[f64], _| -20.0 * x[0])];

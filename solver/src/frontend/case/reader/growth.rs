@@ -169,7 +169,10 @@ impl Reader {
                     header.clone(),
                     "growth.velocity",
                     "missing: the growth velocity v(x, t), one expression per coordinate",
-                    Some("e.g. velocity = [\"0.1*x\", \"0.1*y\"] (uniform growth at rate 0.1)".into()),
+                    Some(
+                        "e.g. velocity = [\"0.1*x\", \"0.1*y\"] (uniform growth at rate 0.1)"
+                            .into(),
+                    ),
                 );
                 None
             }
