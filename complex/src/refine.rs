@@ -390,7 +390,7 @@ pub fn divide_midpoint(
     let zeta0 = CsMat::new(
         (v0 + cells.len(), v0),
         (0..=v0)
-            .chain(std::iter::repeat(v0).take(cells.len()))
+            .chain(std::iter::repeat_n(v0, cells.len()))
             .collect(),
         (0..v0).collect(),
         vec![1i8; v0],
