@@ -177,7 +177,7 @@ pub fn grow_case(
     let started = Instant::now();
     let mut levels: Vec<(f64, Complex, Vec<Cochain>)> = Vec::new();
     let mut saved_steps: Vec<usize> = vec![0];
-    let mut last: Option<(Complex, Vec<f64>)> = None;
+    let mut last: Option<Complex> = None;
     let mut start_mass = 0.0;
     let mut start_cells = 0;
     let steps = growth
@@ -206,16 +206,13 @@ pub fn grow_case(
                     ));
                 }
                 if k == time.steps {
-                    last = Some((tissue.complex.clone(), tissue.concentration()));
+                    last = Some(tissue.complex.clone());
                 }
             },
         )
         .map_err(|e| growth_error(case, spec, e))?;
     let seconds = started.elapsed().as_secs_f64();
-    let final_complex = match last {
-        Some((k, _)) => k,
-        None => complex.clone(),
-    };
+    let final_complex = last.unwrap_or_else(|| complex.clone());
     let n = final_complex.dim();
     let fields = levels.last().map(|(_, _, f)| f.clone()).unwrap_or_default();
     let worst = steps.iter().map(|s| s.relative).fold(0.0, f64::max);
