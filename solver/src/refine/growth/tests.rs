@@ -83,6 +83,7 @@ fn a_filament_divides_at_the_hand_counted_steps() {
     );
     let mut counts = Vec::new();
     let mut checks = Vec::new();
+    let mut lengths = Vec::new();
     let steps = growth
         .run(
             &interval(4, 0.0, 1.0).unwrap(),
@@ -90,6 +91,7 @@ fn a_filament_divides_at_the_hand_counted_steps() {
             20,
             &mut |t, _| {
                 counts.push(t.complex.cell_count(1));
+                lengths = t.complex.measure(1).to_vec();
                 checks.push((
                     t.complex.euler_characteristic(),
                     signed_measures(&t.complex).iter().all(|&l| l > 0.0),
@@ -109,7 +111,10 @@ fn a_filament_divides_at_the_hand_counted_steps() {
     // vertex up to one rounding a step (20 steps: ~20 ulp).
     assert_relative_eq!(steps[19].size, 1.05f64.powi(20), max_relative = 1e-14);
     // The equal halves of equal cells: all 16 lengths are 1.05²⁰/16.
-    assert_eq!(steps[19].cells, 16);
+    assert_eq!(lengths.len(), 16);
+    for l in lengths {
+        assert_relative_eq!(l, 1.05f64.powi(20) / 16.0, max_relative = 1e-13);
+    }
 }
 
 #[test]
