@@ -20,10 +20,12 @@
 //! assert_eq!(fine.cell_count(2), 16 + 3);
 //! ```
 
+use crate::cells::{TopCells, Vertices};
 use crate::complex::Complex;
 use crate::error::SplitError;
 use crate::split::{split_cells, Hyperplane, Refinement, SplitOptions};
 use nalgebra::{Matrix2, Matrix3, SymmetricEigen, Vector3};
+use sprs::CsMat;
 
 /// Split each listed top cell by the d axis-aligned hyperplanes through its
 /// centroid (quads → 4 quads, hexes → 8 hexes, simplices → convex
@@ -285,6 +287,126 @@ pub fn divide_longest_axis(
     split_cells(complex, &cuts, SplitOptions::default())
 }
 
+/// Division of a 1-complex (a filament: a chain of edges, in R^d): each
+/// listed edge divides at its midpoint. SPLIT cuts cells by hyperplanes and
+/// needs n = d ≥ 2; an edge has one possible cut, its midpoint, so this is
+/// the rule of every 1D division (the thesis's Anabaena cells divide in
+/// half). A divided edge keeps its index for the piece at its lower vertex
+/// and the piece at its higher vertex is appended; the midpoints are
+/// appended to the vertices. ζ_1 maps the edge to its two pieces (signed by
+/// their direction relative to it), ζ_0 keeps the old vertices (midpoints
+/// are new cells, without a parent) and the nodal interpolation gives a
+/// midpoint ½, ½ of its edge's ends. Tags are kept; a tagged edge's pieces
+/// keep its tag.
+///
+/// ```
+/// use hasse_complex::generate::interval;
+/// use hasse_complex::refine::divide_midpoint;
+/// let k = interval(2, 0.0, 2.0).unwrap();
+/// let (fine, r) = divide_midpoint(&k, &[1]).unwrap();
+/// assert_eq!(fine.cell_counts(), vec![4, 3]);
+/// assert_eq!(fine.measure(1), &[1.0, 0.5, 0.5]);
+/// assert_eq!(r.parent(1, 2), Some((1, 1)));
+/// assert!(divide_midpoint(&hasse_complex::generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap(), &[0]).is_err());
+/// ```
+pub fn divide_midpoint(
+    complex: &Complex,
+    cells: &[usize],
+) -> Result<(Complex, Refinement), SplitError> {
+    if complex.dim() != 1 {
+        return Err(SplitError::Invalid(format!(
+            "midpoint division divides the edges of a 1-complex (a filament); this complex has dimension {}",
+            complex.dim()
+        )));
+    }
+    check_cells(complex, cells)?;
+    let mut cells = cells.to_vec();
+    cells.sort_unstable();
+    cells.dedup();
+    let d = complex.embedding_dim();
+    let (v0, e0) = (complex.cell_count(0), complex.cell_count(1));
+    let mut coords = complex.vertices().as_slice().to_vec();
+    let mut edges: Vec<[usize; 2]> = (0..e0)
+        .map(|e| {
+            let v = complex.cell_vertices(1, e);
+            [v[0], v[1]]
+        })
+        .collect();
+    // parent[i] for every fine edge; the midpoint's ends for the nodal rows.
+    let mut parent: Vec<usize> = (0..e0).collect();
+    let mut ends = Vec::with_capacity(cells.len());
+    for (k, &c) in cells.iter().enumerate() {
+        let [a, b] = edges[c];
+        let m = v0 + k;
+        let (xa, xb) = (complex.vertices().point(a), complex.vertices().point(b));
+        coords.extend(xa.iter().zip(xb).map(|(p, q)| 0.5 * (p + q)));
+        edges[c] = [a, m];
+        edges.push([m, b]);
+        parent.push(c);
+        ends.push((a, b));
+    }
+    let vertices = Vertices::new(d, coords)?;
+    let mut fine = Complex::build(vertices, TopCells::simplices(&edges))?;
+    for (name, tag) in complex.tags().iter() {
+        let mut tagged = tag.cells.clone();
+        if tag.dim == 1 {
+            tagged.extend((e0..edges.len()).filter(|&i| tag.contains(parent[i])));
+        }
+        fine.set_tag(name, tag.dim, tagged)?;
+    }
+    // The sign of a piece: whether it runs the way its parent does (the
+    // direction of an edge is head − tail of its column of ∂_1).
+    let direction = |k: &Complex, e: usize| -> Vec<f64> {
+        let mut dir = vec![0.0; d];
+        if let Some(col) = k.boundary_csc(1).outer_view(e) {
+            for (v, &s) in col.iter() {
+                for (x, p) in dir.iter_mut().zip(k.vertices().point(v)) {
+                    *x += f64::from(s) * p;
+                }
+            }
+        }
+        dir
+    };
+    let mut zeta1 = Vec::with_capacity(edges.len());
+    for (i, &c) in parent.iter().enumerate() {
+        let (piece, whole) = (direction(&fine, i), direction(complex, c));
+        let dot: f64 = piece.iter().zip(&whole).map(|(a, b)| a * b).sum();
+        zeta1.push(if dot > 0.0 { 1i8 } else { -1 });
+    }
+    let fine_edges = fine.cell_count(1);
+    if fine_edges != edges.len() {
+        return Err(SplitError::Invalid(format!(
+            "dividing {} edges gave {fine_edges} edges instead of {}: the filament has repeated edges",
+            cells.len(),
+            edges.len()
+        )));
+    }
+    let zeta1 = CsMat::new(
+        (edges.len(), e0),
+        (0..=edges.len()).collect(),
+        parent.clone(),
+        zeta1,
+    );
+    let zeta0 = CsMat::new(
+        (v0 + cells.len(), v0),
+        (0..=v0)
+            .chain(std::iter::repeat_n(v0, cells.len()))
+            .collect(),
+        (0..v0).collect(),
+        vec![1i8; v0],
+    );
+    let mut indptr: Vec<usize> = (0..=v0).collect();
+    let mut indices: Vec<usize> = (0..v0).collect();
+    let mut data = vec![1.0; v0];
+    for &(a, b) in &ends {
+        indices.extend([a.min(b), a.max(b)]);
+        data.extend([0.5, 0.5]);
+        indptr.push(indices.len());
+    }
+    let nodal = CsMat::new((v0 + cells.len(), v0), indptr, indices, data);
+    Ok((fine, Refinement::from_parts(vec![zeta0, zeta1], nodal)))
+}
+
 /// Eigenvector of the largest eigenvalue of the leading d × d block.
 fn principal_axis(d: usize, cov: &[[f64; 3]; 3]) -> Vec<f64> {
     if d == 2 {
@@ -468,4 +590,82 @@ fn padded(x: &[f64]) -> [f64; 3] {
         *o = *v;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generate::interval;
+
+    /// ∂_1 ζ_1 = ζ_0 ∂_1, compared entry by entry (integers).
+    fn commutes(coarse: &Complex, fine: &Complex, r: &Refinement) -> bool {
+        let left = &**fine.boundary(1) * r.zeta(1);
+        let right = r.zeta(0) * &**coarse.boundary(1);
+        left.to_dense() == right.to_dense()
+    }
+
+    #[test]
+    fn midpoint_division_of_a_straight_filament() {
+        // Three unit edges on [0, 3]; dividing the first and the last by
+        // hand gives 6 vertices, 5 edges (χ = 6 − 5 = 1, as before) and
+        // lengths 0.5, 1, 0.5, 0.5, 0.5 in the documented numbering.
+        let k = interval(3, 0.0, 3.0).unwrap();
+        let (fine, r) = divide_midpoint(&k, &[2, 0]).unwrap();
+        assert_eq!(fine.cell_counts(), vec![6, 5]);
+        assert_eq!(fine.euler_characteristic(), 1);
+        assert_eq!(fine.measure(1), &[0.5, 1.0, 0.5, 0.5, 0.5]);
+        assert_eq!(fine.vertices().point(4), &[0.5]);
+        assert_eq!(fine.vertices().point(5), &[2.5]);
+        assert!(commutes(&k, &fine, &r));
+        // Every edge of a filament in R¹ runs towards +x (positive).
+        for e in 0..fine.cell_count(1) {
+            let col = fine.boundary_csc(1).outer_view(e).unwrap();
+            let head_minus_tail: f64 = col
+                .iter()
+                .map(|(v, &s)| f64::from(s) * fine.vertices().point(v)[0])
+                .sum();
+            assert!(head_minus_tail > 0.0);
+        }
+        // The boundary tags keep their vertices, the end points 0 and 3.
+        assert_eq!(fine.tag("xmin").unwrap().cells, vec![0]);
+        assert_eq!(fine.tag("xmax").unwrap().cells, vec![3]);
+        // Midpoint values interpolate ½, ½.
+        let u = r.nodal(&[0.0, 1.0, 2.0, 3.0]).unwrap();
+        assert_eq!(u, vec![0.0, 1.0, 2.0, 3.0, 0.5, 2.5]);
+    }
+
+    #[test]
+    fn midpoint_division_of_a_bent_filament_in_the_plane() {
+        // An L-shaped chain (0,0) → (1,0) → (1,1): each edge halves, and ζ
+        // carries each piece's direction relative to its parent, so ∂ζ = ζ∂
+        // whatever orientation the embedded edges got.
+        let v = Vertices::from_points(&[[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]]).unwrap();
+        let k = Complex::build(v, TopCells::simplices([[0, 1], [1, 2]])).unwrap();
+        let (fine, r) = divide_midpoint(&k, &[0, 1]).unwrap();
+        assert_eq!(fine.cell_counts(), vec![5, 4]);
+        assert!(commutes(&k, &fine, &r));
+        assert_eq!(fine.measure(1), &[0.5, 0.5, 0.5, 0.5]);
+        // Every piece has a parent (no new edges): 0, 1 and their halves.
+        let parents: Vec<usize> = (0..4).map(|e| r.parent(1, e).unwrap().0).collect();
+        assert_eq!(parents, vec![0, 1, 0, 1]);
+    }
+
+    #[test]
+    fn midpoint_division_refuses_other_dimensions_and_bad_cells() {
+        let square = crate::generate::rectangle(1, 1, [0.0, 1.0], [0.0, 1.0]).unwrap();
+        assert!(divide_midpoint(&square, &[0]).is_err());
+        let k = interval(2, 0.0, 1.0).unwrap();
+        assert!(matches!(
+            divide_midpoint(&k, &[2]),
+            Err(SplitError::CellOutOfRange {
+                p: 1,
+                cell: 2,
+                count: 2
+            })
+        ));
+        // Nothing listed: the same filament and the identity map.
+        let (same, r) = divide_midpoint(&k, &[]).unwrap();
+        assert_eq!(same.cell_counts(), k.cell_counts());
+        assert_eq!(r, Refinement::identity(&k));
+    }
 }

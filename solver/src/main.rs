@@ -296,6 +296,13 @@ fn describe_problem(case: &Case) -> String {
             }
             None => "transport, method fv, upwind, steady".to_string(),
         },
+        Problem::Growth(g) => format!(
+            "growth, {}, {} steps of dt = {}, divide above {}",
+            g.method.name(),
+            g.time.steps,
+            g.time.dt,
+            g.divide_above
+        ),
         Problem::Coupled(c) => format!(
             "coupled fields {} ({}) and {} ({})",
             c.fields[0].name,
@@ -387,7 +394,25 @@ fn run_case(
     let mut stream = (writing && case.output.partial).then(|| run::LevelStream::new(&case, &stem));
     // With a [refine] table the case is solved, refined and re-solved; the
     // output holds every level, each on its own mesh.
+    // A growing tissue changes its mesh at every step: the output holds
+    // every saved level, each on its own mesh.
+    let mut grown = None;
     let (refined, study, result) = match &case.refine {
+        None if matches!(
+            case.problem,
+            hasse_solver::frontend::case::Problem::Growth(_)
+        ) =>
+        {
+            match run::growth::grow_case(&case, &complex, &mut |name| progress.phase(name)) {
+                Ok(growth) => {
+                    let result = Ok(growth.result.clone());
+                    let last = growth.complex.clone();
+                    grown = Some(growth);
+                    (Some(last), None, result)
+                }
+                Err(e) => (None, None, Err(e)),
+            }
+        }
         None => {
             let result = run::solve_streaming(&case, &complex, stream.as_mut(), &mut |name| {
                 progress.phase(name)
@@ -455,6 +480,16 @@ fn run_case(
                     Ok(files)
                 })
             }
+            (None, _) if grown.is_some() => match &grown {
+                Some(growth) => {
+                    run::growth::write_series(&case, growth, result.report_json(complex), &stem)
+                        .and_then(|files| {
+                            hasse_solver::frontend::output::remove_partial(&stem)?;
+                            Ok(files)
+                        })
+                }
+                None => run::write_output(&case, complex, &result, &stem),
+            },
             (None, Some(stream)) => stream.finish(complex, &mut result),
             (None, None) => run::write_output(&case, complex, &result, &stem),
         };

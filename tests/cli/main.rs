@@ -33,6 +33,7 @@ mod distributed;
 mod doc_commands;
 mod form_poisson;
 mod fuzz_regressions;
+mod growth;
 mod heat_solvers;
 mod hodge;
 mod hodge_decomposition;

@@ -52,6 +52,8 @@
 //! assert!(fine < coarse / 8.0); // two halvings of h, second order
 //! ```
 
+pub mod growth;
+
 use crate::la::iterative::CgOptions;
 use crate::metric::Location;
 use crate::multigrid::{Hierarchy, MultigridOptions};

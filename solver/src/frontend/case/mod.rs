@@ -36,6 +36,7 @@ mod dec_spec;
 pub mod diagnostic;
 mod elasticity_spec;
 pub mod expr;
+mod growth_spec;
 mod hodge_spec;
 mod mesh_checks;
 mod problem;
@@ -46,6 +47,7 @@ mod transport_spec;
 pub use dec_spec::{CohomologySpec, DecompositionSpec, FormDiffusionSpec};
 pub use diagnostic::{Diagnostic, Diagnostics};
 pub use elasticity_spec::{ElasticBoundaryKind, ElasticBoundarySpec, ElasticitySpec, MaterialSpec};
+pub use growth_spec::GrowthSpec;
 pub use hodge_spec::{HodgeMethod, HodgeSpec};
 pub use problem::*;
 pub use quantity::{ProbeSpec, QuantityKind, QuantitySpec};
@@ -514,6 +516,7 @@ impl Case {
             Problem::Diffusion(d) => Some(d.method),
             Problem::Heat(h) => Some(h.method),
             Problem::Transport(t) => Some(t.method),
+            Problem::Growth(g) => Some(g.method),
             Problem::Gradient(_)
             | Problem::Darcy(_)
             | Problem::Maxwell(_)

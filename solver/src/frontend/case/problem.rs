@@ -582,6 +582,8 @@ pub enum Problem {
     Coupled(Box<CoupledSpec>),
     /// `kind = "transport"`.
     Transport(super::TransportSpec),
+    /// `kind = "growth"`.
+    Growth(super::GrowthSpec),
 }
 
 impl Problem {
@@ -599,6 +601,7 @@ impl Problem {
             Problem::Elasticity(_) => "elasticity",
             Problem::Coupled(_) => "coupled",
             Problem::Transport(_) => "transport",
+            Problem::Growth(_) => "growth",
         }
     }
 
@@ -609,6 +612,7 @@ impl Problem {
             Problem::Heat(h) => &h.boundary,
             Problem::Darcy(d) => &d.boundary,
             Problem::Transport(t) => &t.boundary,
+            Problem::Growth(g) => &g.boundary,
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
@@ -650,6 +654,7 @@ impl Problem {
             Problem::Heat(h) => Some(&h.conductivity),
             Problem::Darcy(d) => Some(&d.permeability),
             Problem::Transport(t) => t.conductivity.as_ref(),
+            Problem::Growth(g) => Some(&g.conductivity),
             Problem::Gradient(_)
             | Problem::Maxwell(_)
             | Problem::Hodge(_)
@@ -673,6 +678,7 @@ impl Problem {
                 .iter()
                 .map(|k| ("problem.conductivity".into(), k))
                 .collect(),
+            Problem::Growth(g) => vec![("problem.conductivity".into(), &g.conductivity)],
             Problem::Coupled(c) => c
                 .fields
                 .iter()
@@ -712,6 +718,7 @@ impl Problem {
         match self {
             Problem::Diffusion(d) => diffusion(&mut all, "problem", &d.conductivity, &d.source),
             Problem::Heat(h) => diffusion(&mut all, "problem", &h.conductivity, &h.source),
+            Problem::Growth(g) => diffusion(&mut all, "problem", &g.conductivity, &g.source),
             Problem::Transport(t) => {
                 if let Some(e) = t
                     .conductivity

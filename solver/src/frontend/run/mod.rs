@@ -54,6 +54,7 @@ mod elasticity;
 mod error;
 mod form_diffusion;
 mod gradient;
+pub mod growth;
 mod heat;
 mod hodge;
 mod maxwell;
@@ -177,6 +178,7 @@ pub fn solve(
         Problem::Elasticity(spec) => elasticity::solve(case, spec, complex, phase),
         Problem::Coupled(spec) => coupled::solve(case, spec, complex, phase),
         Problem::Transport(spec) => transport::solve(case, spec, complex, phase),
+        Problem::Growth(_) => growth::solve(case, complex, phase),
     }?;
     if let Some(k) = probes::form_degree(&case.problem) {
         probes::attach_form_probes(case, complex, k, &mut result)?;
@@ -214,6 +216,7 @@ pub fn check_data(case: &Case, complex: &Complex) -> Result<(), RunError> {
         Problem::Elasticity(spec) => elasticity::check(case, spec, complex),
         Problem::Coupled(spec) => coupled::check(case, spec, complex),
         Problem::Transport(spec) => transport::check(case, spec, complex),
+        Problem::Growth(spec) => growth::check(case, spec, complex),
     }
 }
 

@@ -131,13 +131,23 @@ impl Reader {
                 );
             }
         }
-        if kind != "heat" && kind != "transport" {
+        if kind != "growth" {
+            if let Some((k, _)) = root.get_key_value("growth") {
+                self.error(
+                    k.span(),
+                    "growth",
+                    format!("[growth] is for kind = \"growth\"; this problem is {kind}"),
+                    Some("remove [growth], or set problem.kind = \"growth\"".into()),
+                );
+            }
+        }
+        if !["heat", "transport", "growth"].contains(&kind) {
             if let Some((k, _)) = root.get_key_value("time") {
                 self.error(
                     k.span(),
                     "time",
                     format!(
-                        "[time] is for kind = \"heat\" or \"transport\"; this problem is {kind}"
+                        "[time] is for kind = \"heat\", \"transport\" or \"growth\"; this problem is {kind}"
                     ),
                     Some("remove [time], or set problem.kind = \"heat\"".into()),
                 );

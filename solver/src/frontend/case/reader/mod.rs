@@ -23,6 +23,7 @@ mod coefficient;
 mod coupled;
 mod dec;
 mod elasticity;
+mod growth;
 mod hodge;
 mod kinds;
 mod overrides;
@@ -52,6 +53,7 @@ pub(super) const TOP_KEYS: &[&str] = &[
     "refine",
     "time",
     "field",
+    "growth",
 ];
 pub(super) const PROBLEM_KEYS: &[&str] = &[
     "kind",
@@ -84,6 +86,7 @@ pub(super) const PROBLEM_KEYS: &[&str] = &[
     "stabilisation",
     "stars",
     "cochain",
+    "decay",
 ];
 /// The `problem` keys each kind takes (besides `kind`).
 pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
@@ -121,6 +124,10 @@ pub(super) const KIND_KEYS: &[(&str, &[&str])] = &[
         &["lambda", "mu", "young", "poisson", "body_force", "plane"],
     ),
     ("coupled", &["a", "b", "c"]),
+    (
+        "growth",
+        &["method", "conductivity", "source", "initial", "decay"],
+    ),
     (
         "transport",
         &[

@@ -188,6 +188,7 @@ impl Reader {
             "elasticity" => self.elasticity(root, table, problem_entry.span(), scope),
             "coupled" => self.coupled(root, table, problem_entry.span(), scope),
             "transport" => self.transport(root, table, problem_entry.span(), scope),
+            "growth" => self.growth(root, table, problem_entry.span(), scope),
             "gradient" => {
                 if let Some(e) = self.entry(root, "", "boundary") {
                     self.error(
