@@ -402,7 +402,7 @@ impl Scope {
 
     /// Parse `text` against this scope.
     pub fn parse(&self, text: &str) -> Result<Expression, ExprError> {
-        let rewritten = ops::rewrite_conditionals(text)?;
+        let rewritten = ops::rewrite_unary_powers(&ops::rewrite_conditionals(text)?);
         let flat = Flat::parse(&rewritten).map_err(|_| ExprError::Syntax {
             text: text.to_string(),
             message: syntax_problem(text, &self.names()),
@@ -720,5 +720,28 @@ mod tests {
     fn division_by_zero_gives_a_non_finite_value() {
         let e = Scope::new().parse("1 / x").unwrap();
         assert!(!e.eval(&[0.0], 0.0).is_finite());
+    }
+
+    /// A unary minus applies to the whole power, as in mathematics (and
+    /// Python, Fortran, MATLAB): −x² is −(x²), so exp(−x²) decays. exmex
+    /// alone binds the sign first, (−x)².
+    #[test]
+    fn unary_minus_binds_looser_than_powers() {
+        let scope = Scope::new();
+        let at_two = |text: &str| scope.parse(text).unwrap().eval(&[2.0], 0.0);
+        assert_eq!(at_two("-2^2"), -4.0);
+        assert_eq!(at_two("-x^2"), -4.0);
+        assert_eq!(at_two("exp(-x^2)"), (-4.0f64).exp());
+        assert_eq!(at_two("2*-x^2"), -8.0);
+        assert_eq!(at_two("-(x)^2"), -4.0);
+        assert_eq!(at_two("-sin(x)^2"), -(2.0f64.sin().powi(2)));
+        assert_eq!(at_two("-2^-2"), -0.25);
+        assert_eq!(at_two("(-x)^2"), 4.0);
+        // Unchanged: signs in exponents, products, binary minus.
+        assert_eq!(at_two("2^-x"), 0.25);
+        assert_eq!(at_two("-x*3"), -6.0);
+        assert_eq!(at_two("3 - x^2"), -1.0);
+        assert_eq!(at_two("-1e-1^2"), -(0.1f64.powi(2)));
+        assert_eq!(at_two("if(x > 1, -x^2, 0)"), -4.0);
     }
 }

@@ -154,3 +154,130 @@ pub(crate) fn rewrite_conditionals(text: &str) -> Result<String, ExprError> {
     }
     Ok(out)
 }
+
+/// `text` with every unary minus whose operand is raised to a power
+/// wrapped around the whole power: `-x^2` becomes `-(x^2)`. exmex binds a
+/// unary operator before any binary one, so it would read (−x)², which no
+/// mathematical reader means (exp(−x²) would grow). Signs in exponents
+/// (`2^-x`), before products (`-x*3`) and binary minus are left alone.
+pub(crate) fn rewrite_unary_powers(text: &str) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let mut out = String::with_capacity(text.len() + 8);
+    // The last character that is not white space: a minus after an
+    // operator, a bracket or a comma (or first) is unary.
+    let mut previous: Option<char> = None;
+    let mut i = 0;
+    while i < chars.len() {
+        let c = chars[i];
+        let unary = previous.is_none_or(|p| "(,+-*/^<>=&|!".contains(p));
+        if c == '-' && unary {
+            if let Some(end) = power_end(&chars, i + 1) {
+                let inner: String = chars[i + 1..end].iter().collect();
+                out.push_str("-(");
+                out.push_str(&rewrite_unary_powers(&inner));
+                out.push(')');
+                previous = Some(')');
+                i = end;
+                continue;
+            }
+        }
+        out.push(c);
+        if !c.is_whitespace() {
+            previous = Some(c);
+        }
+        i += 1;
+    }
+    out
+}
+
+/// Where the power that starts at `start` ends (an operand followed by one
+/// or more `^ operand`), or `None` when the operand is not raised to a
+/// power.
+fn power_end(chars: &[char], start: usize) -> Option<usize> {
+    let mut end = operand_end(chars, start)?;
+    let mut powered = false;
+    loop {
+        let mut k = skip_spaces(chars, end);
+        if chars.get(k) != Some(&'^') {
+            break;
+        }
+        k = skip_spaces(chars, k + 1);
+        while chars.get(k).is_some_and(|&c| c == '-' || c == '+') {
+            k = skip_spaces(chars, k + 1);
+        }
+        end = operand_end(chars, k)?;
+        powered = true;
+    }
+    powered.then_some(end)
+}
+
+fn skip_spaces(chars: &[char], mut k: usize) -> usize {
+    while chars.get(k).is_some_and(|c| c.is_whitespace()) {
+        k += 1;
+    }
+    k
+}
+
+/// The end of the operand at `start` (after white space): a bracketed
+/// group, a number, or a name with its call's brackets.
+fn operand_end(chars: &[char], start: usize) -> Option<usize> {
+    let k = skip_spaces(chars, start);
+    let group_end = |open: usize| -> Option<usize> {
+        let mut depth = 0usize;
+        for (j, &c) in chars.iter().enumerate().skip(open) {
+            match c {
+                '(' => depth += 1,
+                ')' => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return Some(j + 1);
+                    }
+                }
+                _ => {}
+            }
+        }
+        None
+    };
+    let c = *chars.get(k)?;
+    if c == '(' {
+        return group_end(k);
+    }
+    if c.is_ascii_digit() || c == '.' {
+        let mut j = k;
+        while chars
+            .get(j)
+            .is_some_and(|c| c.is_ascii_digit() || *c == '.')
+        {
+            j += 1;
+        }
+        // An exponent: e, an optional sign, digits.
+        if chars.get(j).is_some_and(|c| *c == 'e' || *c == 'E') {
+            let mut m = j + 1;
+            if chars.get(m).is_some_and(|c| *c == '-' || *c == '+') {
+                m += 1;
+            }
+            if chars.get(m).is_some_and(|c| c.is_ascii_digit()) {
+                j = m;
+                while chars.get(j).is_some_and(|c| c.is_ascii_digit()) {
+                    j += 1;
+                }
+            }
+        }
+        return Some(j);
+    }
+    if c.is_alphabetic() || c == '_' {
+        let mut j = k;
+        while chars
+            .get(j)
+            .is_some_and(|c| c.is_alphanumeric() || *c == '_')
+        {
+            j += 1;
+        }
+        let call = skip_spaces(chars, j);
+        if chars.get(call) == Some(&'(') {
+            return group_end(call);
+        }
+        return Some(j);
+    }
+    None
+}
