@@ -3,13 +3,13 @@
 //! own mesh (a series that ParaView plays), and a per-level summary of
 //! cells, χ, mass and the mass balance.
 
-use super::heat::time_fn;
-use super::{conductivity, diffusion_error, scalar_fn, Keys, RunError, RunResult};
-use crate::frontend::case::{BoundaryKindSpec, Case, GrowthSpec, Problem};
+use super::heat::{time_fn, with_boundaries};
+use super::{conductivity, diffusion_error, Keys, RunError, RunResult};
+use crate::frontend::case::{Case, GrowthSpec, Problem};
 use crate::frontend::output::{
     Cochain, MeshStep, OutputError, OutputFiles, Provenance, SeriesOutput,
 };
-use crate::physics::heat::{Heat, HeatBoundary, SpaceTimeFn};
+use crate::physics::heat::{Heat, SpaceTimeFn};
 use crate::refine::growth::{Growth, GrowthError, GrowthStep, Tissue};
 use hasse_complex::Complex;
 use std::sync::Arc;
@@ -34,17 +34,7 @@ fn growth_problem(case: &Case, spec: &GrowthSpec, dim: usize) -> Growth {
     let mut heat = Heat::new(spec.method, conductivity(&spec.conductivity), spec.time.dt)
         .with_source(time_fn(&spec.source));
     heat.start = spec.time.start;
-    for b in &spec.boundary {
-        let kind = match &b.kind {
-            BoundaryKindSpec::Dirichlet(v) => HeatBoundary::Dirichlet(time_fn(v)),
-            BoundaryKindSpec::Neumann(v) => HeatBoundary::Neumann(time_fn(v)),
-            BoundaryKindSpec::Robin { alpha, value } => HeatBoundary::Robin {
-                alpha: scalar_fn(alpha),
-                value: time_fn(value),
-            },
-        };
-        heat = heat.with_boundary(&b.tag, kind);
-    }
+    heat = with_boundaries(heat, &spec.boundary);
     heat.ordering = case.solver.ordering;
     let velocity: Vec<SpaceTimeFn> = spec
         .velocity

@@ -4,7 +4,7 @@
 
 use super::{conductivity, diffusion_error, scalar_fn, Keys, LevelStream, RunError, RunResult};
 use crate::frontend::case::expr::Expression;
-use crate::frontend::case::{BoundaryKindSpec, Case, HeatSpec};
+use crate::frontend::case::{BoundaryKindSpec, BoundarySpec, Case, HeatSpec};
 use crate::frontend::output::Cochain;
 use crate::metric::mass::lumped_vertex_volumes;
 use crate::physics::diffusion::Errors;
@@ -26,6 +26,22 @@ pub(super) fn time_fn(e: &Expression) -> TimeFn {
     }
 }
 
+/// `heat` with the case's boundary conditions, data in time.
+pub(super) fn with_boundaries(mut heat: Heat, boundary: &[BoundarySpec]) -> Heat {
+    for b in boundary {
+        let kind = match &b.kind {
+            BoundaryKindSpec::Dirichlet(v) => HeatBoundary::Dirichlet(time_fn(v)),
+            BoundaryKindSpec::Neumann(v) => HeatBoundary::Neumann(time_fn(v)),
+            BoundaryKindSpec::Robin { alpha, value } => HeatBoundary::Robin {
+                alpha: scalar_fn(alpha),
+                value: time_fn(value),
+            },
+        };
+        heat = heat.with_boundary(&b.tag, kind);
+    }
+    heat
+}
+
 fn heat_problem(case: &Case, spec: &HeatSpec) -> Heat {
     let mut heat = Heat::new(spec.method, conductivity(&spec.conductivity), spec.time.dt)
         .with_theta(spec.time.theta)
@@ -41,17 +57,7 @@ fn heat_problem(case: &Case, spec: &HeatSpec) -> Heat {
         ));
     }
     heat.start = spec.time.start;
-    for b in &spec.boundary {
-        let kind = match &b.kind {
-            BoundaryKindSpec::Dirichlet(v) => HeatBoundary::Dirichlet(time_fn(v)),
-            BoundaryKindSpec::Neumann(v) => HeatBoundary::Neumann(time_fn(v)),
-            BoundaryKindSpec::Robin { alpha, value } => HeatBoundary::Robin {
-                alpha: scalar_fn(alpha),
-                value: time_fn(value),
-            },
-        };
-        heat = heat.with_boundary(&b.tag, kind);
-    }
+    heat = with_boundaries(heat, &spec.boundary);
     if let Some(f) = case.solver.factorization {
         heat.factorization = f;
     }
