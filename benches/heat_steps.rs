@@ -1,6 +1,7 @@
 //! Transient heat steps: the direct path (one factorisation of M/Δt + θK,
 //! then two triangular solves a step) against multigrid-preconditioned CG
-//! started from the previous level, on the same grid in the same run.
+//! started from the previous levels (Fischer's projection, and the linear
+//! extrapolation it replaced), on the same grid in the same run.
 //!
 //! FV (cell-centred) on the unit square or cube with u = 0 on the boundary,
 //! from sin(πx) sin(πy) (sin(πz)), steady data, backward Euler, Δt = 10⁻⁴,
@@ -11,6 +12,9 @@
 //! - `cargo bench --bench heat_steps -- full` — 500² (2.5·10⁵ unknowns),
 //!   200 steps; target: multigrid per step ≤ 0.5× the direct path's
 //!   triangular solves of the same system.
+//! - `-- forced` (with or without `full`): the same with a source that
+//!   circles the centre (a hot spot, one turn every 200 steps), so that
+//!   the levels do not stay in a few modes as the decaying sines do.
 //! - `cargo bench --bench heat_steps -- 3d` — the 100³ box (10⁶ unknowns,
 //!   beyond a factorisation), 50 steps by multigrid; target: time per
 //!   step ≤ 0.3× one cold steady multigrid solve (setup + solve) of the
@@ -44,6 +48,15 @@ fn heat() -> Heat {
     )
 }
 
+/// A hot spot circling the centre once every 200 steps: data that keep
+/// changing, so that no span of past levels holds the next one.
+fn circling(x: &[f64], t: f64) -> f64 {
+    let angle = 2.0 * PI * t / (200.0 * DT);
+    let (cx, cy) = (0.5 + 0.25 * angle.cos(), 0.5 + 0.25 * angle.sin());
+    let r2 = (x[0] - cx).powi(2) + (x[1] - cy).powi(2);
+    100.0 * (-r2 / 0.01).exp()
+}
+
 fn sines(x: &[f64]) -> f64 {
     x.iter().map(|&xi| (PI * xi).sin()).product()
 }
@@ -68,18 +81,47 @@ fn print(name: &str, history: &History, total: f64) {
     );
 }
 
-fn square(n: usize, steps: usize) {
-    println!("heat_steps: {n}×{n} unit square, FV, {steps} backward-Euler steps, Δt = {DT}");
+fn square(n: usize, steps: usize, forced: bool) {
+    let source = if forced {
+        ", source: a hot spot circling once every 200 steps"
+    } else {
+        ""
+    };
+    println!(
+        "heat_steps: {n}×{n} unit square, FV, {steps} backward-Euler steps, Δt = {DT}{source}"
+    );
+    let heat = || {
+        if forced {
+            heat().with_source(TimeFn::Varying(Arc::new(circling)))
+        } else {
+            heat()
+        }
+    };
     let mesh = rectangle(n, n, [0.0, 1.0], [0.0, 1.0]).expect("grid");
     let (direct, direct_total) = run(&mesh, heat(), steps);
     print("direct LLᵀ", &direct, direct_total);
     let grid = Hierarchy::Grid { cells: vec![n, n] };
-    let (mg, mg_total) = run(
-        &mesh,
-        heat().with_solver(SolverChoice::Multigrid(grid), TOLERANCE, &mesh),
-        steps,
-    );
+    let mut projected = heat().with_solver(SolverChoice::Multigrid(grid), TOLERANCE, &mesh);
+    // HASSE_BENCH_PROJECTION=k keeps k levels instead of the default.
+    if let Some(k) = std::env::var("HASSE_BENCH_PROJECTION")
+        .ok()
+        .and_then(|k| k.parse().ok())
+    {
+        projected.projection = k;
+    }
+    println!("  projection: {} levels", projected.projection);
+    let (mg, mg_total) = run(&mesh, projected, steps);
     print("multigrid-CG", &mg, mg_total);
+    // The start before Fischer's projection, for comparison: uⁿ
+    // extrapolated along the last step.
+    let mut extrapolated = heat().with_solver(
+        SolverChoice::Multigrid(Hierarchy::Grid { cells: vec![n, n] }),
+        TOLERANCE,
+        &mesh,
+    );
+    extrapolated.projection = 0;
+    let (old, old_total) = run(&mesh, extrapolated, steps);
+    print("multigrid-CG, extrapolated start", &old, old_total);
     let difference = direct.fields[1]
         .iter()
         .zip(&mg.fields[1])
@@ -89,6 +131,10 @@ fn square(n: usize, steps: usize) {
         mg.seconds_per_step / direct.solve_seconds_per_step,
         mg.seconds_per_step / direct.seconds_per_step,
         mg.factorization_seconds / direct.factorization_seconds,
+    );
+    println!(
+        "  extrapolated start: step / direct triangular solves = {:.2}",
+        old.seconds_per_step / direct.solve_seconds_per_step,
     );
 }
 
@@ -136,8 +182,8 @@ fn main() {
     } else if has("3d-60") {
         cube(60, 50);
     } else if has("full") {
-        square(500, 200);
+        square(500, 200, has("forced"));
     } else {
-        square(200, 50);
+        square(200, 50, has("forced"));
     }
 }

@@ -646,86 +646,151 @@ pub fn preconditioned_cg(
     options: &CgOptions,
     preconditioner: &dyn Preconditioner,
 ) -> Result<(Vec<f64>, CgReport), CgError> {
+    check_sizes(matrix.nrows(), matrix.ncols(), rhs, initial)?;
+    let n = rhs.len();
+    let mut x = initial.map_or_else(|| vec![0.0; n], <[f64]>::to_vec);
+    let mut work = CgWork::default();
+    let report = preconditioned_cg_in(matrix, rhs, &mut x, options, preconditioner, &mut work)?;
+    Ok((x, report))
+}
+
+/// The vectors of a conjugate-gradient solve, kept between solves of the
+/// same size so that a sequence of solves (the steps of a transient run)
+/// allocates them once. After a solve, [`CgWork::residual`] is its true
+/// residual b − M x.
+///
+/// ```
+/// use hasse_solver::la::iterative::{preconditioned_cg_in, CgOptions, CgWork, Jacobi, RowMatrix};
+/// let m = RowMatrix::from_rows(2, vec![vec![(0, 4.0), (1, 1.0)], vec![(0, 1.0), (1, 3.0)]]).unwrap();
+/// let jacobi = Jacobi::new(&m).unwrap();
+/// let mut work = CgWork::default();
+/// // [4 1; 1 3] x = [1, 2] has x = [1/11, 7/11].
+/// let mut x = vec![0.0; 2];
+/// let report = preconditioned_cg_in(&m, &[1.0, 2.0], &mut x, &CgOptions::default(), &jacobi, &mut work).unwrap();
+/// assert!((x[0] - 1.0 / 11.0).abs() < 1e-12 && (x[1] - 7.0 / 11.0).abs() < 1e-12);
+/// assert!(work.residual().iter().all(|r| r.abs() <= 1e-10 * 5f64.sqrt()));
+/// // Started from the answer, no iteration and no preconditioning is needed.
+/// let again = preconditioned_cg_in(&m, &[1.0, 2.0], &mut x, &CgOptions::default(), &jacobi, &mut work).unwrap();
+/// assert_eq!(again.iterations, 0);
+/// # assert!(report.iterations <= 2);
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct CgWork {
+    r: Vec<f64>,
+    z: Vec<f64>,
+    p: Vec<f64>,
+    product: Vec<f64>,
+}
+
+impl CgWork {
+    /// b − M x of the last solve (empty before any).
+    pub fn residual(&self) -> &[f64] {
+        &self.r
+    }
+
+    fn fit(&mut self, n: usize) {
+        for v in [&mut self.r, &mut self.z, &mut self.p, &mut self.product] {
+            v.resize(n, 0.0);
+        }
+    }
+}
+
+/// [`preconditioned_cg`] in place: `x` holds the initial guess on entry
+/// and the solution on return, and the vectors come from `work` (resized
+/// to the system once, then reused). When the initial guess already meets
+/// the tolerance, nothing more is computed: no preconditioner application
+/// and no second residual.
+pub fn preconditioned_cg_in(
+    matrix: &RowMatrix,
+    rhs: &[f64],
+    x: &mut [f64],
+    options: &CgOptions,
+    preconditioner: &dyn Preconditioner,
+    work: &mut CgWork,
+) -> Result<CgReport, CgError> {
     let started = std::time::Instant::now();
     let n = rhs.len();
-    check_sizes(matrix.nrows(), matrix.ncols(), rhs, initial)?;
+    check_sizes(matrix.nrows(), matrix.ncols(), rhs, Some(x))?;
+    work.fit(n);
+    let CgWork { r, z, p, product } = work;
     let norm_b = dot(rhs, rhs).sqrt();
-    let mut x = initial.map_or_else(|| vec![0.0; n], <[f64]>::to_vec);
     if norm_b == 0.0 {
+        x.iter_mut().for_each(|x| *x = 0.0);
+        r.iter_mut().for_each(|r| *r = 0.0);
         let report = CgReport {
             iterations: 0,
             relative_residual: 0.0,
             initial_residual: 0.0,
             seconds: started.elapsed().as_secs_f64(),
         };
-        return Ok((vec![0.0; n], report));
+        return Ok(report);
     }
-    let mut product = vec![0.0; n];
-    let mut r = vec![0.0; n];
-    matrix.residual(rhs, &x, &mut r);
-    let initial_residual = dot(&r, &r).sqrt() / norm_b;
-    let mut z = vec![0.0; n];
-    preconditioner.apply(&r, &mut z);
-    let mut p = z.clone();
-    let mut rz = dot(&r, &z);
+    matrix.residual(rhs, x, r);
+    let initial_residual = dot(r, r).sqrt() / norm_b;
     let mut iterations = 0;
     let mut residual = initial_residual;
-    while residual > options.tolerance {
-        if iterations == options.max_iterations {
-            return Err(CgError::NotConverged {
-                iterations,
-                relative_residual: residual,
-                tolerance: options.tolerance,
-            });
+    if residual > options.tolerance {
+        preconditioner.apply(r, z);
+        p.copy_from_slice(z);
+        let mut rz = dot(r, z);
+        while residual > options.tolerance {
+            if iterations == options.max_iterations {
+                return Err(CgError::NotConverged {
+                    iterations,
+                    relative_residual: residual,
+                    tolerance: options.tolerance,
+                });
+            }
+            let curvature = matrix.multiply_dot(p, product);
+            if curvature.is_nan() || curvature <= 0.0 {
+                return Err(CgError::Breakdown {
+                    iteration: iterations,
+                    curvature,
+                });
+            }
+            let alpha = rz / curvature;
+            // x += αp, r −= αq and rᵀr in one pass, rᵀr summed as `dot` does.
+            let partial: Vec<f64> = x
+                .par_chunks_mut(DOT_CHUNK)
+                .zip(r.par_chunks_mut(DOT_CHUNK))
+                .zip(p.par_chunks(DOT_CHUNK))
+                .zip(product.par_chunks(DOT_CHUNK))
+                .map(|(((x, r), p), q)| {
+                    x.iter_mut().zip(p).for_each(|(x, p)| *x += alpha * p);
+                    r.iter_mut().zip(q).for_each(|(r, q)| *r -= alpha * q);
+                    r.iter().map(|r| r * r).sum::<f64>()
+                })
+                .collect();
+            let rr: f64 = partial.iter().sum();
+            preconditioner.apply(r, z);
+            let rz_next = dot(r, z);
+            if rz_next.is_nan() || (rz_next <= 0.0 && rr > 0.0) {
+                return Err(CgError::Preconditioner {
+                    iteration: iterations,
+                    value: rz_next,
+                });
+            }
+            let beta = rz_next / rz;
+            rz = rz_next;
+            p.par_iter_mut()
+                .with_min_len(ROW_CHUNK)
+                .zip(&z[..])
+                .for_each(|(p, z)| *p = z + beta * *p);
+            iterations += 1;
+            residual = rr.sqrt() / norm_b;
         }
-        let curvature = matrix.multiply_dot(&p, &mut product);
-        if curvature.is_nan() || curvature <= 0.0 {
-            return Err(CgError::Breakdown {
-                iteration: iterations,
-                curvature,
-            });
-        }
-        let alpha = rz / curvature;
-        // x += αp, r −= αq and rᵀr in one pass, rᵀr summed as `dot` does.
-        let partial: Vec<f64> = x
-            .par_chunks_mut(DOT_CHUNK)
-            .zip(r.par_chunks_mut(DOT_CHUNK))
-            .zip(p.par_chunks(DOT_CHUNK))
-            .zip(product.par_chunks(DOT_CHUNK))
-            .map(|(((x, r), p), q)| {
-                x.iter_mut().zip(p).for_each(|(x, p)| *x += alpha * p);
-                r.iter_mut().zip(q).for_each(|(r, q)| *r -= alpha * q);
-                r.iter().map(|r| r * r).sum::<f64>()
-            })
-            .collect();
-        let rr: f64 = partial.iter().sum();
-        preconditioner.apply(&r, &mut z);
-        let rz_next = dot(&r, &z);
-        if rz_next.is_nan() || (rz_next <= 0.0 && rr > 0.0) {
-            return Err(CgError::Preconditioner {
-                iteration: iterations,
-                value: rz_next,
-            });
-        }
-        let beta = rz_next / rz;
-        rz = rz_next;
-        p.par_iter_mut()
-            .with_min_len(ROW_CHUNK)
-            .zip(&z)
-            .for_each(|(p, z)| *p = z + beta * *p);
-        iterations += 1;
-        residual = rr.sqrt() / norm_b;
+        // The recurrence drifts from the true residual; report the true
+        // one (with no iteration, r is already b − M x as computed).
+        matrix.residual(rhs, x, r);
+        residual = dot(r, r).sqrt() / norm_b;
     }
-    // The recurrence drifts from the true residual; report the true one.
-    matrix.residual(rhs, &x, &mut product);
-    let true_residual = dot(&product, &product).sqrt() / norm_b;
     let report = CgReport {
         iterations,
-        relative_residual: true_residual,
+        relative_residual: residual,
         initial_residual,
         seconds: started.elapsed().as_secs_f64(),
     };
-    Ok((x, report))
+    Ok(report)
 }
 
 #[cfg(test)]
@@ -829,6 +894,50 @@ mod tests {
             conjugate_gradient(&m, &[1.0, 0.0, 1.0], None, &CgOptions::default()).unwrap();
         assert!(x.iter().all(|v| (v - 1.0).abs() < 1e-10));
         assert!(report.iterations <= 3);
+    }
+
+    /// A preconditioner that counts its applications (Jacobi inside).
+    struct Counting(Jacobi, std::sync::atomic::AtomicUsize);
+
+    impl Preconditioner for Counting {
+        fn apply(&self, r: &[f64], z: &mut [f64]) {
+            self.1.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.0.apply(r, z);
+        }
+        fn name(&self) -> &'static str {
+            "counting"
+        }
+    }
+
+    #[test]
+    fn in_place_cg_skips_the_preconditioner_when_the_start_is_converged() {
+        // [4 1; 1 3] x = [1, 2] has x = [1/11, 7/11] (Cramer's rule).
+        let m = RowMatrix::from_rows(2, vec![vec![(0, 4.0), (1, 1.0)], vec![(0, 1.0), (1, 3.0)]])
+            .unwrap();
+        let counting = Counting(Jacobi::new(&m).unwrap(), Default::default());
+        let mut work = CgWork::default();
+        let options = CgOptions::default();
+        // From x = [0.1, 0.6]: r = b − Mx = [1 − 1, 2 − 1.9] = [0, 0.1].
+        let mut x = vec![0.1, 0.6];
+        let report =
+            preconditioned_cg_in(&m, &[1.0, 2.0], &mut x, &options, &counting, &mut work).unwrap();
+        assert!((x[0] - 1.0 / 11.0).abs() < 1e-14 && (x[1] - 7.0 / 11.0).abs() < 1e-14);
+        // One application per iteration plus the first.
+        let applied = counting.1.load(std::sync::atomic::Ordering::Relaxed);
+        assert_eq!(applied, report.iterations + 1);
+        assert!((report.initial_residual - 0.1 / 5f64.sqrt()).abs() < 1e-15);
+        // Started from the answer: the residual check alone, no application.
+        let mut exact = vec![1.0 / 11.0, 7.0 / 11.0];
+        let again =
+            preconditioned_cg_in(&m, &[1.0, 2.0], &mut exact, &options, &counting, &mut work)
+                .unwrap();
+        assert_eq!(again.iterations, 0);
+        assert_eq!(
+            counting.1.load(std::sync::atomic::Ordering::Relaxed),
+            applied
+        );
+        // The kept residual is b − Mx of the answer: rounding of values ≤ 3.
+        assert!(work.residual().iter().all(|r| r.abs() < 1e-15));
     }
 
     #[test]

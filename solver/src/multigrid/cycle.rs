@@ -6,7 +6,8 @@ use super::aggregation::{aggregate, smooth_prolongation, Strength};
 use super::transfer::{Prolongation, Transfer};
 use super::{check_options, CellProlongation, MultigridError, MultigridOptions, Smoother};
 use crate::la::iterative::{
-    dot, preconditioned_cg, CgOptions, CgReport, Preconditioner, RowMatrix, DOT_CHUNK,
+    dot, preconditioned_cg, preconditioned_cg_in, CgOptions, CgReport, CgWork, Preconditioner,
+    RowMatrix, DOT_CHUNK,
 };
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::sparse::linalg::cholesky::{
@@ -471,6 +472,26 @@ impl Multigrid {
             initial,
             options,
             self,
+        )?)
+    }
+
+    /// [`solve`](Self::solve) in place with kept vectors (see
+    /// [`preconditioned_cg_in`]): `x` holds the initial guess on entry and
+    /// the solution on return.
+    pub fn solve_in(
+        &self,
+        rhs: &[f64],
+        x: &mut [f64],
+        options: &CgOptions,
+        work: &mut CgWork,
+    ) -> Result<CgReport, MultigridError> {
+        Ok(preconditioned_cg_in(
+            self.matrix(),
+            rhs,
+            x,
+            options,
+            self,
+            work,
         )?)
     }
 

@@ -17,6 +17,7 @@
 //! order, L-stable), θ = ½ Crank–Nicolson (second order, A-stable).
 
 mod balance;
+mod projection;
 mod stepping;
 mod system;
 #[cfg(test)]
@@ -353,10 +354,19 @@ pub struct Heat {
     /// Its fill-reducing ordering (default automatic).
     pub ordering: Ordering,
     /// Conjugate gradients instead of a factorisation, started at every
-    /// step from the previous level (see [`Heat::with_solver`]).
+    /// step from the previous levels (see [`Heat::with_solver`] and
+    /// [`Heat::projection`]).
     pub iterative: Option<Iterative>,
     /// Adaptive step sizes instead of the constant `dt`.
     pub adaptive: Option<Adaptive>,
+    /// Where the conjugate gradients of an iterative run start: with
+    /// `projection` = k ≥ 1, the field closest to the new level in the
+    /// energy norm of M/Δt + θK among the combinations of the last levels
+    /// of the same step size (Fischer's projection, at most k of them,
+    /// restarting from the newest when full); with 0, uⁿ extrapolated
+    /// linearly along the last step. Default [`Heat::PROJECTION`]. The
+    /// tolerance is the same either way; only the iterations differ.
+    pub projection: usize,
 }
 
 /// The computed time levels and how long they took.
@@ -458,15 +468,21 @@ impl Heat {
             ordering: Ordering::Automatic,
             iterative: None,
             adaptive: None,
+            projection: Self::PROJECTION,
         }
     }
+
+    /// The default [`Heat::projection`]: levels kept for the start of
+    /// iterative steps.
+    pub const PROJECTION: usize = 8;
 
     /// Choose how every step's system M/Δt + θK is solved, as
     /// [`Diffusion::with_solver`] does for a steady problem:
     /// [`SolverChoice::Direct`] factorises it once (per step size),
     /// [`SolverChoice::Multigrid`] builds a multigrid preconditioner once
     /// and runs conjugate gradients to `tolerance` at every step, started
-    /// from the previous level, [`SolverChoice::Auto`] applies
+    /// from the previous levels (see [`Heat::projection`]),
+    /// [`SolverChoice::Auto`] applies
     /// [`crate::multigrid::automatic`] to this method's unknowns on `complex`.
     ///
     /// ```

@@ -1,10 +1,11 @@
 //! The time loop of the θ-scheme: constant steps, or adaptive steps chosen
 //! by an embedded estimate of the local error (see [`Adaptive`]).
 
+use super::projection::Projection;
 use super::system::{StepFailure, StepSolver, StepSystem};
 use super::{Adaptive, AdaptiveReport, Heat, HeatError, HeatEvent, History, StepIterations};
 use crate::la::fixed::FixedSplit;
-use crate::la::iterative::RowMatrix;
+use crate::la::iterative::{CgWork, RowMatrix};
 use crate::metric::Location;
 use crate::operator::{BlockMetric, Canonical};
 use crate::physics::Datum;
@@ -166,6 +167,18 @@ impl Heat {
         let mut fixed_new: Vec<Option<f64>> = first.fixed.clone();
         let mut rhs = vec![0.0; free.len()];
         let mut ku = vec![0.0; unknowns];
+        // The vectors of every step, allocated once: the solution on the
+        // free unknowns (the iterative start on entry to the solve), the
+        // next level, the solve's own vectors.
+        let mut x = vec![0.0; free.len()];
+        let mut u_next = u.clone();
+        let mut cg_work = CgWork::default();
+        // Fischer's projection start for iterative steps (see the
+        // projection module), unless `projection` is 0.
+        let mut projection = match &self.iterative {
+            Some(_) if self.projection > 0 => Some(Projection::new(self.projection)),
+            _ => None,
+        };
         let mut solve_seconds = 0.0;
         let mut iterations = StepIterations::default();
         let mut controller = match self.adaptive {
@@ -181,8 +194,13 @@ impl Heat {
         let mut t = t0;
         let mut step = 0;
         // The last step's size and its starting level on the free
-        // unknowns, for the iterative solver's initial guess.
+        // unknowns, for the extrapolated start of iterative steps (when
+        // the projection is off).
         let mut previous: Option<(f64, Vec<f64>)> = None;
+        // K uⁿ enters the right-hand side with the factor 1 − θ and the
+        // error estimate of adaptive steps: backward Euler at constant
+        // steps needs no product.
+        let needs_ku = theta != 1.0 || controller.is_some();
         loop {
             // The step size and the time it reaches.
             let (mut h, mut t_new) = match &controller {
@@ -191,28 +209,17 @@ impl Heat {
                 Some(_) if t >= end - 1e-12 * end.abs().max(dt) => break,
                 Some(c) => c.step_to(t, end),
             };
-            stiffness.multiply(&u, &mut ku);
+            if needs_ku {
+                stiffness.multiply(&u, &mut ku);
+            }
             // uⁿ' = M⁻¹(bⁿ − K uⁿ) on the free unknowns, for the error
             // estimate of adaptive steps.
             let derivative: Vec<f64> = match &controller {
                 Some(_) => free.iter().map(|&i| (b_old[i] - ku[i]) / mass[i]).collect(),
                 None => Vec::new(),
             };
-            // Where CG starts: uⁿ extrapolated along the last step,
-            // uⁿ + (h/h_prev)(uⁿ − uⁿ⁻¹), whose error is O(h²) where uⁿ's
-            // is O(h); the first step starts from u⁰.
-            let guess: Vec<f64> = match &previous {
-                Some((h_prev, u_prev)) if self.iterative.is_some() => {
-                    let r = h / h_prev;
-                    free.iter()
-                        .zip(u_prev)
-                        .map(|(&i, p)| u[i] + r * (u[i] - p))
-                        .collect()
-                }
-                _ => free.iter().map(|&i| u[i]).collect(),
-            };
             // Tried until the step is accepted (always, at constant Δt).
-            let u_new = loop {
+            loop {
                 if vary {
                     // Only the data change: Ω, M and the boundary layout are kept.
                     let (rhs, fixed) = self.at(t_new).data(complex, &first)?;
@@ -264,9 +271,35 @@ impl Heat {
                 if rhs.iter().any(|v| !v.is_finite()) {
                     return Err(overflow(&rhs));
                 }
+                // Where CG starts. With the projection: the level closest
+                // to the answer in the energy norm within the span of the
+                // last levels of this step size (uⁿ alone, its product
+                // formed once, when the span is new). Without: uⁿ
+                // extrapolated along the last step, uⁿ + (h/h_prev)(uⁿ −
+                // uⁿ⁻¹), whose error is O(h²) where uⁿ's is O(h); the
+                // first step starts from u⁰. A direct solve reads no start.
+                let multiply = |v: &[f64], y: &mut [f64]| {
+                    system.multiply(v, y);
+                };
+                match (&mut projection, &previous) {
+                    (Some(p), _) => {
+                        if !p.for_step(h) {
+                            free.iter().zip(x.iter_mut()).for_each(|(&i, x)| *x = u[i]);
+                            p.add(&x, &[], &[], &multiply);
+                        }
+                        p.guess(&rhs, &mut x);
+                    }
+                    (None, Some((h_prev, u_prev))) if self.iterative.is_some() => {
+                        let r = h / h_prev;
+                        for ((x, &i), p) in x.iter_mut().zip(&free).zip(u_prev) {
+                            *x = u[i] + r * (u[i] - p);
+                        }
+                    }
+                    _ => free.iter().zip(x.iter_mut()).for_each(|(&i, x)| *x = u[i]),
+                }
                 let solving = Instant::now();
-                let (x, taken) = match system.solve(&rhs, &guess, cg_options.as_ref()) {
-                    Ok(solved) => solved,
+                let taken = match system.solve(&rhs, &mut x, cg_options.as_ref(), &mut cg_work) {
+                    Ok(taken) => taken,
                     Err(StepFailure::Overflow) => return Err(overflow(&rhs)),
                     Err(StepFailure::Error(e)) => return Err(e),
                 };
@@ -274,29 +307,41 @@ impl Heat {
                 if let Some(taken) = taken {
                     iterations.add(taken);
                 }
-                let mut u_new = u.clone();
+                // A start that needed no iteration is the level, and it
+                // lies in the span already: nothing to add.
+                if let (Some(p), Some(1..)) = (projection.as_mut(), taken) {
+                    p.add(&x, &rhs, cg_work.residual(), &multiply);
+                }
+                u_next.copy_from_slice(&u);
                 for (k, &i) in free.iter().enumerate() {
-                    u_new[i] = x[k];
+                    u_next[i] = x[k];
                 }
                 for (i, g) in fixed_new.iter().enumerate() {
                     if let Some(g) = g {
-                        u_new[i] = *g;
+                        u_next[i] = *g;
                     }
                 }
                 let Some(c) = controller.as_mut() else {
-                    break u_new;
+                    break;
                 };
-                let estimate = c.estimate(h, &free, &u, &u_new, &derivative);
+                let estimate = c.estimate(h, &free, &u, &u_next, &derivative);
                 if c.accept(estimate, t_new)? {
                     c.record(h, estimate, derivative);
-                    break u_new;
+                    break;
                 }
                 (h, t_new) = c.step_to(t, end);
-            };
-            let u_old = std::mem::replace(&mut u, u_new);
+            }
+            // u becomes uⁿ⁺¹ and u_next keeps uⁿ until the next step
+            // overwrites it.
+            std::mem::swap(&mut u, &mut u_next);
+            let u_old = &u_next;
             let t_old = std::mem::replace(&mut t, t_new);
-            if self.iterative.is_some() {
-                previous = Some((h, free.iter().map(|&i| u_old[i]).collect()));
+            if self.iterative.is_some() && projection.is_none() {
+                let kept = previous.get_or_insert_with(|| (h, vec![0.0; free.len()]));
+                kept.0 = h;
+                for (p, &i) in kept.1.iter_mut().zip(&free) {
+                    *p = u_old[i];
+                }
             }
             step += 1;
             if vary {
@@ -312,7 +357,7 @@ impl Heat {
                     index: times.len(),
                     time: t,
                     field: &u,
-                    previous: Some((t_old, &u_old)),
+                    previous: Some((t_old, u_old)),
                 });
                 excluded_seconds += observing.elapsed().as_secs_f64();
                 times.push(t);

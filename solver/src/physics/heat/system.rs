@@ -6,14 +6,14 @@
 //! only; the pattern of L, and with it a direct solver's symbolic
 //! analysis, is the same for every Δt. A direct solve factorises L once
 //! per step size; multigrid builds its levels once per step size and then
-//! starts conjugate gradients from the previous level's field, which is
-//! within O(Δt) of the answer: that warm start is what makes iterative
-//! stepping cheap.
+//! starts conjugate gradients at every step from the previous levels
+//! (projected, see the projection module): that warm start is what makes
+//! iterative stepping cheap. The solve's vectors are kept between steps.
 
 use super::HeatError;
 use crate::la::direct::{DirectSolver, Factor, Factorization, SolveError};
 use crate::la::fixed::FixedSplit;
-use crate::la::iterative::{preconditioned_cg, CgOptions, Jacobi, RowMatrix};
+use crate::la::iterative::{preconditioned_cg_in, CgOptions, CgWork, Jacobi, RowMatrix};
 use crate::la::ordering::Ordering;
 use crate::multigrid::{self, Hierarchy, Multigrid, MultigridOptions};
 use crate::operator::Canonical;
@@ -149,36 +149,53 @@ impl StepSystem {
         FixedSplit::lift_into(&self.lift, fixed, rhs);
     }
 
-    /// Solve L_free x = rhs; `guess` is where an iterative solve starts.
-    /// Returns x and the iterations taken (none for a direct solve).
+    /// Solve L_free x = rhs. For an iterative solve `x` holds the start on
+    /// entry, and `work` keeps the vectors between steps and, after the
+    /// solve, its final residual. Returns the iterations taken (none for a
+    /// direct solve).
     pub(super) fn solve(
         &self,
         rhs: &[f64],
-        guess: &[f64],
+        x: &mut [f64],
         options: Option<&CgOptions>,
-    ) -> Result<(Vec<f64>, Option<usize>), StepFailure> {
+        work: &mut CgWork,
+    ) -> Result<Option<usize>, StepFailure> {
         let options = options.copied().unwrap_or_default();
         match &self.solve {
-            Solve::Nothing => Ok((Vec::new(), None)),
+            Solve::Nothing => Ok(None),
             Solve::Factor(factor) => match factor.solve(rhs) {
-                Ok(x) => Ok((x, None)),
+                Ok(solution) => {
+                    x.copy_from_slice(&solution);
+                    Ok(None)
+                }
                 // The matrix was factorised, so a singular solve means a
                 // non-finite solution: overflow of an unstable scheme.
                 Err(SolveError::Singular { .. }) => Err(StepFailure::Overflow),
                 Err(e) => Err(StepFailure::Error(e.into())),
             },
             Solve::Jacobi(rows, jacobi) => {
-                let (x, report) = preconditioned_cg(rows, rhs, Some(guess), &options, jacobi)
+                let report = preconditioned_cg_in(rows, rhs, x, &options, jacobi, work)
                     .map_err(|e| StepFailure::Error(HeatError::Cg(e)))?;
-                Ok((x, Some(report.iterations)))
+                Ok(Some(report.iterations))
             }
             Solve::Multigrid(mg) => {
-                let (x, report) = mg
-                    .solve(rhs, Some(guess), &options)
+                let report = mg
+                    .solve_in(rhs, x, &options, work)
                     .map_err(|e| StepFailure::Error(HeatError::Multigrid(e)))?;
-                Ok((x, Some(report.iterations)))
+                Ok(Some(report.iterations))
             }
         }
+    }
+
+    /// y = L_free x, for the iterative solvers (which keep L by rows);
+    /// false for a direct or empty system, which keep no rows.
+    pub(super) fn multiply(&self, x: &[f64], y: &mut [f64]) -> bool {
+        match &self.solve {
+            Solve::Jacobi(rows, _) => rows.multiply(x, y),
+            Solve::Multigrid(mg) => mg.matrix().multiply(x, y),
+            Solve::Nothing | Solve::Factor(_) => return false,
+        }
+        true
     }
 }
 
