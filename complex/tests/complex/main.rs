@@ -8,6 +8,7 @@
 //! looks for the `main.rs` above a test source and keeps its seeds in a
 //! `proptest-regressions` directory beside that directory.
 
+mod coarsen;
 mod euler;
 mod generators;
 mod geometry;
