@@ -14,5 +14,6 @@ mod generators;
 mod geometry;
 mod io;
 mod lar_format;
+mod makes;
 mod seeds;
 mod split;
