@@ -175,6 +175,20 @@ pub fn coarsen_traced(
             // Candidate facets N: made by the cut, bounding exactly two
             // p-cells of one label.
             let rows = &state.boundaries[p - 1];
+            let columns = rows.to_csc();
+            // Pieces that share more than this facet cannot merge yet (a
+            // kill would refuse them); telling them apart here keeps a
+            // scan from paying a whole kill for each of them.
+            let shared = |x: usize, y: usize| -> usize {
+                match (columns.outer_view(x), columns.outer_view(y)) {
+                    (Some(a), Some(b)) => a
+                        .indices()
+                        .iter()
+                        .filter(|i| b.indices().binary_search(i).is_ok())
+                        .count(),
+                    _ => 0,
+                }
+            };
             let mut candidates = Vec::new();
             for (facet, row) in rows.outer_iterator().enumerate() {
                 if refinement
@@ -185,7 +199,7 @@ pub fn coarsen_traced(
                 }
                 if let [x, y] = row.indices() {
                     let (x, y) = ((*x).min(*y), (*x).max(*y));
-                    if labels[p][x].is_some() && labels[p][x] == labels[p][y] {
+                    if labels[p][x].is_some() && labels[p][x] == labels[p][y] && shared(x, y) == 1 {
                         candidates.push((x, y));
                     }
                 }
