@@ -14,6 +14,7 @@
 //! ```
 
 pub mod cells;
+pub mod coarsen;
 pub mod complex;
 mod convex_order;
 pub mod dual;

@@ -43,5 +43,6 @@ mod method_warnings;
 mod nonlinear;
 mod probes;
 mod quantities;
+mod refine_coarsen;
 mod regions;
 mod transport;

@@ -48,9 +48,11 @@
 //! ```
 
 mod cut;
+mod makes;
 mod round;
 mod transfer;
 
+pub use makes::{split_by_makes, MadeSplit};
 pub use transfer::Refinement;
 
 use crate::complex::Complex;

@@ -8,10 +8,12 @@
 //! looks for the `main.rs` above a test source and keeps its seeds in a
 //! `proptest-regressions` directory beside that directory.
 
+mod coarsen;
 mod euler;
 mod generators;
 mod geometry;
 mod io;
 mod lar_format;
+mod makes;
 mod seeds;
 mod split;

@@ -61,6 +61,7 @@ use crate::physics::diffusion::{
     self, Diffusion, DiffusionError, Iterative, Preconditioning, Solution,
 };
 use crate::physics::{ScalarFn, VectorFn};
+use hasse_complex::coarsen::{self, Coarsening};
 use hasse_complex::refine;
 use hasse_complex::split::Refinement;
 use hasse_complex::Complex;
@@ -87,21 +88,27 @@ use std::sync::Arc;
 /// assert_eq!(refined(Strategy::Uniform).levels[1].complex.cell_count(2), 64);
 /// assert_eq!(refined(Strategy::DivideLongestAxis).levels[1].complex.cell_count(2), 32);
 /// // Dörfler marking splits only the cells that carry most of the error.
-/// let adaptive = refined(Strategy::Adaptive { theta: 0.3 });
+/// let adaptive = refined(Strategy::Adaptive { theta: 0.3, coarsen: 0.0 });
 /// let marked = adaptive.steps[0].marked.unwrap();
 /// assert!(0 < marked && marked < 16);
-/// assert_eq!(Strategy::Adaptive { theta: 0.3 }.name(), "adaptive");
+/// assert_eq!(Strategy::Adaptive { theta: 0.3, coarsen: 0.0 }.name(), "adaptive");
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Strategy {
     /// Every top cell by the axis-aligned hyperplanes through its centroid.
     Uniform,
     /// The cells holding the fraction θ of the squared error indicator
-    /// (Dörfler marking), each split like a uniform step.
+    /// (Dörfler marking), each split like a uniform step; and, from the
+    /// second step on, the sibling groups of the previous step holding
+    /// the smallest part of it merged back (see [`coarsening_groups`]).
     Adaptive {
         /// θ ∈ (0, 1]: the share of Σ η_c² the marked cells hold; small θ
         /// marks few cells, 1 marks them all.
         theta: f64,
+        /// ∈ [0, 1): at most this share of Σ η_c² is held by the sibling
+        /// groups merged back into their parents each step; 0 never
+        /// coarsens.
+        coarsen: f64,
     },
     /// Every top cell divided once by the plane through its centroid normal
     /// to its longest axis (growing tissue).
@@ -162,6 +169,9 @@ pub struct StepReport {
     pub solver: String,
     /// Cells marked for refinement at the end of this step (adaptive).
     pub marked: Option<usize>,
+    /// Parent cells restored at the end of this step, each from its
+    /// sibling pieces (adaptive with `coarsen` > 0).
+    pub coarsened: Option<usize>,
     /// L² error against the exact solution, when one was given (see
     /// [`diffusion::Errors`]).
     pub l2: Option<f64>,
@@ -244,7 +254,8 @@ fn transfer(
     coarse: &Complex,
     fine: &Complex,
     refinement: &Refinement,
-    solution: &Solution,
+    location: Location,
+    coarse_values: &[f64],
 ) -> Result<Vec<f64>, RefineError> {
     let n = coarse.dim();
     let copy = |p: usize, values: &[f64]| -> Vec<f64> {
@@ -252,13 +263,13 @@ fn transfer(
             .map(|i| refinement.parent(p, i).map_or(f64::NAN, |(j, _)| values[j]))
             .collect()
     };
-    match solution.location {
-        Location::Nodal => refinement.nodal(&solution.values).map_err(input),
-        Location::CellCentred => Ok(copy(n, &solution.values)),
+    match location {
+        Location::Nodal => refinement.nodal(coarse_values).map_err(input),
+        Location::CellCentred => Ok(copy(n, coarse_values)),
         Location::Hybrid => {
             let cells = coarse.cell_count(n);
-            let mut values = copy(n, &solution.values[..cells]);
-            let mut faces = copy(n - 1, &solution.values[cells..]);
+            let mut values = copy(n, &coarse_values[..cells]);
+            let mut faces = copy(n - 1, &coarse_values[cells..]);
             let by_face = fine.boundary(n);
             for (f, row) in by_face.outer_iterator().enumerate() {
                 if faces[f].is_nan() {
@@ -272,6 +283,109 @@ fn transfer(
             Ok(values)
         }
     }
+}
+
+/// Move a solution's unknowns back to the coarsened complex through the
+/// coarsening's chain map: nodal values by injection at the kept
+/// vertices, cell values (and hybrid face values) as the measure-weighted
+/// mean of their pieces. Face values of the hybrid method are traces, not
+/// oriented, so their mean ignores the orientation signs of ζ.
+fn restrict(
+    fine: &Complex,
+    coarsening: &Coarsening,
+    location: Location,
+    values: &[f64],
+) -> Result<Vec<f64>, RefineError> {
+    let n = fine.dim();
+    match location {
+        Location::Nodal => coarsening.restrict_nodal(values).map_err(input),
+        Location::CellCentred => coarsening
+            .restrict_intensive(fine, n, values)
+            .map_err(input),
+        Location::Hybrid => {
+            let cells = fine.cell_count(n);
+            let mut out = coarsening
+                .restrict_intensive(fine, n, &values[..cells])
+                .map_err(input)?;
+            let (_, coarse_counts) = coarsening.counts();
+            let measure = fine.measure(n - 1);
+            let mut sum = vec![0.0; coarse_counts[n - 1]];
+            let mut total = vec![0.0; coarse_counts[n - 1]];
+            for (f, &v) in values[cells..].iter().enumerate() {
+                if let Some((g, _)) = coarsening.coarse_cell(n - 1, f) {
+                    sum[g] += measure[f] * v;
+                    total[g] += measure[f];
+                }
+            }
+            out.extend(sum.iter().zip(&total).map(|(s, t)| s / t));
+            Ok(out)
+        }
+    }
+}
+
+/// Dörfler marking for coarsening: the parents of `refinement` (the last
+/// step's SPLIT) that it cut into two or more pieces, none of them in
+/// `marked` (cells about to be refined), are taken in order of increasing
+/// summed η² of their pieces (ties by parent) as long as the taken groups
+/// hold at most `fraction` of Σ_c η_c² over all cells. Returns the chosen
+/// parents, sorted. Every piece is a leaf: the pieces are top cells of the
+/// complex `refinement` produced.
+///
+/// ```
+/// use hasse_complex::generate::rectangle;
+/// use hasse_complex::refine::refine_marked;
+/// use hasse_solver::refine::coarsening_groups;
+/// let k = rectangle(3, 1, [0.0, 3.0], [0.0, 1.0]).unwrap();
+/// let (fine, r) = refine_marked(&k, &[0, 2]).unwrap();
+/// // Cell 1 was not split; squares 0 and 2 are groups of 4 pieces.
+/// let mut eta = vec![0.0; fine.cell_count(2)];
+/// for c in 0..fine.cell_count(2) {
+///     eta[c] = match r.parent(2, c).unwrap().0 { 0 => 0.1, 1 => 2.0, _ => 0.5 };
+/// }
+/// // Σ η² = 4·0.01 + 4 + 4·0.25 = 5.04; group 0 holds 0.04, group 2 holds 1.
+/// assert_eq!(coarsening_groups(&r, &eta, &[], 0.01), vec![0]);
+/// assert_eq!(coarsening_groups(&r, &eta, &[], 0.007), Vec::<usize>::new());
+/// assert_eq!(coarsening_groups(&r, &eta, &[], 0.25), vec![0, 2]);
+/// ```
+pub fn coarsening_groups(
+    refinement: &Refinement,
+    eta: &[f64],
+    marked: &[usize],
+    fraction: f64,
+) -> Vec<usize> {
+    let n = refinement.dim();
+    let (coarse, _) = refinement.counts();
+    let mut pieces = vec![0usize; coarse[n]];
+    let mut held = vec![0.0; coarse[n]];
+    let mut blocked = vec![false; coarse[n]];
+    for (c, e) in eta.iter().enumerate() {
+        if let Some((q, _)) = refinement.parent(n, c) {
+            pieces[q] += 1;
+            held[q] += e * e;
+        }
+    }
+    for &c in marked {
+        if let Some((q, _)) = refinement.parent(n, c) {
+            blocked[q] = true;
+        }
+    }
+    let total: f64 = eta.iter().map(|e| e * e).sum();
+    let mut order: Vec<usize> = (0..coarse[n])
+        .filter(|&q| pieces[q] >= 2 && !blocked[q])
+        .collect();
+    order.sort_by(|&a, &b| held[a].total_cmp(&held[b]).then(a.cmp(&b)));
+    let budget = fraction * total;
+    let mut acc = 0.0;
+    let mut chosen = Vec::new();
+    for q in order {
+        if acc + held[q] > budget {
+            break;
+        }
+        acc += held[q];
+        chosen.push(q);
+    }
+    chosen.sort_unstable();
+    chosen
 }
 
 /// Residual-type indicator per top cell: η_c² = h_c² |c| f(x_c)² +
@@ -314,28 +428,76 @@ pub fn indicators(
 /// Directions searched for the shortest wall: every 5° in 2D.
 const SHORTEST_WALL_DIRECTIONS: usize = 36;
 
+/// One step's new mesh: `complex` coarsened (adaptive with `coarsen` > 0
+/// and a previous step to undo), then refined.
+struct NewMesh {
+    /// The refined complex and the SPLIT from `coarsened` (or the step's
+    /// starting complex) to it.
+    fine: Complex,
+    refinement: Refinement,
+    /// The coarsened complex and the maps to it from the starting complex.
+    coarsened: Option<(Complex, Coarsening)>,
+    marked: Option<usize>,
+    groups: Option<usize>,
+}
+
 fn refine_once(
     complex: &Complex,
     strategy: Strategy,
     eta: &[f64],
-) -> Result<(Complex, Refinement, Option<usize>), RefineError> {
-    let all: Vec<usize> = (0..complex.cell_count(complex.dim())).collect();
+    last: Option<&Refinement>,
+) -> Result<NewMesh, RefineError> {
+    let n = complex.dim();
+    let all: Vec<usize> = (0..complex.cell_count(n)).collect();
+    let plain = |(fine, refinement): (Complex, Refinement)| NewMesh {
+        fine,
+        refinement,
+        coarsened: None,
+        marked: None,
+        groups: None,
+    };
     match strategy {
-        Strategy::Uniform => refine::uniform(complex).map(|(k, r)| (k, r, None)),
-        Strategy::Adaptive { theta } => {
+        Strategy::Uniform => refine::uniform(complex).map(plain).map_err(input),
+        Strategy::Adaptive { theta, coarsen } => {
             let marked = refine::dorfler_mark(eta, theta).map_err(input)?;
             let count = marked.len();
-            refine::refine_marked(complex, &marked).map(|(k, r)| (k, r, Some(count)))
+            let groups = match last {
+                Some(last) if coarsen > 0.0 => coarsening_groups(last, eta, &marked, coarsen),
+                _ => Vec::new(),
+            };
+            let (Some(last), false) = (last, groups.is_empty()) else {
+                let (fine, refinement) = refine::refine_marked(complex, &marked).map_err(input)?;
+                return Ok(NewMesh {
+                    marked: Some(count),
+                    groups: (coarsen > 0.0).then_some(0),
+                    ..plain((fine, refinement))
+                });
+            };
+            let (coarse, coarsening) = coarsen::coarsen(complex, last, &groups).map_err(input)?;
+            // The marked cells are in no merged group: each is a cell of
+            // the coarsened complex too.
+            let moved: Vec<usize> = marked
+                .iter()
+                .filter_map(|&c| coarsening.coarse_cell(n, c).map(|(k, _)| k))
+                .collect();
+            let (fine, refinement) = refine::refine_marked(&coarse, &moved).map_err(input)?;
+            Ok(NewMesh {
+                fine,
+                refinement,
+                coarsened: Some((coarse, coarsening)),
+                marked: Some(count),
+                groups: Some(groups.len()),
+            })
         }
-        Strategy::DivideLongestAxis => {
-            refine::divide_longest_axis(complex, &all).map(|(k, r)| (k, r, None))
-        }
+        Strategy::DivideLongestAxis => refine::divide_longest_axis(complex, &all)
+            .map(plain)
+            .map_err(input),
         Strategy::DivideShortestWall => {
             refine::divide_shortest_wall(complex, &all, SHORTEST_WALL_DIRECTIONS)
-                .map(|(k, r)| (k, r, None))
+                .map(plain)
+                .map_err(input)
         }
     }
-    .map_err(input)
 }
 
 /// The name of the linear solver `problem` runs.
@@ -373,6 +535,7 @@ fn report(
         estimator: eta.iter().map(|e| e * e).sum::<f64>().sqrt(),
         solver,
         marked: None,
+        coarsened: None,
         l2: errors.map(|e| e.l2),
         max: errors.map(|e| e.max),
         gradient_l2: errors.map(|e| e.gradient_l2).filter(|g| g.is_finite()),
@@ -410,14 +573,39 @@ pub fn refine_and_solve(
     )];
     let mut levels = Vec::new();
     let mut refinements: Vec<Refinement> = Vec::new();
+    // From the initial mesh to the current one, for the hierarchy after a
+    // coarsening.
+    let mut total = Refinement::identity(complex);
     for step in 1..=spec.steps {
         phase(&format!("step {step}: refining ({})", spec.strategy.name()));
         let started = std::time::Instant::now();
-        let (fine, refinement, marked) = refine_once(&current, spec.strategy, &eta)?;
+        let new = refine_once(&current, spec.strategy, &eta, refinements.last())?;
         if let Some(last) = steps.last_mut() {
-            last.marked = marked;
+            last.marked = new.marked;
+            last.coarsened = new.groups;
         }
-        let guess = transfer(&current, &fine, &refinement, &solution)?;
+        let (fine, refinement) = (new.fine, new.refinement);
+        let guess = match &new.coarsened {
+            Some((coarse, coarsening)) => {
+                // Back to the coarsened mesh through the kills' chain map,
+                // then on to the refined one through the SPLIT's. The
+                // coarsened mesh is no refinement of the previous levels,
+                // but still one of the initial mesh: the hierarchy restarts
+                // from there.
+                let back = restrict(&current, coarsening, solution.location, &solution.values)?;
+                total = coarsening.after(&total).map_err(input)?;
+                refinements = vec![total.clone()];
+                transfer(coarse, &fine, &refinement, solution.location, &back)?
+            }
+            None => transfer(
+                &current,
+                &fine,
+                &refinement,
+                solution.location,
+                &solution.values,
+            )?,
+        };
+        total = total.compose(&refinement).map_err(input)?;
         refinements.push(refinement);
         phase(&format!(
             "step {step}: solving on {} cells",
@@ -481,7 +669,7 @@ impl fmt::Display for StepReport {
         let count = |v: Option<usize>| v.map_or("-".to_string(), |x| x.to_string());
         write!(
             f,
-            "{:>4} {:>9} {:>9} {:>11} {:>11} {:>11} {:>11} {:>6} {:>9} {:>9}",
+            "{:>4} {:>9} {:>9} {:>11} {:>11} {:>11} {:>11} {:>6} {:>9} {:>9} {:>9}",
             self.step,
             top,
             self.unknowns,
@@ -493,13 +681,14 @@ impl fmt::Display for StepReport {
             self.start_residual
                 .map_or("-".to_string(), |r| format!("{r:.2e}")),
             count(self.marked),
+            count(self.coarsened),
         )
     }
 }
 
 /// The header matching [`StepReport`]'s `Display`.
 pub const TABLE_HEADER: &str =
-    "step     cells  unknowns   estimator    L2 error   max error  grad error  iters   start r    marked";
+    "step     cells  unknowns   estimator    L2 error   max error  grad error  iters   start r    marked coarsened";
 
 /// Which solver ran which steps, consecutive steps with one solver
 /// grouped: `step 0: sparse LLᵀ (faer); steps 1–8: multigrid-CG, SPLIT
@@ -537,6 +726,7 @@ pub fn steps_json(steps: &[StepReport]) -> serde_json::Value {
                 "estimator": s.estimator,
                 "solver": s.solver,
                 "marked": s.marked,
+                "coarsened": s.coarsened,
                 "l2": s.l2,
                 "max": s.max,
                 "gradient_l2": s.gradient_l2,

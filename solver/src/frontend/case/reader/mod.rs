@@ -169,7 +169,7 @@ pub(super) const OUTPUT_KEYS: &[&str] = &[
     "partial",
     "complex",
 ];
-pub(super) const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "tolerance"];
+pub(super) const REFINE_KEYS: &[&str] = &["strategy", "steps", "theta", "coarsen", "tolerance"];
 pub(super) const STRATEGIES: &[&str] = &[
     "uniform",
     "adaptive",

@@ -491,11 +491,26 @@ impl Reader {
                 );
             }
         }
+        let coarsen = self.number_at(table, "refine", "coarsen");
+        if let Some(c) = coarsen {
+            if !(0.0..1.0).contains(&c) {
+                let span = self
+                    .entry(table, "refine", "coarsen")
+                    .and_then(|e| e.span());
+                self.error(
+                    span,
+                    "refine.coarsen",
+                    format!("the coarsening fraction of Σ η² must lie in [0, 1), found {c}"),
+                    Some("e.g. `coarsen = 0.1` merges back the sibling groups holding at most a tenth of the squared indicator; 0 never coarsens".into()),
+                );
+            }
+        }
         match self.string_at(table, "refine", "strategy").as_deref() {
             None | Some("uniform") => {}
             Some("adaptive") => {
                 spec.strategy = Strategy::Adaptive {
                     theta: theta.unwrap_or(0.5),
+                    coarsen: coarsen.filter(|c| (0.0..1.0).contains(c)).unwrap_or(0.0),
                 }
             }
             Some("divide-longest-axis") => spec.strategy = Strategy::DivideLongestAxis,
@@ -517,9 +532,27 @@ impl Reader {
                 );
             }
         }
-        if theta.is_some() && !matches!(spec.strategy, Strategy::Adaptive { .. }) {
+        for (key, value) in [("theta", theta), ("coarsen", coarsen)] {
+            if value.is_some() {
+                self.adaptive_only(table, key, &spec);
+            }
+        }
+        self.refine_steps(table, entry, spec)
+    }
+
+    /// A key of the adaptive strategy (`theta`, `coarsen`) given with
+    /// another strategy: an error when both come from the same place, a
+    /// warning when the command line switched the strategy of an adaptive
+    /// file.
+    fn adaptive_only(&mut self, table: &dyn TableLike, key: &str, spec: &RefineSpec) {
+        let name = format!("refine.{key}");
+        let what = match key {
+            "theta" => "marks cells",
+            _ => "coarsens cells",
+        };
+        if !matches!(spec.strategy, Strategy::Adaptive { .. }) {
             let span = self
-                .entry(table, "refine", "theta")
+                .entry(table, "refine", key)
                 .and_then(|e| e.key_span.clone());
             // A θ written in the file for its adaptive strategy is left
             // unused, not wrong, when the command line chose another
@@ -527,28 +560,36 @@ impl Reader {
             // uniform`): the file still reads as written. A θ and a
             // non-adaptive strategy from the same source contradict.
             let strategy_from_command_line =
-                self.collector.is_set("refine.strategy") && !self.collector.is_set("refine.theta");
+                self.collector.is_set("refine.strategy") && !self.collector.is_set(&name);
             if strategy_from_command_line {
                 let strategy = self
                     .string_at(table, "refine", "strategy")
                     .unwrap_or_default();
                 self.collector.warning(
                     span,
-                    "refine.theta",
+                    &name,
                     format!(
-                        "unused: the command line sets strategy \"{strategy}\", and only the adaptive strategy marks cells"
+                        "unused: the command line sets strategy \"{strategy}\", and only the adaptive strategy {what}"
                     ),
                     None,
                 );
             } else {
                 self.error(
                     span,
-                    "refine.theta",
-                    "only the adaptive strategy marks cells",
-                    Some("remove `theta`, or set `strategy = \"adaptive\"`".into()),
+                    &name,
+                    format!("only the adaptive strategy {what}"),
+                    Some(format!("remove `{key}`, or set `strategy = \"adaptive\"`")),
                 );
             }
         }
+    }
+
+    fn refine_steps(
+        &mut self,
+        table: &dyn TableLike,
+        entry: Entry<'_>,
+        mut spec: RefineSpec,
+    ) -> Option<RefineSpec> {
         match self.entry(table, "refine", "steps") {
             Some(e) => match e.item.as_integer() {
                 Some(n) if (0..=20).contains(&n) => spec.steps = n as usize,
