@@ -562,18 +562,7 @@ fn cell_edges(complex: &Complex, c: usize) -> Vec<(usize, usize)> {
     let n = complex.dim();
     let mut cells = vec![c];
     for p in (2..=n).rev() {
-        let csc = complex.boundary_csc(p);
-        let mut next: Vec<usize> = cells
-            .iter()
-            .flat_map(|&j| {
-                csc.outer_view(j)
-                    .map(|v| v.indices().to_vec())
-                    .unwrap_or_default()
-            })
-            .collect();
-        next.sort_unstable();
-        next.dedup();
-        cells = next;
+        cells = crate::split::makes::facets_of_all(&cells, complex.boundary_csc(p));
     }
     cells
         .into_iter()

@@ -590,7 +590,7 @@ fn voronoi_virtual_elements() {
 fn refinement_cases_run_as_shipped() {
     // l-shape-adaptive: 8 Dörfler steps. Columns: step, cells, unknowns,
     // estimator, L2, max and gradient errors, CG iterations, start
-    // residual, marked.
+    // residual, marked, coarsened.
     let (stdout, _) = run_case("cases/l-shape-adaptive.toml", &[], "l-shape-adaptive");
     let rows: Vec<Vec<&str>> = stdout
         .lines()

@@ -133,18 +133,22 @@ pub fn split_by_makes(
 fn cell_vertices(boundaries: &[CsMat<i8>], p: usize, c: usize) -> Vec<usize> {
     let mut cells = vec![c];
     for q in (1..=p).rev() {
-        let csc = boundaries[q - 1].to_csc();
-        let mut next: Vec<usize> = cells
-            .iter()
-            .flat_map(|&j| {
-                csc.outer_view(j)
-                    .map(|v| v.indices().to_vec())
-                    .unwrap_or_default()
-            })
-            .collect();
-        next.sort_unstable();
-        next.dedup();
-        cells = next;
+        cells = facets_of_all(&cells, &boundaries[q - 1].to_csc());
     }
     cells
+}
+
+/// The facets of `cells` (sorted, once each) through ∂ stored by columns.
+pub(crate) fn facets_of_all(cells: &[usize], csc: &CsMat<i8>) -> Vec<usize> {
+    let mut next: Vec<usize> = cells
+        .iter()
+        .flat_map(|&j| {
+            csc.outer_view(j)
+                .map(|v| v.indices().to_vec())
+                .unwrap_or_default()
+        })
+        .collect();
+    next.sort_unstable();
+    next.dedup();
+    next
 }

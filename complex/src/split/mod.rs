@@ -48,7 +48,7 @@
 //! ```
 
 mod cut;
-mod makes;
+pub(crate) mod makes;
 mod round;
 mod transfer;
 
