@@ -244,3 +244,23 @@ fn check_refuses_what_cannot_grow() -> Result {
     )?;
     Ok(())
 }
+
+/// A growth case without `[time]` is told so in its own kind's terms.
+#[test]
+fn a_growth_case_without_time_is_refused_in_its_terms() {
+    let dir = Scratch::new("growth_without_time");
+    std::fs::create_dir_all(&*dir).unwrap();
+    let path = dir.join("filament.toml");
+    std::fs::write(
+        &path,
+        "[mesh]\ngenerator = \"interval\"\nn = [4]\n\n[problem]\nkind = \"growth\"\nmethod = \"fv\"\ninitial = 1\n\n[growth]\nvelocity = [\"x\"]\ndivide_above = 0.5\n",
+    )
+    .unwrap();
+    let out = hasse(&["check", path.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("no [time] table: a growth problem steps in time"),
+        "{stderr}"
+    );
+}

@@ -23,14 +23,16 @@ pub(super) const SCHEMES: &[&str] = &["backward-euler", "crank-nicolson"];
 pub(super) const MAX_STEPS: i64 = 10_000_000;
 
 impl Reader {
-    /// The `[time]` table of a heat problem.
+    /// The `[time]` table of a transient problem (heat, growth, transport
+    /// in time).
     pub(super) fn time(&mut self, root: &dyn TableLike) -> Option<TimeSpec> {
         let Some((table, entry)) = self.subtable(root, "", "time") else {
             if root.get("time").is_none() {
+                let kind = super::kinds::problem_kind(root).to_string();
                 self.error(
                     None,
                     "time",
-                    "no [time] table: a heat problem steps in time",
+                    format!("no [time] table: a {kind} problem steps in time"),
                     Some("add [time] with `dt = 0.01` and `steps = 100` (or `end = 1.0`)".into()),
                 );
             }
