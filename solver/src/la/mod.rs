@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 
 pub mod direct;
+pub(crate) mod disjoint;
 pub mod eigen;
 pub mod fixed;
 pub mod iterative;

@@ -35,6 +35,7 @@
 
 use super::assemble::CellConductivity;
 use super::*;
+use crate::la::disjoint::DisjointSets;
 use std::collections::HashMap;
 
 /// The flux through a set of (n−1)-cells ([`Diffusion::flux_across`]).
@@ -303,14 +304,7 @@ fn interface_sides(complex: &Complex, faces: &[usize]) -> InterfaceSides {
             .map(|r| r.indices().to_vec())
             .unwrap_or_default();
         let local = |c: usize| around.binary_search(&c).ok();
-        let mut parent: Vec<usize> = (0..around.len()).collect();
-        fn root(parent: &mut [usize], mut a: usize) -> usize {
-            while parent[a] != a {
-                parent[a] = parent[parent[a]];
-                a = parent[a];
-            }
-            a
-        }
+        let mut sides = DisjointSets::new(around.len());
         let at_vertex: Vec<usize> = face_star
             .outer_view(v)
             .map(|r| r.indices().to_vec())
@@ -321,8 +315,7 @@ fn interface_sides(complex: &Complex, faces: &[usize]) -> InterfaceSides {
             }
             if let [(a, _), (b, _)] = cells_of(f)[..] {
                 if let (Some(a), Some(b)) = (local(a), local(b)) {
-                    let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
-                    parent[ra] = rb;
+                    sides.join(a, b);
                 }
             }
         }
@@ -337,7 +330,7 @@ fn interface_sides(complex: &Complex, faces: &[usize]) -> InterfaceSides {
             let (Some(plus), Some(minus)) = (plus.and_then(local), minus.and_then(local)) else {
                 continue;
             };
-            let (rp, rm) = (root(&mut parent, plus), root(&mut parent, minus));
+            let (rp, rm) = (sides.root(plus), sides.root(minus));
             if rp == rm {
                 if result.ends.last() != Some(&v) {
                     result.ends.push(v);
@@ -346,7 +339,7 @@ fn interface_sides(complex: &Complex, faces: &[usize]) -> InterfaceSides {
                 split.push((f, rp, rm));
             }
         }
-        let roots: Vec<usize> = (0..around.len()).map(|l| root(&mut parent, l)).collect();
+        let roots: Vec<usize> = (0..around.len()).map(|l| sides.root(l)).collect();
         let mut side_of_root: HashMap<usize, usize> = HashMap::new();
         for &(f, rp, _) in &split {
             let side = *side_of_root.entry(rp).or_insert_with(|| {

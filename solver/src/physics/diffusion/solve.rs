@@ -4,6 +4,7 @@
 //! the free unknowns.
 
 use super::*;
+use crate::la::disjoint::DisjointSets;
 use crate::la::fixed::FixedSplit;
 use std::sync::Arc;
 
@@ -20,14 +21,7 @@ pub(super) fn check_anchored(
     fixed: &[Option<f64>],
 ) -> Result<(), DiffusionError> {
     let size = matrix.ncols();
-    let mut parent: Vec<usize> = (0..size).collect();
-    pub(super) fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
+    let mut parts = DisjointSets::new(size);
     let free = |i: usize| fixed.get(i).is_none_or(Option::is_none);
     for c in 0..size {
         if !free(c) {
@@ -38,8 +32,7 @@ pub(super) fn check_anchored(
             .zip(&matrix.val()[matrix.col_range(c)])
         {
             if r != c && v != 0.0 && free(r) {
-                let (a, b) = (root(&mut parent, r), root(&mut parent, c));
-                parent[a] = b;
+                parts.join(r, c);
             }
         }
     }
@@ -66,7 +59,7 @@ pub(super) fn check_anchored(
     let mut scale = vec![0.0f64; size];
     let mut first = vec![usize::MAX; size];
     for i in (0..size).filter(|&i| free(i)) {
-        let p = root(&mut parent, i);
+        let p = parts.root(i);
         if first[p] == usize::MAX {
             first[p] = i;
         }

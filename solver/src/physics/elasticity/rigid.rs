@@ -2,6 +2,7 @@
 //! components hold every one of them on every connected part of the mesh.
 
 use super::ElasticityError;
+use crate::la::disjoint::DisjointSets;
 use hasse_complex::Complex;
 use nalgebra::DMatrix;
 
@@ -52,23 +53,15 @@ fn modes_on(complex: &Complex, part: &[usize]) -> Vec<Vec<f64>> {
 /// Connected parts of the edge graph, as vertex lists.
 fn parts(complex: &Complex) -> Vec<Vec<usize>> {
     let vertices = complex.cell_count(0);
-    let mut parent: Vec<usize> = (0..vertices).collect();
-    fn root(parent: &mut [usize], mut v: usize) -> usize {
-        while parent[v] != v {
-            parent[v] = parent[parent[v]];
-            v = parent[v];
-        }
-        v
-    }
+    let mut sets = DisjointSets::new(vertices);
     for e in 0..complex.cell_count(1) {
         let ends = complex.cell_vertices(1, e);
-        let (a, b) = (root(&mut parent, ends[0]), root(&mut parent, ends[1]));
-        parent[a] = b;
+        sets.join(ends[0], ends[1]);
     }
     let mut index = vec![usize::MAX; vertices];
     let mut out: Vec<Vec<usize>> = Vec::new();
     for v in 0..vertices {
-        let r = root(&mut parent, v);
+        let r = sets.root(v);
         if index[r] == usize::MAX {
             index[r] = out.len();
             out.push(Vec::new());
